@@ -1,0 +1,25 @@
+from setuptools import find_packages, setup
+
+package_name = 'multilift_sim'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='multilift developers',
+    maintainer_email='dev@multilift.dev',
+    description='Formation DAE simulator node, physics core and bag recorder of multilift.',
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'sim_node = multilift_sim.sim_node:main',
+            'recorder_node = multilift_sim.recorder_node:main',
+        ],
+    },
+)

@@ -1,0 +1,161 @@
+"""Cascade multirotor control (seed Ch. 3): position -> attitude setpoint and thrust -> torques
+-> rotor speeds, saturated to the vehicle's [omega_min, omega_max].
+
+World frame z up, body frame FLU, ZYX Euler angles (docs/conventions.md). Pure numpy.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from multilift_sim.allocation import allocation_matrix
+from multilift_sim.multirotor import MultirotorParams
+from multilift_sim.scenario import ControlConfig
+
+E_Z = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True)
+class UavState:
+    """What a controller measures of one UAV, world frame."""
+    position: np.ndarray    # [m]
+    velocity: np.ndarray    # [m/s]
+    euler: np.ndarray       # (roll, pitch, yaw) [rad]
+    body_rates: np.ndarray  # body angular velocity, FLU [rad/s]
+
+
+@dataclass(frozen=True)
+class ControlOutput:
+    """One tick of a controller's answer."""
+    rotor_speeds: np.ndarray      # after saturation [rad/s]
+    saturated: np.ndarray         # True where the request left [omega_min, omega_max]
+    attitude_setpoint: np.ndarray  # (roll, pitch, yaw) asked of the inner loop [rad]
+    thrust: float                 # collective thrust asked of the rotors [N]
+
+
+def attitude_from_force(force: np.ndarray, yaw: float,
+                        max_tilt: float = math.radians(89.0)) -> tuple[float, float, float]:
+    """Roll and pitch setpoints that point the thrust along `force` (world) at heading `yaw`.
+
+    Seed Eq. 3.13 with u_T = |force|: R e_z = (c_phi s_theta c_psi + s_phi s_psi,
+    c_phi s_theta s_psi - s_phi c_psi, c_phi c_theta) for ZYX angles. The tilt is limited to
+    `max_tilt` by shrinking the horizontal part. Returns (roll [rad], pitch [rad], thrust [N]).
+    """
+    f = np.asarray(force, dtype=float).copy()
+    f[2] = max(f[2], 1e-6)
+    horizontal = math.hypot(f[0], f[1])
+    limit = f[2] * math.tan(max_tilt)
+    if horizontal > limit:
+        f[:2] *= limit / horizontal
+    thrust = float(np.linalg.norm(f))
+    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
+    roll = math.asin(max(-1.0, min(1.0, (f[0] * s_psi - f[1] * c_psi) / thrust)))
+    pitch = math.atan2(f[0] * c_psi + f[1] * s_psi, f[2])
+    return roll, pitch, thrust
+
+
+def wrap_angle(angle: np.ndarray | float) -> np.ndarray | float:
+    """Angle wrapped to [-pi, pi)."""
+    return (np.asarray(angle) + math.pi) % (2 * math.pi) - math.pi
+
+
+class RotorMixer:
+    """Body wrench -> rotor speeds with saturation (inverse of seed Eq. 2.14, Eq. 2.15).
+
+    Attitude comes first: when a rotor would leave [omega_min, omega_max], the collective part is
+    shifted (equal omega^2 on every rotor changes thrust only) to bring the request inside; what
+    still does not fit is clipped. `saturated` flags the rotors whose request was out of range.
+    """
+
+    def __init__(self, vehicle: MultirotorParams):
+        self.matrix = allocation_matrix(vehicle.frame_type, vehicle.arm_length,
+                                        vehicle.thrust_coefficient, vehicle.moment_coefficient)
+        self.pinv = np.linalg.pinv(self.matrix)
+        self.square_min = vehicle.rotor_speed_min ** 2
+        self.square_max = vehicle.rotor_speed_max ** 2
+        self.collective = self.pinv @ np.array([1.0, 0.0, 0.0, 0.0])  # omega^2 per newton
+
+    def rotor_speeds(self, thrust: float, torque: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(omega [rad/s], saturated) for collective thrust [N] and body torque [N m]."""
+        request = self.pinv @ np.concatenate(([thrust], torque))
+        saturated = (request > self.square_max) | (request < self.square_min)
+        squares = request
+        if saturated.any():
+            spread = request.max() - request.min()
+            if spread <= self.square_max - self.square_min:
+                # shift along the collective direction until every rotor fits
+                high = (request.max() - self.square_max) / self.collective[np.argmax(request)]
+                low = (self.square_min - request.min()) / self.collective[np.argmin(request)]
+                shift = -high if high > 0 else (low if low > 0 else 0.0)
+                squares = request + shift * self.collective
+            squares = np.clip(squares, self.square_min, self.square_max)
+        return np.sqrt(squares), saturated
+
+
+class CascadeController:
+    """Leader controller: tracks a position reference (seed Ch. 3 cascade).
+
+    Outer loop: PID on position with reference velocity and acceleration feed-forward gives the
+    force the thrust must produce; the gravity feed-forward uses `hover_mass` (the UAV and its
+    static share of the payload). The cable pull beyond that is a disturbance the integral
+    absorbs, as in the seed. Inner loop: PD on Euler angles -> body torques (J-scaled) plus the
+    gyroscopic term. Then `RotorMixer`.
+    """
+
+    def __init__(self, vehicle: MultirotorParams, gains: ControlConfig, hover_mass: float,
+                 gravity: float):
+        self.vehicle = vehicle
+        self.gains = gains
+        self.hover_mass = hover_mass
+        self.gravity = gravity
+        self.inertia = np.asarray(vehicle.inertia, dtype=float)
+        self.mixer = RotorMixer(vehicle)
+        self.integral = np.zeros(3)
+        self.integral_limit = 0.5 * gravity  # [m/s^2] of integral authority
+        self._t_prev: float | None = None
+
+    def position_force(self, t: float, state: UavState, position_ref: np.ndarray,
+                       velocity_ref: np.ndarray, acceleration_ref: np.ndarray) -> np.ndarray:
+        """Force the thrust should produce, world frame [N]."""
+        dt = 0.0 if self._t_prev is None else max(0.0, t - self._t_prev)
+        self._t_prev = t
+        error = position_ref - state.position
+        self.integral = np.clip(self.integral + np.asarray(self.gains.position_ki) * error * dt,
+                                -self.integral_limit, self.integral_limit)
+        accel = (acceleration_ref + np.asarray(self.gains.position_kp) * error
+                 + np.asarray(self.gains.position_kd) * (velocity_ref - state.velocity)
+                 + self.integral)
+        return self.hover_mass * (accel + self.gravity * E_Z)
+
+    def attitude_torque(self, state: UavState, setpoint: np.ndarray) -> np.ndarray:
+        """Body torque [N m] driving the Euler angles to `setpoint`."""
+        error = wrap_angle(np.asarray(setpoint) - state.euler)
+        rates = state.body_rates
+        accel = np.asarray(self.gains.attitude_kp) * error - np.asarray(self.gains.attitude_kd) \
+            * rates
+        return self.inertia * accel + np.cross(rates, self.inertia * rates)
+
+    def command(self, state: UavState, force: np.ndarray, yaw: float) -> ControlOutput:
+        """Rotor speeds that produce `force` (world) at heading `yaw`."""
+        roll, pitch, thrust = attitude_from_force(force, yaw, self.gains.max_tilt)
+        setpoint = np.array([roll, pitch, yaw])
+        # the thrust acts along the current body z: ask for the part along it
+        torque = self.attitude_torque(state, setpoint)
+        speeds, saturated = self.mixer.rotor_speeds(thrust, torque)
+        return ControlOutput(speeds, saturated, setpoint, thrust)
+
+    def update(self, t: float, state: UavState, position_ref: np.ndarray,
+               velocity_ref: np.ndarray, acceleration_ref: np.ndarray,
+               yaw_ref: float = 0.0) -> ControlOutput:
+        """One control tick at simulated time t [s]."""
+        force = self.position_force(t, state, position_ref, velocity_ref, acceleration_ref)
+        return self.command(state, force, yaw_ref)
+
+
+def balancing_rotor_speed(vehicle: MultirotorParams, supported_mass: float,
+                          gravity: float) -> float:
+    """Equal rotor speed whose thrust carries `supported_mass` [kg] in hover [rad/s]."""
+    per_rotor = supported_mass * gravity / vehicle.n_rotors
+    return math.sqrt(per_rotor / vehicle.thrust_coefficient)

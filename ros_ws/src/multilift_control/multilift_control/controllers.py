@@ -1,0 +1,65 @@
+"""The controllers a scenario can pick (`control.mode`), behind one `update(t, state)` call.
+
+A controller answers a UAV state at simulated time t [s] with a `ControlOutput` and the
+reference it tracked (or None).
+"""
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from multilift_control.cascade import (CascadeController, ControlOutput, UavState,
+                                       balancing_rotor_speed)
+from multilift_control.mission import MissionPath, Reference
+from multilift_sim.scenario import Scenario
+
+
+class Controller(Protocol):
+    def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
+        ...
+
+
+class ConstantRotorSpeed:
+    """Holds every rotor at one speed (the seed's open-loop test of §4.1)."""
+
+    def __init__(self, scenario: Scenario, index: int):
+        vehicle = scenario.uavs[index].vehicle
+        speed = scenario.control.constant_rotor_speed
+        if speed is None:  # balance the whole formation's weight, shared equally
+            mass = sum(u.vehicle.mass for u in scenario.uavs) + scenario.payload.mass
+            speed = balancing_rotor_speed(vehicle, mass / scenario.n_uavs,
+                                          scenario.simulation.gravity)
+        clipped = min(max(speed, vehicle.rotor_speed_min), vehicle.rotor_speed_max)
+        self.output = ControlOutput(
+            rotor_speeds=np.full(vehicle.n_rotors, clipped),
+            saturated=np.full(vehicle.n_rotors, clipped != speed),
+            attitude_setpoint=np.zeros(3),
+            thrust=vehicle.n_rotors * vehicle.thrust_coefficient * clipped ** 2)
+
+    def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
+        return self.output, None
+
+
+class MissionLeader:
+    """The leader: cascade control along the mission path."""
+
+    def __init__(self, scenario: Scenario, index: int):
+        uav = scenario.uavs[index]
+        hover_mass = uav.vehicle.mass + scenario.payload.mass / scenario.n_uavs
+        self.cascade = CascadeController(uav.vehicle, scenario.control, hover_mass,
+                                         scenario.simulation.gravity)
+        self.path = MissionPath(scenario.mission)
+
+    def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
+        ref = self.path(t)
+        out = self.cascade.update(t, state, ref.position, ref.velocity, ref.acceleration)
+        return out, ref
+
+
+LEADER_CONTROLLERS = {'cascade': MissionLeader, 'constant_rotor_speed': ConstantRotorSpeed}
+
+
+def make_controller(scenario: Scenario, index: int) -> Controller:
+    """The leader's controller named by the scenario's control.mode."""
+    return LEADER_CONTROLLERS[scenario.control.mode](scenario, index)

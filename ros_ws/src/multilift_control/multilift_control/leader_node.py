@@ -1,0 +1,105 @@
+"""Leader node: tracks the mission path with the cascade controller (seed Ch. 3).
+
+Subscribes `/uav1/odom`; for every state it answers with `/uav1/rotor_cmd` stamped with the
+state's time, and publishes what it aimed at on `/uav1/reference` (mission reference) and
+`/uav1/attitude_setpoint` (outer-loop output). Parameters: scenario, record, summary_dir.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from geometry_msgs.msg import Point, Vector3
+from multilift_msgs.msg import AttitudeSetpoint, RotorCommand, TrackingReference
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+
+from multilift_control.cascade import UavState
+from multilift_control.controllers import make_controller
+from multilift_sim import scenario as scenario_io
+from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
+                                      odometry_arrays,
+                                      run_node, uav_frame, uav_topic, wait_until, write_summary)
+
+STARTUP_TIMEOUT = 60.0  # [s] wall
+
+
+class LeaderNode(Node):
+    def __init__(self) -> None:
+        super().__init__('leader')
+        name = self.declare_parameter('scenario', '').value
+        self.record = bool(self.declare_parameter('record', False).value)
+        self.summary_dir = self.declare_parameter('summary_dir', '').value
+        if not name:
+            raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
+        self.scenario = scenario_io.load(name)
+        self.controller = make_controller(self.scenario, index=0)
+        self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(1, 'rotor_cmd'),
+                                             PUBLISHER_QOS)
+        self.ref_pub = self.create_publisher(TrackingReference, uav_topic(1, 'reference'),
+                                             PUBLISHER_QOS)
+        self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
+                                                  uav_topic(1, 'attitude_setpoint'), PUBLISHER_QOS)
+        self.create_subscription(Odometry, uav_topic(1, 'odom'), self.on_odometry, SUBSCRIBER_QOS)
+        self.max_tracking_error = 0.0
+        self.sum_sq_tracking_error = 0.0
+        self.samples = 0
+
+    def missing_peers(self) -> str | None:
+        if self.cmd_pub.get_subscription_count() < 1 + self.record:
+            return f'subscribers of {self.cmd_pub.topic_name}'
+        if self.record and min(self.ref_pub.get_subscription_count(),
+                               self.setpoint_pub.get_subscription_count()) < 1:
+            return 'the recorder'
+        return None
+
+    def on_odometry(self, msg: Odometry) -> None:
+        t_ns = ns_from_stamp(msg.header.stamp)
+        state = UavState(*odometry_arrays(msg))
+        out, reference = self.controller.update(t_ns * 1e-9, state)
+        cmd = RotorCommand()
+        cmd.header.stamp = msg.header.stamp
+        cmd.header.frame_id = uav_frame(1)
+        cmd.angular_velocity = out.rotor_speeds.tolist()
+        cmd.saturated = [bool(s) for s in out.saturated]
+        self.cmd_pub.publish(cmd)
+        setpoint = AttitudeSetpoint()
+        setpoint.header = cmd.header
+        setpoint.roll, setpoint.pitch, setpoint.yaw = (float(a) for a in out.attitude_setpoint)
+        setpoint.thrust = float(out.thrust)
+        self.setpoint_pub.publish(setpoint)
+        if reference is not None:
+            ref = TrackingReference()
+            ref.header.stamp = msg.header.stamp
+            ref.header.frame_id = 'world'
+            ref.position = Point(x=float(reference.position[0]), y=float(reference.position[1]),
+                                 z=float(reference.position[2]))
+            ref.velocity = Vector3(x=float(reference.velocity[0]),
+                                   y=float(reference.velocity[1]),
+                                   z=float(reference.velocity[2]))
+            ref.acceleration = Vector3(x=float(reference.acceleration[0]),
+                                       y=float(reference.acceleration[1]),
+                                       z=float(reference.acceleration[2]))
+            self.ref_pub.publish(ref)
+            error = float(np.linalg.norm(reference.position - state.position))
+            self.max_tracking_error = max(self.max_tracking_error, error)
+            self.sum_sq_tracking_error += error * error
+            self.samples += 1
+
+    def run(self) -> None:
+        wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
+        try:
+            self.executor.spin()
+        finally:
+            rms = math.sqrt(self.sum_sq_tracking_error / self.samples) if self.samples else 0.0
+            write_summary(self.summary_dir, 'leader', {
+                'max_tracking_error': self.max_tracking_error, 'rms_tracking_error': rms,
+                'answered_states': self.samples})
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_node(LeaderNode, lambda node: node.run(), args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

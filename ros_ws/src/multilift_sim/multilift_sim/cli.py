@@ -1,0 +1,203 @@
+"""`scripts/multilift`: the command line of multilift (what ros2cli and launch give elsewhere).
+
+    multilift run SCENARIO [--bag DIR] [--duration S] [--realtime]
+    multilift node PKG EXECUTABLE [args...]
+    multilift topic list | echo TOPIC [--once] | info TOPIC
+
+Exit codes: 0 done, 1 the run failed, 2 bad input, 130 interrupted.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from multilift_sim import scenario as scenario_io
+from multilift_sim.launcher import Child, Supervisor, find_executable
+from multilift_sim.ros_common import run_topics
+
+
+def _ros_args(params: dict) -> list[str]:
+    out = ['--ros-args']
+    for key, value in params.items():
+        if isinstance(value, bool):
+            value = 'true' if value else 'false'
+        elif isinstance(value, list):
+            value = '[' + ','.join(f"'{v}'" for v in value) + ']'
+        out += ['-p', f'{key}:={value}']
+    return out
+
+
+def _fresh_bag_dir(bag: Path) -> None:
+    """Like rosbag2 the recorder wants a new directory; an old bag there is moved aside."""
+    if bag.exists() and any(bag.iterdir()):
+        k = 1
+        while Path(f'{bag}.{k}').exists():
+            k += 1
+        bag.rename(f'{bag}.{k}')
+        print(f'note: {bag} existed; moved it to {bag}.{k}', file=sys.stderr)
+    elif bag.exists():
+        bag.rmdir()
+    bag.parent.mkdir(parents=True, exist_ok=True)
+
+
+class Progress:
+    """Simulated time and real-time factor, on one terminal line (or a line every 10 %)."""
+
+    def __init__(self, path: Path, tty: bool):
+        self.path = path
+        self.tty = tty
+        self.last_decile = -1
+
+    def __call__(self) -> None:
+        try:
+            t, t_max, wall = (float(v) for v in self.path.read_text().split())
+        except (OSError, ValueError):
+            return
+        rtf = t / wall if wall > 0 else 0.0
+        if self.tty:
+            print(f'\r  t = {t:7.2f} / {t_max:.1f} s   {rtf:5.1f}x real time ',
+                  end='', flush=True)
+        elif t_max > 0 and int(10 * t / t_max) > self.last_decile:
+            self.last_decile = int(10 * t / t_max)
+            print(f'  t = {t:.1f} / {t_max:.1f} s   {rtf:.1f}x real time', flush=True)
+
+    def close(self) -> None:
+        if self.tty:
+            print()
+
+
+def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
+    data = {}
+    for part in ('sim', 'leader'):
+        path = summary_dir / f'{part}.json'
+        if path.is_file():
+            data[part] = json.loads(path.read_text())
+    sim = data.get('sim', {})
+    lines = []
+    if sim:
+        wall = sim.get('wall_time') or 0.0
+        t = sim.get('simulated_time', 0.0)
+        lines.append(f'{name}: {t:.1f} s simulated in {wall:.1f} s wall '
+                     f'({t / wall if wall else 0:.1f}x real time)')
+        tol = scenario.simulation.constraint_tolerance
+        lines.append(f'  max |g|          {sim["max_abs_constraint"]:.3g} m^2 '
+                     f'(tolerance {tol:g})')
+        lines.append(f'  max |g_dot|      {sim["max_abs_constraint_rate"]:.3g} m^2/s')
+        for i, (w, s) in enumerate(zip(sim['max_rotor_speed'], sim['saturated_time'])):
+            limit = scenario.uavs[i].vehicle.rotor_speed_max
+            lines.append(f'  uav{i + 1} rotors      max {w:.1f} rad/s (limit {limit:g}), '
+                         f'saturated {s:.2f} s')
+        lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} N')
+    leader = data.get('leader')
+    if leader and leader.get('answered_states'):
+        lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} m, '
+                     f'rms {leader["rms_tracking_error"]:.3f} m')
+    if bag is not None:
+        lines.append(f'  bag              {bag}')
+    print('\n'.join(lines))
+    return data
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    try:
+        scenario = scenario_io.load(args.scenario)
+    except scenario_io.ScenarioError as exc:
+        print(f'error: {exc}', file=sys.stderr)
+        return 2
+    for warning in scenario.warnings:
+        print(f'warning: {warning}', file=sys.stderr)
+    if args.duration is not None and args.duration <= 0:
+        print(f'error: --duration: {args.duration} must be > 0', file=sys.stderr)
+        return 2
+    scenario_path = str(scenario_io.resolve(args.scenario).resolve())
+    work = Path(tempfile.mkdtemp(prefix=f'multilift-{scenario.name}-'))
+    summary_dir = work / 'summary'
+    record = args.bag is not None
+    bag = Path(args.bag) if record else None
+    common = {'scenario': scenario_path, 'record': record, 'summary_dir': str(summary_dir)}
+    try:
+        sim_exe = find_executable('multilift_sim', 'sim_node')
+        leader_exe = find_executable('multilift_control', 'leader_node')
+        recorder_exe = find_executable('multilift_sim', 'recorder_node')
+    except FileNotFoundError as exc:
+        print(f'error: {exc}', file=sys.stderr)
+        return 2
+    sim_params = dict(common, realtime=args.realtime, progress_file=str(work / 'progress'))
+    if args.duration is not None:
+        sim_params['duration'] = float(args.duration)
+    children = [Child('sim_node', [str(sim_exe), *_ros_args(sim_params)],
+                      work / 'sim_node.log', 'sim'),
+                Child('leader_node', [str(leader_exe), *_ros_args(common)],
+                      work / 'leader_node.log', 'controller')]
+    if record:
+        _fresh_bag_dir(bag)
+        topics = [f'{name}|{kind}' for name, kind in run_topics(scenario.n_uavs)]
+        children.append(Child('recorder_node', [str(recorder_exe), *_ros_args(
+            {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder'))
+    progress = Progress(work / 'progress', sys.stdout.isatty())
+    print(f'multilift run {scenario.name}: {scenario.n_uavs} UAV(s), '
+          f'{args.duration or scenario.simulation.duration:g} s, logs in {work}', flush=True)
+    outcome, dead = Supervisor(children).run(on_tick=progress)
+    progress()
+    progress.close()
+    if outcome == 'interrupted':
+        print('interrupted: every process stopped' + (f'; bag closed at {bag}' if bag else ''),
+              file=sys.stderr)
+        return 130
+    if outcome == 'died':
+        print(f'error: {dead.name} stopped (exit code {dead.returncode()}): '
+              f'{dead.last_error()}', file=sys.stderr)
+        if bag:
+            print(f'the other processes were stopped; bag closed at {bag}', file=sys.stderr)
+        print(f'logs: {work}', file=sys.stderr)
+        return 1
+    data = _summary(scenario.name, summary_dir, bag, scenario)
+    if bag is not None:
+        (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))
+    shutil.rmtree(work, ignore_errors=True)
+    return 0
+
+
+def cmd_node(args: argparse.Namespace) -> int:
+    from multilift_sim.cli_tools import node_main
+    return node_main([args.package, args.executable, *args.rest])
+
+
+def cmd_topic(args: argparse.Namespace) -> int:
+    from multilift_sim.cli_tools import topic_main
+    return topic_main(args.rest)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog='multilift', description=__doc__.split('\n')[0])
+    sub = parser.add_subparsers(dest='command', required=True)
+    run = sub.add_parser('run', help='run a scenario: simulator, controllers, recorder')
+    run.add_argument('scenario', help='a name in scenarios/ or a YAML path')
+    run.add_argument('--bag', help='record every topic to this rosbag2 (MCAP) directory')
+    run.add_argument('--duration', type=float, help='simulated seconds (default: scenario)')
+    run.add_argument('--realtime', action='store_true', help='pace to the wall clock')
+    run.set_defaults(func=cmd_run)
+    node = sub.add_parser('node', help='run one node, like `ros2 run`')
+    node.add_argument('package')
+    node.add_argument('executable')
+    node.add_argument('rest', nargs=argparse.REMAINDER)
+    node.set_defaults(func=cmd_node)
+    topic = sub.add_parser('topic', help='inspect live topics, like `ros2 topic`',
+                           add_help=False)
+    topic.add_argument('rest', nargs=argparse.REMAINDER)
+    topic.set_defaults(func=cmd_topic)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

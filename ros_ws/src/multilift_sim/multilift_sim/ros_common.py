@@ -1,0 +1,184 @@
+"""What every multilift node shares: QoS, time stamps, message <-> model conversions, the
+topic names, and a shutdown-safe `run_node`. This is ROS adapter code; the physics never sees it.
+"""
+from __future__ import annotations
+
+import json
+import math
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import rclpy
+from builtin_interfaces.msg import Time
+from nav_msgs.msg import Odometry
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+WORLD_FRAME = 'world'
+
+# Publishers keep their last messages for late joiners (a recorder that matched a moment late
+# still gets the start of the run); subscribers are plain reliable.
+PUBLISHER_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                           reliability=ReliabilityPolicy.RELIABLE,
+                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
+SUBSCRIBER_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                            reliability=ReliabilityPolicy.RELIABLE,
+                            durability=DurabilityPolicy.VOLATILE)
+
+
+class StartupError(RuntimeError):
+    """The graph did not come together in time; the message says what is missing."""
+
+
+def uav_topic(index: int, leaf: str) -> str:
+    """`/uav{index}/{leaf}`, index from 1 (1 is the leader)."""
+    return f'/uav{index}/{leaf}'
+
+
+def uav_frame(index: int) -> str:
+    return f'uav{index}/base_link'
+
+
+def stamp_from_ns(t_ns: int) -> Time:
+    return Time(sec=int(t_ns // 1_000_000_000), nanosec=int(t_ns % 1_000_000_000))
+
+
+def ns_from_stamp(stamp: Time) -> int:
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> tuple[float, float, float,
+                                                                          float]:
+    """(x, y, z, w) of R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+def euler_from_quaternion(x: float, y: float, z: float, w: float) -> np.ndarray:
+    """ZYX Euler angles (roll, pitch, yaw) [rad] of a unit quaternion."""
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return np.array([roll, pitch, yaw])
+
+
+def fill_odometry(msg: Odometry, t_ns: int, child_frame: str, position: np.ndarray,
+                  velocity_world: np.ndarray, euler: np.ndarray | None,
+                  rotation: np.ndarray | None, body_rates: np.ndarray | None) -> Odometry:
+    """Odometry in `world`; twist in the child frame as nav_msgs/Odometry specifies."""
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    msg.child_frame_id = child_frame
+    p = msg.pose.pose.position
+    p.x, p.y, p.z = (float(v) for v in position)
+    q = msg.pose.pose.orientation
+    if euler is None:
+        q.x, q.y, q.z, q.w = 0.0, 0.0, 0.0, 1.0
+        linear = velocity_world
+    else:
+        q.x, q.y, q.z, q.w = quaternion_from_euler(*(float(a) for a in euler))
+        linear = rotation.T @ velocity_world  # world -> body
+    v = msg.twist.twist.linear
+    v.x, v.y, v.z = (float(c) for c in linear)
+    w = msg.twist.twist.angular
+    rates = np.zeros(3) if body_rates is None else body_rates
+    w.x, w.y, w.z = (float(c) for c in rates)
+    return msg
+
+
+def odometry_arrays(msg: Odometry) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(position, velocity, euler, body_rates) of an Odometry: world position and velocity,
+    ZYX Euler angles, body (FLU) angular velocity; the twist's linear part is rotated from the
+    body frame to world."""
+    from multilift_sim.kinematics import rotation_matrix
+    p = msg.pose.pose.position
+    q = msg.pose.pose.orientation
+    euler = euler_from_quaternion(q.x, q.y, q.z, q.w)
+    v = msg.twist.twist.linear
+    w = msg.twist.twist.angular
+    velocity = rotation_matrix(euler) @ np.array([v.x, v.y, v.z])
+    return (np.array([p.x, p.y, p.z]), velocity, euler, np.array([w.x, w.y, w.z]))
+
+
+def write_summary(directory: str, name: str, data: dict) -> None:
+    """Leave this node's end-of-run figures as `<directory>/<name>.json` (no-op without one)."""
+    if directory:
+        path = Path(directory)
+        path.mkdir(parents=True, exist_ok=True)
+        (path / f'{name}.json').write_text(json.dumps(data, indent=1, sort_keys=True))
+
+
+def wait_until(node: Node, ready: Callable[[], str | None], timeout: float) -> None:
+    """Spin until `ready()` returns None (it returns what is still missing), or raise."""
+    deadline = time.monotonic() + timeout
+    missing = ready()
+    while missing is not None:
+        if time.monotonic() > deadline:
+            raise StartupError(f'{node.get_name()}: gave up after {timeout:.0f} s waiting for '
+                               f'{missing}')
+        node.executor.spin_once(timeout_sec=0.05)
+        missing = ready()
+
+
+class Fatal(Exception):
+    """A node must stop; the message is printed as one line and the exit code is 1."""
+
+
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
+def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None = None,
+             args: list[str] | None = None) -> int:
+    """Create, run and shut down a node safely (SIGINT, SIGTERM, external shutdown).
+
+    The node is added to an executor (`node.executor`). `body(node)` runs the node's own loop
+    if it has one; otherwise the node is spun.
+    Errors of kind Fatal, StartupError or ScenarioError print one line; exit code 1.
+    """
+    from multilift_sim.scenario import ScenarioError
+    rclpy.init(args=args)
+    signal.signal(signal.SIGTERM, _interrupt)
+    node = None
+    code = 0
+    executor = SingleThreadedExecutor()
+    try:
+        node = make_node()
+        executor.add_node(node)
+        if body is None:
+            executor.spin()
+        else:
+            body(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (Fatal, StartupError, ScenarioError) as exc:
+        print(f'error: {exc}', file=sys.stderr, flush=True)
+        code = 1 if not isinstance(exc, ScenarioError) else 2
+    finally:
+        if node is not None:
+            try:
+                node.destroy_node()
+            except Exception:  # noqa: BLE001 - shutting down anyway
+                pass
+        rclpy.try_shutdown()
+    return code
+
+
+def run_topics(n_uavs: int) -> list[tuple[str, str]]:
+    """Every topic a run of n UAVs publishes, with its type: what the recorder records."""
+    topics = [('/clock', 'rosgraph_msgs/msg/Clock'), ('/payload/odom', 'nav_msgs/msg/Odometry'),
+              ('/formation/state', 'multilift_msgs/msg/FormationState'),
+              (uav_topic(1, 'reference'), 'multilift_msgs/msg/TrackingReference')]
+    for i in range(1, n_uavs + 1):
+        topics += [(uav_topic(i, 'odom'), 'nav_msgs/msg/Odometry'),
+                   (uav_topic(i, 'rotor_cmd'), 'multilift_msgs/msg/RotorCommand'),
+                   (uav_topic(i, 'attitude_setpoint'), 'multilift_msgs/msg/AttitudeSetpoint')]
+    return topics

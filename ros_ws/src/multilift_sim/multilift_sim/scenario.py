@@ -1,0 +1,408 @@
+"""Scenario files: YAML in `scenarios/`, loaded and validated once into frozen dataclasses.
+
+Every scenario is written in the world frame (z up, REP-103 SI units). A bad value is one
+`ScenarioError` whose message names the file, the key, the value and the rule; the command line
+turns it into a single line on stderr and exit code 2.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import yaml
+
+from multilift_sim.allocation import FRAME_TYPES
+from multilift_sim.disturbances import Gust
+from multilift_sim.dynamics import FormationParams
+from multilift_sim.multirotor import MultirotorParams
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be run; the message says where and why."""
+
+
+CONTROL_MODES = ('cascade', 'constant_rotor_speed')
+
+
+@dataclass(frozen=True)
+class SimulationConfig:
+    duration: float                  # t_max [s]
+    physics_rate: float              # RK4 steps per second [Hz]
+    control_rate: float              # control ticks per second [Hz]; divides physics_rate
+    gravity: float                   # [m/s^2]
+    baumgarte_alpha: float           # alpha_f of seed Eq. 2.59 [1/s]
+    baumgarte_beta: float            # beta_f of seed Eq. 2.59 [1/s]
+    constraint_tolerance: float      # eps_g of Algorithm 1 [m^2]
+    constraint_rate_tolerance: float  # eps_gdot of Algorithm 1 [m^2/s]
+    command_timeout: float           # wall time the simulator waits for a rotor command [s]
+
+    @property
+    def physics_steps_per_tick(self) -> int:
+        return int(round(self.physics_rate / self.control_rate))
+
+    @property
+    def control_period(self) -> float:
+        """Time between control ticks [s]."""
+        return 1.0 / self.control_rate
+
+    @property
+    def tick_count(self) -> int:
+        """Number of control periods in the run."""
+        return int(round(self.duration * self.control_rate))
+
+
+@dataclass(frozen=True)
+class UavConfig:
+    vehicle: MultirotorParams
+    cable_length: float              # l_i [m]
+    position: tuple[float, float, float]  # initial position, world [m]
+    yaw: float                       # initial yaw [rad]
+
+
+@dataclass(frozen=True)
+class PayloadConfig:
+    mass: float                      # m_p [kg]
+    drag_coefficient: float          # c_pd of seed Eq. 2.53 [kg/m]
+    alpha: float                     # release angle alpha of seed Eq. 2.33 [rad] (n = 1)
+    beta: float                      # release angle beta of seed Eq. 2.33 [rad] (n = 1)
+
+
+@dataclass(frozen=True)
+class ControlConfig:
+    mode: str                        # 'cascade' or 'constant_rotor_speed'
+    constant_rotor_speed: float | None  # [rad/s]; None = balance the total weight
+    position_kp: tuple[float, float, float]  # [1/s^2]
+    position_kd: tuple[float, float, float]  # [1/s]
+    position_ki: tuple[float, float, float]  # [1/s^3]
+    attitude_kp: tuple[float, float, float]  # [1/s^2]
+    attitude_kd: tuple[float, float, float]  # [1/s]
+    max_tilt: float                  # [rad]
+
+
+@dataclass(frozen=True)
+class MissionSegment:
+    velocity: tuple[float, float, float]  # leader reference velocity, world [m/s]
+    end_time: float                  # the segment ends at this simulated time [s]
+
+
+@dataclass(frozen=True)
+class MissionConfig:
+    start: tuple[float, float, float]  # reference position at t = 0, world [m]
+    segments: tuple[MissionSegment, ...]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    description: str
+    source: str                      # the file it came from
+    simulation: SimulationConfig
+    uavs: tuple[UavConfig, ...]
+    payload: PayloadConfig
+    gusts: tuple[Gust, ...]
+    control: ControlConfig
+    mission: MissionConfig
+    warnings: tuple[str, ...] = field(default=())
+
+    @property
+    def n_uavs(self) -> int:
+        return len(self.uavs)
+
+    def formation_params(self, baumgarte_alpha: float | None = None,
+                         baumgarte_beta: float | None = None) -> FormationParams:
+        """Physics parameters of the formation DAE (optionally other Baumgarte gains)."""
+        sim = self.simulation
+        return FormationParams(
+            uavs=tuple(u.vehicle for u in self.uavs),
+            cable_lengths=tuple(u.cable_length for u in self.uavs),
+            payload_mass=self.payload.mass,
+            payload_drag_coefficient=self.payload.drag_coefficient,
+            gusts=self.gusts,
+            gravity=sim.gravity,
+            baumgarte_alpha=sim.baumgarte_alpha if baumgarte_alpha is None else baumgarte_alpha,
+            baumgarte_beta=sim.baumgarte_beta if baumgarte_beta is None else baumgarte_beta,
+        )
+
+    def total_weight(self) -> float:
+        """Weight of every UAV and the payload [N]."""
+        mass = sum(u.vehicle.mass for u in self.uavs) + self.payload.mass
+        return mass * self.simulation.gravity
+
+
+# --------------------------------------------------------------------------------------------
+# Reading with checks. `_Section` walks one mapping, remembers which keys were read and rejects
+# the rest, so a typo is an error rather than a silently ignored key.
+
+
+class _Section:
+    def __init__(self, data: Any, path: str, where: str):
+        if not isinstance(data, dict):
+            raise ScenarioError(f'{where}: {path or "top level"}: expected a mapping, '
+                                f'got {type(data).__name__}')
+        self.data = data
+        self.path = path
+        self.where = where
+        self.used: set[str] = set()
+
+    def key(self, name: str) -> str:
+        return f'{self.path}.{name}' if self.path else name
+
+    def fail(self, name: str, value: Any, rule: str) -> ScenarioError:
+        return ScenarioError(f'{self.where}: {self.key(name)}: {value!r} {rule}')
+
+    def has(self, name: str) -> bool:
+        return name in self.data
+
+    def raw(self, name: str, default: Any = ...) -> Any:
+        self.used.add(name)
+        if name not in self.data:
+            if default is ...:
+                raise ScenarioError(f'{self.where}: {self.key(name)}: missing key')
+            return default
+        return self.data[name]
+
+    def number(self, name: str, default: Any = ..., check: Callable[[float], bool] | None = None,
+               rule: str = '') -> float:
+        value = self.raw(name, default)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(name, value, 'must be a number')
+        value = float(value)
+        if not math.isfinite(value):
+            raise self.fail(name, value, 'must be finite')
+        if check is not None and not check(value):
+            raise self.fail(name, value, rule)
+        return value
+
+    def positive(self, name: str, default: Any = ...) -> float:
+        return self.number(name, default, lambda v: v > 0, 'must be > 0')
+
+    def non_negative(self, name: str, default: Any = ...) -> float:
+        return self.number(name, default, lambda v: v >= 0, 'must be >= 0')
+
+    def vector(self, name: str, default: Any = ..., length: int = 3,
+               check: Callable[[float], bool] | None = None, rule: str = '') -> tuple[float, ...]:
+        value = self.raw(name, default)
+        if (not isinstance(value, (list, tuple)) or len(value) != length
+                or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)):
+            raise self.fail(name, value, f'must be a list of {length} numbers')
+        out = tuple(float(v) for v in value)
+        if not all(math.isfinite(v) for v in out):
+            raise self.fail(name, value, 'must be finite')
+        if check is not None and not all(check(v) for v in out):
+            raise self.fail(name, value, rule)
+        return out
+
+    def text(self, name: str, default: Any = ..., choices: tuple[str, ...] | None = None) -> str:
+        value = self.raw(name, default)
+        if not isinstance(value, str):
+            raise self.fail(name, value, 'must be a string')
+        if choices is not None and value not in choices:
+            raise self.fail(name, value, f'must be one of {", ".join(choices)}')
+        return value
+
+    def section(self, name: str, default: Any = ...) -> '_Section':
+        return _Section(self.raw(name, default), self.key(name), self.where)
+
+    def done(self) -> None:
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            raise ScenarioError(f'{self.where}: {self.key(unknown[0])}: unknown key '
+                                f'(known here: {", ".join(sorted(self.used))})')
+
+
+VEHICLE_KEYS = ('mass', 'inertia', 'frame_type', 'arm_length', 'thrust_coefficient',
+                'moment_coefficient', 'rotor_speed_min', 'rotor_speed_max')
+
+
+def _vehicle(sec: _Section, base: dict[str, Any] | None) -> MultirotorParams:
+    """A MultirotorParams from `sec`, falling back to `base` (the shared `vehicle` section)."""
+    def default(key: str) -> Any:
+        return ... if base is None else base[key]
+    mass = sec.positive('mass', default('mass'))
+    inertia = sec.vector('inertia', default('inertia'), check=lambda v: v > 0, rule='must be > 0')
+    frame_type = sec.text('frame_type', default('frame_type'), choices=FRAME_TYPES)
+    arm_length = sec.positive('arm_length', default('arm_length'))
+    k_t = sec.positive('thrust_coefficient', default('thrust_coefficient'))
+    k_d = sec.positive('moment_coefficient', default('moment_coefficient'))
+    w_min = sec.non_negative('rotor_speed_min', default('rotor_speed_min'))
+    w_max = sec.number('rotor_speed_max', default('rotor_speed_max'), lambda v: v > w_min,
+                       f'must be > rotor_speed_min ({w_min})')
+    return MultirotorParams(mass=mass, inertia=inertia, frame_type=frame_type,
+                            arm_length=arm_length, thrust_coefficient=k_t,
+                            moment_coefficient=k_d, rotor_speed_min=w_min, rotor_speed_max=w_max)
+
+
+def _inertia_warning(where: str, key: str, inertia: tuple[float, ...]) -> list[str]:
+    a, b, c = inertia
+    if a + b < c or a + c < b or b + c < a:
+        return [f'{where}: {key}: {list(inertia)} breaks the triangle inequality of a rigid '
+                'body (the seed\'s own Table 4.1 value does); used as given']
+    return []
+
+
+def _scenario(data: Any, where: str) -> Scenario:
+    top = _Section(data, '', where)
+    name = top.text('name')
+    description = top.text('description', '')
+    top.text('frame', 'world', choices=('world',))
+
+    s = top.section('simulation')
+    duration = s.positive('duration')
+    physics_rate = s.positive('physics_rate')
+    control_rate = s.number('control_rate', ..., lambda v: 0 < v <= physics_rate,
+                            f'must be > 0 and <= physics_rate ({physics_rate})')
+    ratio = physics_rate / control_rate
+    if abs(ratio - round(ratio)) > 1e-9:
+        raise s.fail('control_rate', control_rate,
+                     f'must divide physics_rate ({physics_rate}) into a whole number of steps')
+    sim = SimulationConfig(
+        duration=duration, physics_rate=physics_rate, control_rate=control_rate,
+        gravity=s.positive('gravity', 9.81),
+        baumgarte_alpha=s.non_negative('baumgarte_alpha'),
+        baumgarte_beta=s.non_negative('baumgarte_beta'),
+        constraint_tolerance=s.positive('constraint_tolerance'),
+        constraint_rate_tolerance=s.positive('constraint_rate_tolerance'),
+        command_timeout=s.positive('command_timeout', 5.0))
+    s.done()
+
+    v = top.section('vehicle')
+    base_vehicle = dataclasses.asdict(_vehicle(v, None))
+    v.done()
+    warnings = _inertia_warning(where, 'vehicle.inertia', tuple(base_vehicle['inertia']))
+
+    uav_list = top.raw('uavs')
+    if not isinstance(uav_list, list) or not uav_list:
+        raise ScenarioError(f'{where}: uavs: {uav_list!r} must be a non-empty list')
+    uavs = []
+    for i, entry in enumerate(uav_list):
+        u = _Section(entry, f'uavs[{i}]', where)
+        vehicle = _vehicle(u, base_vehicle)
+        if vehicle.inertia != tuple(base_vehicle['inertia']):
+            warnings += _inertia_warning(where, u.key('inertia'), vehicle.inertia)
+        uavs.append(UavConfig(vehicle=vehicle, cable_length=u.positive('cable_length'),
+                              position=u.vector('position', [0.0, 0.0, 0.0]),
+                              yaw=u.number('yaw', 0.0)))
+        u.done()
+
+    p = top.section('payload')
+    payload = PayloadConfig(mass=p.positive('mass'),
+                            drag_coefficient=p.non_negative('drag_coefficient', 0.0),
+                            alpha=math.radians(p.number('alpha_deg', 0.0, lambda a: abs(a) < 90,
+                                                        'must be within (-90, 90) degrees')),
+                            beta=math.radians(p.number('beta_deg', 0.0, lambda a: abs(a) < 90,
+                                                       'must be within (-90, 90) degrees')))
+    p.done()
+    if len(uavs) > 1 and (payload.alpha or payload.beta):
+        raise p.fail('alpha_deg', payload.alpha, 'release angles are for n = 1 only')
+
+    gusts = []
+    for i, entry in enumerate(top.raw('gusts', [])):
+        g = _Section(entry, f'gusts[{i}]', where)
+        direction = g.vector('direction')
+        norm = math.sqrt(sum(c * c for c in direction))
+        if norm == 0:
+            raise g.fail('direction', list(direction), 'must not be zero')
+        gusts.append(Gust(center=g.vector('center', length=2),
+                          direction=tuple(c / norm for c in direction),
+                          gradient_distance=g.positive('gradient_distance'),
+                          reference_speed=g.non_negative('reference_speed')))
+        g.done()
+
+    c = top.section('control')
+    mode = c.text('mode', choices=CONTROL_MODES)
+    constant = c.raw('constant_rotor_speed', None)
+    if constant is not None:
+        constant = c.positive('constant_rotor_speed')
+    gains_pos = c.section('position_gains')
+    gains_att = c.section('attitude_gains')
+    nonneg = dict(check=lambda x: x >= 0, rule='must be >= 0')
+    control = ControlConfig(
+        mode=mode, constant_rotor_speed=constant,
+        position_kp=gains_pos.vector('kp', **nonneg), position_kd=gains_pos.vector('kd', **nonneg),
+        position_ki=gains_pos.vector('ki', **nonneg),
+        attitude_kp=gains_att.vector('kp', **nonneg), attitude_kd=gains_att.vector('kd', **nonneg),
+        max_tilt=math.radians(c.number('max_tilt_deg', 30.0, lambda a: 0 < a < 90,
+                                       'must be within (0, 90) degrees')))
+    gains_pos.done()
+    gains_att.done()
+    c.done()
+
+    m = top.section('mission')
+    start = m.vector('start', list(uavs[0].position))
+    segments = []
+    t_prev = 0.0
+    for i, entry in enumerate(m.raw('segments', [])):
+        seg = _Section(entry, f'mission.segments[{i}]', where)
+        velocity = seg.vector('velocity')
+        if seg.has('duration') == seg.has('until'):
+            raise ScenarioError(f'{where}: {seg.path}: give exactly one of duration, until')
+        if seg.has('duration'):
+            end = t_prev + seg.positive('duration')
+        else:
+            end = seg.number('until', ..., lambda t: t > t_prev, f'must be > {t_prev}')
+        seg.done()
+        segments.append(MissionSegment(velocity=velocity, end_time=end))
+        t_prev = end
+    m.done()
+    top.done()
+
+    scenario = Scenario(name=name, description=description, source=where, simulation=sim,
+                        uavs=tuple(uavs), payload=payload, gusts=tuple(gusts), control=control,
+                        mission=MissionConfig(start=start, segments=tuple(segments)),
+                        warnings=tuple(warnings))
+    _check_feasible(scenario)
+    return scenario
+
+
+def _check_feasible(scenario: Scenario) -> None:
+    """Reject what the rotors cannot lift at all."""
+    lift = sum(u.vehicle.max_thrust for u in scenario.uavs)
+    weight = scenario.total_weight()
+    if weight >= lift:
+        raise ScenarioError(
+            f'{scenario.source}: payload.mass: {scenario.payload.mass} kg is too heavy: the '
+            f'formation weighs {weight:.2f} N but its rotors lift at most {lift:.2f} N')
+
+
+def scenario_dir() -> Path:
+    """The `scenarios/` folder: $MULTILIFT_SCENARIOS, else the repository's."""
+    env = os.environ.get('MULTILIFT_SCENARIOS')
+    if env:
+        return Path(env)
+    root = os.environ.get('ML_ROOT')
+    if root:
+        return Path(root) / 'scenarios'
+    return Path.cwd() / 'scenarios'
+
+
+def resolve(name_or_path: str) -> Path:
+    """A scenario name (a file in scenarios/) or a YAML path -> the file."""
+    candidate = Path(name_or_path)
+    if candidate.suffix in ('.yaml', '.yml') or os.sep in name_or_path:
+        if not candidate.is_file():
+            raise ScenarioError(f'{name_or_path}: no such scenario file')
+        return candidate
+    path = scenario_dir() / f'{name_or_path}.yaml'
+    if not path.is_file():
+        known = sorted(p.stem for p in scenario_dir().glob('*.yaml'))
+        raise ScenarioError(f'{name_or_path}: unknown scenario (known: {", ".join(known)})')
+    return path
+
+
+def load(name_or_path: str) -> Scenario:
+    """Load and validate a scenario by name or path. Raises ScenarioError."""
+    path = resolve(name_or_path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ScenarioError(f'{path}: not valid YAML: {exc}'.replace('\n', ' ')) from None
+    return _scenario(data, str(path))
+
+
+def loads(text: str, where: str = '<string>') -> Scenario:
+    """Validate a scenario given as YAML text (tests, tools)."""
+    return _scenario(yaml.safe_load(text), where)

@@ -1,0 +1,151 @@
+"""Simulator node: integrates the formation DAE in lockstep with the controllers.
+
+Each control tick it publishes `/clock` and the state at t (`/uav{i}/odom`, `/payload/odom`),
+waits for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes `/formation/state`, and
+integrates to the next tick. No command within `command_timeout` wall seconds stops the run
+naming the silent UAV. Parameters: scenario (name or path), record (wait for a recorder),
+realtime (pace to the wall clock), duration (override t_max, s), summary_dir, progress_file.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from multilift_msgs.msg import FormationState, RotorCommand
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+
+from multilift_sim import scenario as scenario_io
+from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, WORLD_FRAME, Fatal,
+                                      fill_odometry, ns_from_stamp, run_node, stamp_from_ns,
+                                      uav_frame, uav_topic, wait_until, write_summary)
+from multilift_sim.simulation import FormationSimulator, SimulationStopped
+
+STARTUP_TIMEOUT = 60.0  # wall seconds for the graph to come together [s]
+
+
+class SimNode(Node):
+    def __init__(self) -> None:
+        super().__init__('sim')
+        name = self.declare_parameter('scenario', '').value
+        self.record = bool(self.declare_parameter('record', False).value)
+        self.realtime = bool(self.declare_parameter('realtime', False).value)
+        duration = float(self.declare_parameter('duration', 0.0).value)
+        self.summary_dir = self.declare_parameter('summary_dir', '').value
+        self.progress_file = self.declare_parameter('progress_file', '').value
+        if not name:
+            raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
+        scenario = scenario_io.load(name)
+        if duration > 0:
+            import dataclasses
+            scenario = dataclasses.replace(
+                scenario, simulation=dataclasses.replace(scenario.simulation, duration=duration))
+        self.scenario = scenario
+        self.sim = FormationSimulator(scenario)
+        n = scenario.n_uavs
+        self.clock_pub = self.create_publisher(Clock, '/clock', PUBLISHER_QOS)
+        self.odom_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, 'odom'), PUBLISHER_QOS)
+                          for i in range(n)]
+        self.payload_pub = self.create_publisher(Odometry, '/payload/odom', PUBLISHER_QOS)
+        self.formation_pub = self.create_publisher(FormationState, '/formation/state',
+                                                   PUBLISHER_QOS)
+        self.commands: list[RotorCommand | None] = [None] * n
+        self.cmd_subs = [self.create_subscription(
+            RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
+            lambda msg, i=i: self._on_command(i, msg), SUBSCRIBER_QOS) for i in range(n)]
+        self._odom_msgs = [Odometry() for _ in range(n)]
+        self._payload_msg = Odometry()
+
+    def _on_command(self, index: int, msg: RotorCommand) -> None:
+        if ns_from_stamp(msg.header.stamp) == self.sim.t_ns:
+            self.commands[index] = msg
+
+    def missing_peers(self) -> str | None:
+        """What the lockstep still waits for before t = 0, or None."""
+        for i, sub in enumerate(self.cmd_subs):
+            if sub.get_publisher_count() < 1:
+                return f'a controller publishing {uav_topic(i + 1, "rotor_cmd")}'
+        if self.record:
+            for pub in [self.clock_pub, self.payload_pub, self.formation_pub, *self.odom_pubs]:
+                if pub.get_subscription_count() < 1:
+                    return f'the recorder to subscribe to {pub.topic_name}'
+        return None
+
+    def publish_state(self) -> None:
+        snap = self.sim.snapshot()
+        stamp = stamp_from_ns(snap.t_ns)
+        self.clock_pub.publish(Clock(clock=stamp))
+        for i, (uav, msg) in enumerate(zip(snap.uavs, self._odom_msgs)):
+            fill_odometry(msg, snap.t_ns, uav_frame(i + 1), uav.position, uav.velocity,
+                          uav.euler, uav.rotation, uav.body_rates)
+            self.odom_pubs[i].publish(msg)
+        fill_odometry(self._payload_msg, snap.t_ns, 'payload', snap.payload_position,
+                      snap.payload_velocity, None, None, None)
+        self.payload_pub.publish(self._payload_msg)
+
+    def wait_for_commands(self) -> None:
+        deadline = time.monotonic() + self.scenario.simulation.command_timeout
+        while any(c is None for c in self.commands):
+            if time.monotonic() > deadline:
+                silent = [f'uav{i + 1}' for i, c in enumerate(self.commands) if c is None]
+                raise Fatal(f'no rotor command from {", ".join(silent)} within '
+                            f'{self.scenario.simulation.command_timeout:g} s (wall) for the '
+                            f'state at t = {self.sim.t:.3f} s')
+            self.executor.spin_once(timeout_sec=0.1)
+
+    def publish_formation(self, speeds: list[np.ndarray]) -> None:
+        tension, g, g_dot = self.sim.cable_state(speeds)
+        msg = FormationState()
+        msg.header.stamp = stamp_from_ns(self.sim.t_ns)
+        msg.header.frame_id = WORLD_FRAME
+        msg.cable_tension = tension.tolist()
+        msg.constraint_position = g.tolist()
+        msg.constraint_velocity = g_dot.tolist()
+        self.formation_pub.publish(msg)
+
+    def run(self) -> None:
+        wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
+        wall_start = time.monotonic()
+        last_progress = 0.0
+        try:
+            while True:
+                self.commands = [None] * self.sim.n
+                self.publish_state()
+                self.wait_for_commands()
+                speeds = [np.array(c.angular_velocity, dtype=float) for c in self.commands]
+                flags = [np.array(c.saturated, dtype=bool) for c in self.commands]
+                self.publish_formation(speeds)
+                if self.sim.finished:
+                    break
+                self.sim.advance(speeds, flags)
+                wall = time.monotonic() - wall_start
+                if self.realtime and self.sim.t > wall:
+                    time.sleep(self.sim.t - wall)
+                if self.progress_file and wall - last_progress > 0.5:
+                    last_progress = wall
+                    self._progress(wall)
+        except SimulationStopped as exc:
+            self._finish(time.monotonic() - wall_start, str(exc))
+            raise Fatal(str(exc)) from None
+        self._finish(time.monotonic() - wall_start, None)
+
+    def _progress(self, wall: float) -> None:
+        t_max = self.sim.tick_count * self.sim.period_ns * 1e-9
+        with open(self.progress_file, 'w') as f:
+            f.write(f'{self.sim.t:.3f} {t_max:.3f} {wall:.3f}\n')
+
+    def _finish(self, wall: float, error: str | None) -> None:
+        if self.progress_file:
+            self._progress(wall)
+        stats = self.sim.stats.as_dict()
+        stats.update(wall_time=wall, error=error, scenario=self.scenario.name)
+        write_summary(self.summary_dir, 'sim', stats)
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_node(SimNode, lambda node: node.run(), args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -1,0 +1,93 @@
+"""Scenario loading: every shipped scenario loads; bad values are one clear error."""
+from __future__ import annotations
+
+import math
+import subprocess
+
+import pytest
+import yaml
+
+from conftest import ROOT, SCENARIOS
+from multilift_sim import scenario as scenario_io
+
+
+def _edited(name: str, edit) -> str:
+    data = yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
+    edit(data)
+    return yaml.safe_dump(data)
+
+
+@pytest.mark.parametrize('path', sorted(SCENARIOS.glob('*.yaml')), ids=lambda p: p.stem)
+def test_shipped_scenarios_load(path):
+    s = scenario_io.load(str(path))
+    assert s.name == path.stem
+    assert s.n_uavs >= 1
+    assert s.simulation.physics_steps_per_tick >= 1
+
+
+def test_single_lift_is_the_seed_mission():
+    s = scenario_io.load('single_lift')
+    v = s.uavs[0].vehicle
+    assert (v.mass, v.arm_length, v.thrust_coefficient, v.moment_coefficient) == \
+        (2.5, 0.2, 1.83e-6, 1.85e-7)
+    assert (v.rotor_speed_min, v.rotor_speed_max, v.frame_type) == (0.0, 2100.0, 'quad_x')
+    assert (s.payload.mass, s.uavs[0].cable_length) == (0.4, 2.5)
+    ends = [seg.end_time for seg in s.mission.segments]
+    assert ends == [10.0, 25.0, 40.0, 100.0, 120.0]
+    assert s.mission.segments[0].velocity == (0.0, 0.0, 0.3)     # climb, z up
+    assert s.mission.segments[2].velocity == (0.0, -0.5, 0.0)    # the seed's +j is -y
+    assert s.simulation.duration == 120.0
+
+
+def test_swing_release_angles():
+    s = scenario_io.load('single_lift_swing')
+    assert math.degrees(s.payload.alpha) == pytest.approx(15.0)
+    assert math.degrees(s.payload.beta) == pytest.approx(25.0)
+    assert s.control.mode == 'constant_rotor_speed'
+
+
+def test_seed_inertia_warns_but_loads():
+    s = scenario_io.load('single_lift')
+    assert any('triangle inequality' in w for w in s.warnings)
+
+
+BAD = [
+    (lambda d: d['vehicle'].update(mass=-1.0), 'vehicle.mass: -1.0 must be > 0'),
+    (lambda d: d['uavs'][0].update(cable_length=0.0), 'uavs[0].cable_length: 0.0 must be > 0'),
+    (lambda d: d['vehicle'].update(frame_type='tri'), "vehicle.frame_type: 'tri' must be one of"),
+    (lambda d: d['payload'].pop('mass'), 'payload.mass: missing key'),
+    (lambda d: d['payload'].update(mass=4.0), 'payload.mass: 4.0 kg is too heavy'),
+    (lambda d: d['vehicle'].update(masss=2.5), 'vehicle.masss: unknown key'),
+    (lambda d: d['simulation'].update(control_rate=300.0), 'simulation.control_rate'),
+    (lambda d: d['vehicle'].update(inertia=[1, 2]), 'vehicle.inertia'),
+    (lambda d: d['vehicle'].update(rotor_speed_max=-5), 'vehicle.rotor_speed_max'),
+    (lambda d: d['mission']['segments'][1].update(until=5.0), 'mission.segments[1]'),
+    (lambda d: d['vehicle'].update(mass='heavy'), "vehicle.mass: 'heavy' must be a number"),
+    (lambda d: d['vehicle'].update(mass=float('nan')), 'vehicle.mass: nan must be finite'),
+]
+
+
+@pytest.mark.parametrize('edit,message', BAD, ids=[m for _, m in BAD])
+def test_bad_values_name_key_and_rule(edit, message):
+    with pytest.raises(scenario_io.ScenarioError) as err:
+        scenario_io.loads(_edited('single_lift', edit), 'x.yaml')
+    assert message in str(err.value)
+    assert str(err.value).startswith('x.yaml: ')
+
+
+def test_cli_bad_scenario_is_one_line_exit_2(tmp_path):
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(_edited('single_lift', lambda d: d['vehicle'].update(mass=-1.0)))
+    out = subprocess.run([str(ROOT / 'scripts' / 'multilift'), 'run', str(bad)],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 2
+    assert out.stderr.strip().splitlines() == [
+        f'error: {bad}: vehicle.mass: -1.0 must be > 0']
+    assert 'Traceback' not in out.stderr
+
+
+def test_cli_unknown_scenario_lists_known():
+    out = subprocess.run([str(ROOT / 'scripts' / 'multilift'), 'run', 'no_such_thing'],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 2
+    assert 'unknown scenario' in out.stderr and 'single_lift' in out.stderr

@@ -93,6 +93,8 @@ def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
             lines.append(f'  uav{i + 1} rotors      max {w:.1f} rad/s (limit {limit:g}), '
                          f'saturated {s:.2f} s')
         lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} N')
+        if scenario.gusts:
+            lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} m/s')
     leader = data.get('leader')
     if leader and leader.get('answered_states'):
         lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} m, '

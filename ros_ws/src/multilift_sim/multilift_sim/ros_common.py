@@ -176,9 +176,13 @@ def run_topics(n_uavs: int) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records."""
     topics = [('/clock', 'rosgraph_msgs/msg/Clock'), ('/payload/odom', 'nav_msgs/msg/Odometry'),
               ('/formation/state', 'multilift_msgs/msg/FormationState'),
+              ('/payload/gust', 'geometry_msgs/msg/Vector3Stamped'),
               (uav_topic(1, 'reference'), 'multilift_msgs/msg/TrackingReference')]
     for i in range(1, n_uavs + 1):
         topics += [(uav_topic(i, 'odom'), 'nav_msgs/msg/Odometry'),
                    (uav_topic(i, 'rotor_cmd'), 'multilift_msgs/msg/RotorCommand'),
                    (uav_topic(i, 'attitude_setpoint'), 'multilift_msgs/msg/AttitudeSetpoint')]
+        if i > 1:
+            topics.append((uav_topic(i, 'formation_error'),
+                           'multilift_msgs/msg/VirtualConstraintError'))
     return topics

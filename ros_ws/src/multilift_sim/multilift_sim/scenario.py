@@ -18,6 +18,7 @@ import yaml
 from multilift_sim.allocation import FRAME_TYPES
 from multilift_sim.disturbances import Gust
 from multilift_sim.dynamics import FormationParams
+from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.multirotor import MultirotorParams
 
 
@@ -26,6 +27,7 @@ class ScenarioError(ValueError):
 
 
 CONTROL_MODES = ('cascade', 'constant_rotor_speed')
+FORMATION_GEOMETRIES = ('linear', 'distance', 'v', 'circle')  # seed Table 3.1
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,18 @@ class PayloadConfig:
     drag_coefficient: float          # c_pd of seed Eq. 2.53 [kg/m]
     alpha: float                     # release angle alpha of seed Eq. 2.33 [rad] (n = 1)
     beta: float                      # release angle beta of seed Eq. 2.33 [rad] (n = 1)
+    swing: float                     # release angle out of the UAVs-payload plane [rad] (n = 2)
+
+
+@dataclass(frozen=True)
+class FormationConfig:
+    """Virtual constraints the followers keep (seed §3.2, Table 3.1), world frame."""
+    geometry: str                    # 'linear', 'distance', 'v' or 'circle'
+    offsets: tuple[tuple[float, float, float], ...]  # linear: r_1 - r_i per follower [m]
+    distance: float                  # d [m] (distance, v, circle)
+    half_angle: float                # gamma [rad] (v: vertex angle 2 gamma)
+    alpha_vc: float                  # formation derivative gain (Table 4.2) [1/s]
+    beta_vc: float                   # formation proportional gain (Table 4.2) [1/s]
 
 
 @dataclass(frozen=True)
@@ -106,6 +120,7 @@ class Scenario:
     gusts: tuple[Gust, ...]
     control: ControlConfig
     mission: MissionConfig
+    formation: FormationConfig | None = None
     warnings: tuple[str, ...] = field(default=())
 
     @property
@@ -274,16 +289,33 @@ def _scenario(data: Any, where: str) -> Scenario:
     v.done()
     warnings = _inertia_warning(where, 'vehicle.inertia', tuple(base_vehicle['inertia']))
 
-    uav_list = top.raw('uavs')
+    # n comes from formation.n, or from the length of `uavs` (per-UAV overrides), or is 1
+    n_formation = None
+    if top.has('formation') and isinstance(top.data['formation'], dict) \
+            and 'n' in top.data['formation']:
+        n_formation = top.data['formation']['n']
+        if isinstance(n_formation, bool) or not isinstance(n_formation, int) or n_formation < 1:
+            raise ScenarioError(f'{where}: formation.n: {n_formation!r} must be an integer >= 1')
+    uav_list = top.raw('uavs', None)
+    if uav_list is None:
+        uav_list = [{}] * (n_formation or 1)
     if not isinstance(uav_list, list) or not uav_list:
         raise ScenarioError(f'{where}: uavs: {uav_list!r} must be a non-empty list')
+    if n_formation is not None and len(uav_list) != n_formation:
+        raise ScenarioError(f'{where}: uavs: {len(uav_list)} entries but formation.n is '
+                            f'{n_formation}')
+    default_cable = top.positive('cable_length') if top.has('cable_length') else ...
     uavs = []
     for i, entry in enumerate(uav_list):
         u = _Section(entry, f'uavs[{i}]', where)
         vehicle = _vehicle(u, base_vehicle)
         if vehicle.inertia != tuple(base_vehicle['inertia']):
             warnings += _inertia_warning(where, u.key('inertia'), vehicle.inertia)
-        uavs.append(UavConfig(vehicle=vehicle, cable_length=u.positive('cable_length'),
+        if i > 0 and u.has('position'):
+            raise u.fail('position', u.data['position'],
+                         'is not allowed: follower positions come from the formation geometry')
+        uavs.append(UavConfig(vehicle=vehicle, cable_length=u.positive('cable_length',
+                                                                        default_cable),
                               position=u.vector('position', [0.0, 0.0, 0.0]),
                               yaw=u.number('yaw', 0.0)))
         u.done()
@@ -294,10 +326,20 @@ def _scenario(data: Any, where: str) -> Scenario:
                             alpha=math.radians(p.number('alpha_deg', 0.0, lambda a: abs(a) < 90,
                                                         'must be within (-90, 90) degrees')),
                             beta=math.radians(p.number('beta_deg', 0.0, lambda a: abs(a) < 90,
-                                                       'must be within (-90, 90) degrees')))
+                                                       'must be within (-90, 90) degrees')),
+                            swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
+                                                        'must be within (-90, 90) degrees')))
+    swing = math.degrees(payload.swing)
     p.done()
     if len(uavs) > 1 and (payload.alpha or payload.beta):
-        raise p.fail('alpha_deg', payload.alpha, 'release angles are for n = 1 only')
+        raise p.fail('alpha_deg', math.degrees(payload.alpha),
+                     'release angles alpha/beta are for n = 1 (use swing_deg for n = 2)')
+    if len(uavs) != 2 and payload.swing:
+        raise p.fail('swing_deg', swing, 'a swing out of the UAVs-payload plane needs n = 2')
+
+    formation = None
+    if top.has('formation') or len(uavs) > 1:
+        formation = _formation(top.section('formation'), len(uavs))
 
     gusts = []
     for i, entry in enumerate(top.raw('gusts', [])):
@@ -353,9 +395,35 @@ def _scenario(data: Any, where: str) -> Scenario:
     scenario = Scenario(name=name, description=description, source=where, simulation=sim,
                         uavs=tuple(uavs), payload=payload, gusts=tuple(gusts), control=control,
                         mission=MissionConfig(start=start, segments=tuple(segments)),
-                        warnings=tuple(warnings))
+                        formation=formation, warnings=tuple(warnings))
     _check_feasible(scenario)
     return scenario
+
+
+def _formation(f: _Section, n: int) -> FormationConfig:
+    f.raw('n', n)  # checked with the UAV list
+    geometry = f.text('geometry', choices=FORMATION_GEOMETRIES)
+    offsets: list[tuple[float, ...]] = []
+    if geometry == 'linear':
+        raw = f.raw('offsets')
+        if not isinstance(raw, list) or len(raw) != n - 1:
+            raise f.fail('offsets', raw, f'must list one [dx, dy, dz] per follower ({n - 1})')
+        holder = _Section({str(k): v for k, v in enumerate(raw)}, f.key('offsets'), f.where)
+        offsets = [holder.vector(str(k)) for k in range(n - 1)]
+        holder.done()
+    needs_distance = geometry in ('distance', 'v', 'circle')
+    distance = f.positive('distance') if needs_distance else 0.0
+    half_angle = 0.0
+    if geometry == 'v':
+        half_angle = math.radians(f.number('half_angle_deg', ..., lambda a: 0 < a < 90,
+                                           'must be within (0, 90) degrees'))
+    if geometry == 'circle' and n < 3:
+        raise f.fail('geometry', geometry, 'needs n >= 3')
+    config = FormationConfig(geometry=geometry, offsets=tuple(offsets), distance=distance,
+                             half_angle=half_angle, alpha_vc=f.non_negative('alpha_vc'),
+                             beta_vc=f.non_negative('beta_vc'))
+    f.done()
+    return config
 
 
 def _check_feasible(scenario: Scenario) -> None:
@@ -366,6 +434,14 @@ def _check_feasible(scenario: Scenario) -> None:
         raise ScenarioError(
             f'{scenario.source}: payload.mass: {scenario.payload.mass} kg is too heavy: the '
             f'formation weighs {weight:.2f} N but its rotors lift at most {lift:.2f} N')
+    f = scenario.formation
+    if f is not None and scenario.n_uavs > 1:
+        uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position,
+                                 f.offsets, f.distance, f.half_angle)
+        try:
+            hanging_payload(uavs, [u.cable_length for u in scenario.uavs])
+        except ValueError as exc:
+            raise ScenarioError(f'{scenario.source}: formation: {exc}') from None
 
 
 def scenario_dir() -> Path:

@@ -1,6 +1,7 @@
 """Simulator node: integrates the formation DAE in lockstep with the controllers.
 
-Each control tick it publishes `/clock` and the state at t (`/uav{i}/odom`, `/payload/odom`),
+Each control tick it publishes `/clock` and the state at t (`/uav{i}/odom`, `/payload/odom`,
+`/payload/gust`: the gust velocity at the payload, world frame),
 waits for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes `/formation/state`, and
 integrates to the next tick. No command within `command_timeout` wall seconds stops the run
 naming the silent UAV. Parameters: scenario (name or path), record (wait for a recorder),
@@ -11,6 +12,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from geometry_msgs.msg import Vector3Stamped
 from multilift_msgs.msg import FormationState, RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
@@ -50,6 +52,9 @@ class SimNode(Node):
         self.payload_pub = self.create_publisher(Odometry, '/payload/odom', PUBLISHER_QOS)
         self.formation_pub = self.create_publisher(FormationState, '/formation/state',
                                                    PUBLISHER_QOS)
+        self.gust_pub = self.create_publisher(Vector3Stamped, '/payload/gust', PUBLISHER_QOS)
+        self._gust_msg = Vector3Stamped()
+        self._gust_msg.header.frame_id = WORLD_FRAME
         self.commands: list[RotorCommand | None] = [None] * n
         self.cmd_subs = [self.create_subscription(
             RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
@@ -67,7 +72,8 @@ class SimNode(Node):
             if sub.get_publisher_count() < 1:
                 return f'a controller publishing {uav_topic(i + 1, "rotor_cmd")}'
         if self.record:
-            for pub in [self.clock_pub, self.payload_pub, self.formation_pub, *self.odom_pubs]:
+            for pub in [self.clock_pub, self.payload_pub, self.formation_pub, self.gust_pub,
+                        *self.odom_pubs]:
                 if pub.get_subscription_count() < 1:
                     return f'the recorder to subscribe to {pub.topic_name}'
         return None
@@ -83,6 +89,11 @@ class SimNode(Node):
         fill_odometry(self._payload_msg, snap.t_ns, 'payload', snap.payload_position,
                       snap.payload_velocity, None, None, None)
         self.payload_pub.publish(self._payload_msg)
+        gust = self.sim.model.gust_velocity_at_payload(self.sim.t, self.sim.state)
+        self._gust_msg.header.stamp = stamp
+        v = self._gust_msg.vector
+        v.x, v.y, v.z = (float(c) for c in gust)
+        self.gust_pub.publish(self._gust_msg)
 
     def wait_for_commands(self) -> None:
         deadline = time.monotonic() + self.scenario.simulation.command_timeout

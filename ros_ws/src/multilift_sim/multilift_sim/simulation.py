@@ -11,7 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from multilift_sim.dynamics import FormationModel, initial_state_single_lift
+from multilift_sim.dynamics import FormationModel, StateLayout, initial_state_single_lift
+from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
+                                              swing_about_uav_axis)
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.scenario import Scenario
 
@@ -49,6 +51,7 @@ class RunStatistics:
     min_tension: float = math.inf          # [N]
     max_tension: float = -math.inf         # [N]
     simulated_time: float = 0.0            # [s]
+    max_gust_speed: float = 0.0            # peak gust speed met by the payload [m/s]
 
     def __post_init__(self) -> None:
         self.max_rotor_speed = [0.0] * self.n_uavs
@@ -65,8 +68,22 @@ def initial_state(scenario: Scenario, model: FormationModel) -> np.ndarray:
         return initial_state_single_lift(np.asarray(uav.position, dtype=float),
                                          np.array([0.0, 0.0, uav.yaw]), uav.cable_length,
                                          scenario.payload.alpha, scenario.payload.beta)
-    raise SimulationStopped('formations of n > 1 need the formation initialisation '
-                            '(not built yet)')
+    formation = scenario.formation
+    uavs, payload = formation_start(scenario)
+    if scenario.payload.swing:
+        payload = swing_about_uav_axis(payload, uavs[0], uavs[1], scenario.payload.swing)
+    euler = np.array([[0.0, 0.0, u.yaw] for u in scenario.uavs])
+    layout = StateLayout(scenario.n_uavs)
+    assert formation is not None
+    return layout.pack(uavs, euler, payload)
+
+
+def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """(UAV positions (n, 3), payload position) at t = 0, world [m]."""
+    f = scenario.formation
+    uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position, f.offsets,
+                             f.distance, f.half_angle)
+    return hanging_payload(uavs, [u.cable_length for u in scenario.uavs])
 
 
 class FormationSimulator:
@@ -154,6 +171,10 @@ class FormationSimulator:
             raise SimulationStopped(f'the formation state became non-finite at t = {t:.3f} s')
         g, g_dot = self.model.constraint_residuals(self.state)
         sim = self.scenario.simulation
+        if self.scenario.gusts:
+            gust = self.model.gust_velocity_at_payload(t, self.state)
+            self.stats.max_gust_speed = max(self.stats.max_gust_speed,
+                                            float(np.linalg.norm(gust)))
         self.stats.max_abs_constraint = max(self.stats.max_abs_constraint,
                                             float(np.max(np.abs(g))))
         self.stats.max_abs_constraint_rate = max(self.stats.max_abs_constraint_rate,

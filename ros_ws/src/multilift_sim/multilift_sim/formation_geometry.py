@@ -1,0 +1,88 @@
+"""Where the UAVs of a formation sit and where the payload hangs at the start (world frame).
+
+The followers' nominal places satisfy the virtual constraints of seed Table 3.1 with every UAV
+at the leader's altitude; the payload starts at rest on the constraint manifold (Eq. 2.42, 2.56)
+below the formation.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from multilift_sim.frames import seed_to_world_vector
+
+
+def v_offset(index: int, distance: float, half_angle: float) -> np.ndarray:
+    """v_1i of seed §3.2.1: follower `index` (2..n) sits at r_1 + v_1i.
+
+    The seed writes v_1i = (i/2)(-d c_g, -d s_g, 0) for even i and ((i-1)/2)(-d c_g, d s_g, 0)
+    for odd i in its z-down frame; mapped here to world (even followers on +y, odd on -y).
+    """
+    c, s = math.cos(half_angle), math.sin(half_angle)
+    if index % 2 == 0:
+        seed = (index / 2) * np.array([-distance * c, -distance * s, 0.0])
+    else:
+        seed = ((index - 1) / 2) * np.array([-distance * c, distance * s, 0.0])
+    return seed_to_world_vector(seed)
+
+
+def nominal_positions(geometry: str, n: int, leader_position, offsets=(), distance: float = 0.0,
+                      half_angle: float = 0.0) -> np.ndarray:
+    """(n, 3) positions [m] with every virtual constraint satisfied, all at the leader's height.
+
+    linear: r_i = r_1 - offset_i; v: r_i = r_1 + v_1i; distance: followers evenly on the rear
+    half-circle of radius d; circle: a regular polygon of side d with the leader a vertex.
+    """
+    leader = np.asarray(leader_position, dtype=float)
+    out = np.tile(leader, (n, 1))
+    for i in range(1, n):
+        if geometry == 'linear':
+            out[i] = leader - np.asarray(offsets[i - 1], dtype=float)
+        elif geometry == 'v':
+            out[i] = leader + v_offset(i + 1, distance, half_angle)
+        elif geometry == 'distance':
+            angle = math.pi / 2 + math.pi * i / n
+            out[i] = leader + distance * np.array([math.cos(angle), math.sin(angle), 0.0])
+        elif geometry == 'circle':
+            radius = distance / (2 * math.sin(math.pi / n))
+            angle = 2 * math.pi * i / n
+            out[i] = leader + radius * np.array([math.cos(angle) - 1.0, math.sin(angle), 0.0])
+        else:
+            raise ValueError(f'unknown formation geometry {geometry!r}')
+    return out
+
+
+def hanging_payload(uav_positions: np.ndarray, cable_lengths) -> tuple[np.ndarray, np.ndarray]:
+    """(uav_positions, payload_position) with every cable at its length, payload below.
+
+    The payload sits under the UAVs' horizontal centroid (their equilibrium point when that
+    is equidistant, as for the twin-lift, the V of three and circles); the leader keeps its
+    altitude and each follower's altitude is set so its cable has exactly its length.
+    Raises ValueError naming the cable when a UAV is farther from that point than its cable.
+    """
+    uavs = np.array(uav_positions, dtype=float)
+    lengths = np.asarray(cable_lengths, dtype=float)
+    centre = uavs[:, :2].mean(axis=0)
+    spans = np.linalg.norm(uavs[:, :2] - centre, axis=1)
+    for i, (span, length) in enumerate(zip(spans, lengths)):
+        if span >= length:
+            raise ValueError(f'cable {i + 1} ({length:g} m) is shorter than the horizontal '
+                             f'distance {span:.2f} m from UAV {i + 1} to the payload below '
+                             'the formation')
+    drops = np.sqrt(lengths ** 2 - spans ** 2)
+    payload = np.array([centre[0], centre[1], uavs[0, 2] - drops[0]])
+    uavs[:, 2] = payload[2] + drops
+    return uavs, payload
+
+
+def swing_about_uav_axis(payload: np.ndarray, first: np.ndarray, second: np.ndarray,
+                         angle: float) -> np.ndarray:
+    """The payload rotated by `angle` [rad] about the line through two UAVs (both cables keep
+    their lengths): a release out of the UAVs-payload plane."""
+    axis = np.asarray(second, float) - np.asarray(first, float)
+    axis /= np.linalg.norm(axis)
+    arm = payload - first
+    rotated = (arm * math.cos(angle) + np.cross(axis, arm) * math.sin(angle)
+               + axis * np.dot(axis, arm) * (1 - math.cos(angle)))
+    return first + rotated

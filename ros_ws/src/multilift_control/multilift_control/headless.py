@@ -11,6 +11,8 @@ import numpy as np
 
 from multilift_control.cascade import UavState
 from multilift_control.controllers import make_controller
+from multilift_control.formation import FormationFollower
+from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
 
@@ -24,14 +26,21 @@ def run_headless(scenario: Scenario,
                  ) -> FormationSimulator:
     """Fly `scenario` to t_max; `on_tick(sim, outputs)` sees every tick. Returns the simulator
     (its `stats` hold the run's figures). Raises SimulationStopped like the node would."""
-    if scenario.n_uavs != 1:
-        raise NotImplementedError('headless formations need the follower controller')
     sim = FormationSimulator(scenario)
     leader = make_controller(scenario, 0)
+    followers = [FormationFollower.from_scenario(scenario, i) for i in range(1, scenario.n_uavs)]
+    share = scenario.payload.mass / scenario.n_uavs
+    thrusts = [(u.vehicle.mass + share) * scenario.simulation.gravity for u in scenario.uavs]
+    k_t = [u.vehicle.thrust_coefficient for u in scenario.uavs]
     while True:
         states = uav_states(sim.snapshot())
         output, _ = leader.update(sim.t, states[0])
         outputs = [output]
+        thrusts[0] = k_t[0] * float(np.sum(output.rotor_speeds ** 2))
+        # as the follower nodes: the leader's thrust at t, the other followers' of the last tick
+        vectors = np.array([rotation_matrix(s.euler)[:, 2] * u for s, u in zip(states, thrusts)])
+        outputs += [f.update(sim.t, states, vectors)[0] for f in followers]
+        thrusts = [k * float(np.sum(o.rotor_speeds ** 2)) for k, o in zip(k_t, outputs)]
         if on_tick is not None:
             on_tick(sim, outputs)
         if sim.finished:

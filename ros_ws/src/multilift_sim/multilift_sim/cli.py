@@ -73,7 +73,8 @@ class Progress:
 
 def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
     data = {}
-    for part in ('sim', 'leader'):
+    parts = ['sim', 'leader'] + [f'follower{i}' for i in range(2, scenario.n_uavs + 1)]
+    for part in parts:
         path = summary_dir / f'{part}.json'
         if path.is_file():
             data[part] = json.loads(path.read_text())
@@ -99,6 +100,11 @@ def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
     if leader and leader.get('answered_states'):
         lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} m, '
                      f'rms {leader["rms_tracking_error"]:.3f} m')
+    for i in range(2, scenario.n_uavs + 1):
+        follower = data.get(f'follower{i}')
+        if follower and follower.get('answered_states'):
+            lines.append(f'  uav{i} formation  max |g_vc| {follower["max_abs_formation_error"]:.3f}, '
+                         f'mean |g_vc| {follower["mean_formation_error_norm"]:.3f} (m)')
     if bag is not None:
         lines.append(f'  bag              {bag}')
     print('\n'.join(lines))
@@ -126,6 +132,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         sim_exe = find_executable('multilift_sim', 'sim_node')
         leader_exe = find_executable('multilift_control', 'leader_node')
         recorder_exe = find_executable('multilift_sim', 'recorder_node')
+        follower_exe = find_executable('multilift_control', 'follower_node')
     except FileNotFoundError as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2
@@ -136,6 +143,12 @@ def cmd_run(args: argparse.Namespace) -> int:
                       work / 'sim_node.log', 'sim'),
                 Child('leader_node', [str(leader_exe), *_ros_args(common)],
                       work / 'leader_node.log', 'controller')]
+    if scenario.n_uavs > 1:
+        for i in range(2, scenario.n_uavs + 1):
+            argv = [str(follower_exe), *_ros_args(dict(common, uav_index=i)),
+                    '-r', f'__node:=follower{i}']
+            children.append(Child(f'follower_node (uav{i})', argv,
+                                  work / f'follower{i}_node.log', 'controller'))
     if record:
         _fresh_bag_dir(bag)
         topics = [f'{name}|{kind}' for name, kind in run_topics(scenario.n_uavs)]

@@ -1,0 +1,306 @@
+"""rosbag2 (Jazzy) bag directories with MCAP storage, written without rclpy or rosbag2.
+
+A bag is a directory `DIR/` holding `DIR/<name>_0.mcap` (`<name>` = the directory's base name)
+and, once the bag is closed, `DIR/metadata.yaml` (rosbag2 metadata version 9), laid out as
+`ros2 bag record -s mcap` writes them:
+
+- MCAP header profile `ros2`; one schema per type, named `pkg/msg/Type`, encoding `ros2msg`,
+  data = the full message definition (`msgdefs.message_definition`); one channel per topic,
+  message encoding `cdr`, channel metadata `offered_qos_profiles` (YAML string) and
+  `topic_type_hash`; a metadata record `rosbag2` with `serialized_metadata` at close.
+- Messages go into compressed chunks (zstd by default, lz4 or none on request) of about
+  `chunk_size` bytes [B]. The file is written without a user-space buffer, so every finished chunk
+  is on disk at once: if the process dies, the MCAP stays readable up to the last finished chunk
+  (readers fall back to scanning a file without summary). `flush()` finishes the chunk in progress.
+- Compression is MCAP chunk compression (a storage option, as rosbag2's `zstd_fast` preset), so
+  `metadata.yaml` keeps `compression_format: ""`, `compression_mode: ""` as rosbag2 writes then.
+
+Times are nanoseconds [ns] on whatever clock the caller stamps `log_time_ns` with.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mcap.exceptions import McapError
+from mcap.records import Channel, Message, Schema
+from mcap.stream_reader import StreamReader
+from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
+
+from multilift_sim import bagyaml, msgdefs
+
+DEFAULT_CHUNK_SIZE = 256 * 1024  # [B] uncompressed
+METADATA_VERSION = 9
+ROS_DISTRO = 'jazzy'
+STORAGE_IDENTIFIER = 'mcap'
+MESSAGE_ENCODING = 'cdr'
+LIBRARY = f'multilift bag.py ({LIBRARY_IDENTIFIER})'
+_NO_TIME = 2**63 - 1  # rosbag2's starting_time of a bag without messages [ns]
+_COMPRESSION = {'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4,
+                'none': CompressionType.NONE}
+
+
+class BagError(RuntimeError):
+    """A bag could not be created or written; the message says which bag and why."""
+
+
+class _DirectFile:
+    """A write-only file without user-space buffer: each `write` reaches the OS at once."""
+
+    def __init__(self, path: Path) -> None:
+        self._fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        self._position = 0
+        self.writes = 0
+
+    def write(self, data: bytes) -> int:
+        view = memoryview(data)
+        while view:
+            done = os.write(self._fd, view)
+            view = view[done:]
+        self._position += len(data)
+        self.writes += 1
+        return len(data)
+
+    def tell(self) -> int:
+        return self._position
+
+    def flush(self) -> None:
+        """Nothing is buffered here; kept for the mcap Writer's stream interface."""
+
+    def close(self) -> None:
+        if self._fd >= 0:
+            os.fsync(self._fd)
+            os.close(self._fd)
+            self._fd = -1
+
+
+@dataclass
+class _Topic:
+    name: str
+    type_name: str
+    qos_profiles: list[dict[str, Any]]
+    type_description_hash: str
+    channel_id: int
+    message_count: int = 0
+
+    def metadata(self) -> dict[str, Any]:
+        return {
+            'topic_metadata': {
+                'name': self.name,
+                'type': self.type_name,
+                'serialization_format': MESSAGE_ENCODING,
+                'offered_qos_profiles': self.qos_profiles,
+                'type_description_hash': self.type_description_hash,
+            },
+            'message_count': self.message_count,
+        }
+
+
+class BagWriter:
+    """Writes one rosbag2 bag directory with MCAP storage (see the module docstring).
+
+    `directory` must not exist or be empty, as `ros2 bag record` demands. `compression` is
+    'zstd', 'lz4' or 'none'; `chunk_size` [B] the uncompressed size at which a chunk is finished;
+    `custom_data` string pairs for `metadata.yaml`'s `custom_data`.
+    """
+
+    def __init__(self, directory: str | os.PathLike, *, compression: str = 'zstd',
+                 chunk_size: int = DEFAULT_CHUNK_SIZE,
+                 custom_data: dict[str, str] | None = None) -> None:
+        self.directory = Path(directory)
+        if self.directory.exists() and (
+                not self.directory.is_dir() or any(self.directory.iterdir())):
+            raise BagError(f"bag directory '{self.directory}' already exists and is not empty; "
+                           'give a new directory (ros2 bag record refuses it too)')
+        if compression not in _COMPRESSION:
+            raise BagError(f'compression {compression!r} is not one of {sorted(_COMPRESSION)}')
+        if chunk_size <= 0:
+            raise BagError(f'chunk_size must be positive, got {chunk_size} B')
+        self.directory.mkdir(parents=True, exist_ok=True)
+        self.file_name = f'{self.directory.resolve().name}_0.mcap'
+        self.mcap_path = self.directory / self.file_name
+        self.custom_data = dict(custom_data or {})
+        self._file = _DirectFile(self.mcap_path)
+        self._writer = Writer(self._file, chunk_size=chunk_size,
+                              compression=_COMPRESSION[compression], enable_crcs=True)
+        self._writer.start(profile='ros2', library=LIBRARY)
+        self._topics: dict[str, _Topic] = {}
+        self._schema_ids: dict[str, int] = {}
+        self._start_ns = _NO_TIME
+        self._end_ns = 0
+        self._message_count = 0
+        self._unflushed = 0
+        self._closed = False
+
+    # -- writing ---------------------------------------------------------------------------
+    def add_topic(self, name: str, type_name: str, qos_yaml: str = '',
+                  type_description_hash: str | None = None,
+                  message_definition: str | None = None) -> None:
+        """Declare topic `name` of type `pkg/msg/Type` before its first `write`.
+
+        `qos_yaml` is the publishers' offered QoS as rosbag2 stores it (`bagyaml.qos_yaml`;
+        '' = unknown). The schema text and type hash are looked up on AMENT_PREFIX_PATH unless
+        given. Declaring a topic again with the same type is a no-op.
+        """
+        self._check_open()
+        if name in self._topics:
+            if self._topics[name].type_name != type_name:
+                raise BagError(f'topic {name} is already in bag {self.directory} with type '
+                               f'{self._topics[name].type_name}, not {type_name}')
+            return
+        try:
+            msgdefs.split_type_name(type_name)
+            profiles = bagyaml.parse_qos_yaml(qos_yaml)
+            if type_name not in self._schema_ids:
+                text = (message_definition if message_definition is not None
+                        else msgdefs.message_definition(type_name))
+                self._schema_ids[type_name] = self._writer.register_schema(
+                    type_name, msgdefs.SCHEMA_ENCODING, text.encode('utf-8'))
+            if type_description_hash is None:
+                type_description_hash = msgdefs.type_description_hash(type_name)
+        except (msgdefs.MessageDefinitionError, ValueError) as error:
+            raise BagError(f'cannot add topic {name} to bag {self.directory}: {error}') from None
+        channel_id = self._writer.register_channel(
+            name, MESSAGE_ENCODING, self._schema_ids[type_name],
+            {'offered_qos_profiles': bagyaml.dump(profiles),
+             'topic_type_hash': type_description_hash})
+        self._topics[name] = _Topic(name, type_name, profiles, type_description_hash, channel_id)
+
+    def write(self, topic: str, data: bytes, log_time_ns: int,
+              publish_time_ns: int | None = None) -> None:
+        """Append one CDR-serialized message of `topic`, received at `log_time_ns` [ns]."""
+        self._check_open()
+        entry = self._topics.get(topic)
+        if entry is None:
+            raise BagError(f'topic {topic} was not added to bag {self.directory}; '
+                           'call add_topic first')
+        if log_time_ns < 0:
+            raise BagError(f'negative log time {log_time_ns} ns for a message of {topic}')
+        writes_before = self._file.writes
+        self._writer.add_message(
+            entry.channel_id, log_time_ns, bytes(data),
+            log_time_ns if publish_time_ns is None else publish_time_ns,
+            sequence=entry.message_count)
+        entry.message_count += 1
+        self._message_count += 1
+        self._start_ns = min(self._start_ns, log_time_ns)
+        self._end_ns = max(self._end_ns, log_time_ns)
+        self._unflushed = 0 if self._file.writes != writes_before else self._unflushed + 1
+
+    def flush(self) -> None:
+        """Finish the chunk in progress so every message written so far is on disk."""
+        self._check_open()
+        if self._unflushed:
+            self._writer.flush()
+            self._unflushed = 0
+
+    def close(self) -> None:
+        """Finish the MCAP (summary, `rosbag2` metadata record) and write `metadata.yaml`.
+
+        Idempotent: a second call does nothing.
+        """
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            info = self.metadata()
+            self._writer.add_metadata('rosbag2', {'serialized_metadata': bagyaml.dump(info)})
+            self._writer.finish()
+        finally:
+            self._file.close()
+        text = bagyaml.dump({'rosbag2_bagfile_information': info}) + '\n'
+        tmp = self.directory / 'metadata.yaml.tmp'
+        tmp.write_text(text, encoding='utf-8')
+        tmp.replace(self.directory / 'metadata.yaml')
+
+    # -- state -----------------------------------------------------------------------------
+    @property
+    def message_count(self) -> int:
+        """Messages written so far."""
+        return self._message_count
+
+    @property
+    def unflushed_count(self) -> int:
+        """Messages in the chunk in progress (not yet on disk)."""
+        return self._unflushed
+
+    @property
+    def topics(self) -> dict[str, str]:
+        """Topic name -> type name of the topics added so far."""
+        return {name: t.type_name for name, t in self._topics.items()}
+
+    @property
+    def closed(self) -> bool:
+        """Whether `close()` was called."""
+        return self._closed
+
+    def metadata(self) -> dict[str, Any]:
+        """The `rosbag2_bagfile_information` map as it stands now (times in [ns])."""
+        duration = self._end_ns - self._start_ns if self._message_count else 0
+        file_info = {'path': self.file_name,
+                     'starting_time': {'nanoseconds_since_epoch': self._start_ns},
+                     'duration': {'nanoseconds': duration},
+                     'message_count': self._message_count}
+        return {
+            'version': METADATA_VERSION,
+            'storage_identifier': STORAGE_IDENTIFIER,
+            'duration': {'nanoseconds': duration},
+            'starting_time': {'nanoseconds_since_epoch': self._start_ns},
+            'message_count': self._message_count,
+            'topics_with_message_count': [t.metadata() for t in self._topics.values()],
+            'compression_format': '',
+            'compression_mode': '',
+            'relative_file_paths': [self.file_name],
+            'files': [file_info],
+            'custom_data': dict(self.custom_data) or None,
+            'ros_distro': ROS_DISTRO,
+        }
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise BagError(f'bag {self.directory} is closed')
+
+    def __enter__(self) -> BagWriter:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+
+def recover(directory: str | os.PathLike, output: str | os.PathLike) -> int:
+    """Copy what is readable of a bag whose recorder died into a new, closed bag `output`.
+
+    Reads `directory`'s MCAP file front to back (as `ros2 bag reindex` and `mcap recover` do) and
+    keeps every message of every complete chunk; a torn record at the end ends the copy. Topics,
+    schemas, QoS and type hashes come from the MCAP's own schema and channel records, so the
+    message packages need not be installed. Returns the number of messages recovered.
+    """
+    files = sorted(Path(directory).glob('*.mcap'))
+    if not files:
+        raise BagError(f'no .mcap file in {directory}')
+    schemas: dict[int, Schema] = {}
+    topics: dict[int, str] = {}
+    count = 0
+    with open(files[0], 'rb') as stream, BagWriter(output) as out:
+        try:
+            for record in StreamReader(stream, validate_crcs=True).records:
+                if isinstance(record, Schema):
+                    schemas[record.id] = record
+                elif isinstance(record, Channel):
+                    schema = schemas[record.schema_id]
+                    out.add_topic(record.topic, schema.name,
+                                  record.metadata.get('offered_qos_profiles', ''),
+                                  record.metadata.get('topic_type_hash', ''),
+                                  schema.data.decode('utf-8'))
+                    topics[record.id] = record.topic
+                elif isinstance(record, Message):
+                    out.write(topics[record.channel_id], record.data, record.log_time,
+                              record.publish_time)
+                    count += 1
+        except (McapError, struct.error, EOFError):
+            pass  # the torn tail of a file whose writer was killed
+    return count

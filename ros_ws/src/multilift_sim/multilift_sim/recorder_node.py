@@ -1,0 +1,195 @@
+"""Records topics into a rosbag2 (MCAP) bag: `ros2 bag record` for this workspace.
+
+    recorder_node --ros-args -p bag:=DIR [-p "topics:=['/a|pkg/msg/A', ...]"] [-p all:=false]
+                  [-p time_source:=auto|sim|wall] [-p compression:=zstd|lz4|none]
+                  [-p flush_period:=1.0]
+
+- `topics` are subscribed at once; with `all` (default true) every other topic that has a
+  publisher is added when it appears (graph polled every 0.5 s), except /rosout,
+  /parameter_events and hidden topics.
+- Subscriptions are raw (the CDR bytes go into the bag untouched), keep_last 1000, reliable +
+  transient_local, downgraded per topic only where a publisher offers less (see
+  `introspection.adapted_qos`).
+- Log time: simulated time of the latest /clock message (see `recording` for the rule).
+- Every `flush_period` [s] the chunk in progress is finished, so a crash loses at most that much;
+  `bag.recover()` turns what a killed recorder left into a complete bag.
+- SIGINT or SIGTERM: keep receiving until 0.3 s pass without a message (3 s at most; a second
+  signal stops at once), close the bag (`metadata.yaml` written) and exit 0.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+
+import rclpy
+from rclpy.exceptions import ParameterUninitializedException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from rclpy.subscription import Subscription
+from rosgraph_msgs.msg import Clock
+
+from multilift_sim import introspection, recording
+from multilift_sim.bag import BagError, BagWriter
+from multilift_sim.bagyaml import qos_yaml
+
+POLL_PERIOD = 0.5  # [s] graph poll for new topics
+DRAIN_QUIET = 0.3  # [s] without messages that ends the drain
+DRAIN_MAX = 3.0  # [s] longest drain
+# Messages of one topic taken in one callback: the executor costs ~0.2 ms a message, a take
+# ~0.01 ms, so a backlog is read in batches (bounded, so /clock and other topics keep their turn).
+TAKE_BATCH = 256
+
+
+class RecorderNode(Node):
+    """Subscribes raw to the topics to record and writes them to one BagWriter."""
+
+    def __init__(self) -> None:
+        super().__init__('recorder')
+        self.declare_parameter('bag', '')
+        self.declare_parameter('topics', Parameter.Type.STRING_ARRAY)
+        self.declare_parameter('all', True)
+        self.declare_parameter('time_source', 'auto')
+        self.declare_parameter('compression', 'zstd')
+        self.declare_parameter('flush_period', 1.0)
+        directory = self.get_parameter('bag').value
+        if not directory:
+            raise BagError('parameter bag (the bag directory) is required: -p bag:=DIR')
+        try:
+            listed = self.get_parameter('topics').value
+        except ParameterUninitializedException:
+            listed = []
+        specs = [recording.parse_topic_spec(s) for s in listed]
+        self._log_time = recording.LogTime(self.get_parameter('time_source').value)
+        self.bag = BagWriter(directory, compression=self.get_parameter('compression').value,
+                             custom_data={'recorder': 'multilift_sim recorder_node',
+                                          'time_source': self._log_time.mode})
+        self.last_receive = time.monotonic()
+        self._types: dict[str, str] = {}
+        self._recorded: dict[str, Subscription] = {}
+        self._skipped: set[str] = set()
+        self._in_bag: set[str] = set()
+        self.create_subscription(
+            Clock, recording.CLOCK_TOPIC, self._on_clock,
+            QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT,
+                       durability=DurabilityPolicy.VOLATILE))
+        for topic, type_name in specs:
+            self._subscribe(topic, type_name)
+        record_all = self.get_parameter('all').value
+        if record_all:
+            self._discover()
+            self.create_timer(POLL_PERIOD, self._discover)
+        self.create_timer(self.get_parameter('flush_period').value, self._flush)
+        self.get_logger().info(f'recording into {self.bag.directory} '
+                               f'({len(specs)} listed topics, all={record_all})')
+
+    def _subscribe(self, topic: str, type_name: str) -> None:
+        try:
+            msg_type = introspection.import_message_type(type_name)
+        except ValueError as error:
+            self.get_logger().error(f'not recording {topic}: {error}')
+            self._skipped.add(topic)
+            return
+        qos = introspection.adapted_qos(self.get_publishers_info_by_topic(topic))
+        self._types[topic] = type_name
+        self._recorded[topic] = self.create_subscription(
+            msg_type, topic, lambda data, t=topic: self._on_message(t, data), qos, raw=True)
+        self.get_logger().info(f'subscribed to {topic} [{type_name}] '
+                               f'({qos.reliability.name.lower()}, {qos.durability.name.lower()})')
+
+    def _discover(self) -> None:
+        for topic, types in self.get_topic_names_and_types():
+            if (topic in self._recorded or topic in self._skipped
+                    or not recording.is_recordable(topic) or self.count_publishers(topic) == 0):
+                continue
+            if len(types) > 1:
+                self.get_logger().warn(f'{topic} has several types {types}; recording {types[0]}')
+            self._subscribe(topic, types[0])
+
+    def _add_to_bag(self, topic: str) -> None:
+        offers = introspection.offered_qos(self.get_publishers_info_by_topic(topic))
+        self.bag.add_topic(topic, self._types[topic], qos_yaml(offers))
+        self._in_bag.add(topic)
+
+    def _on_message(self, topic: str, data: bytes) -> None:
+        self.last_receive = time.monotonic()
+        if topic not in self._in_bag:
+            self._add_to_bag(topic)
+        self.bag.write(topic, data, self._stamp())
+        subscription = self._recorded[topic]
+        for _ in range(TAKE_BATCH):
+            with subscription.handle:
+                taken = subscription.handle.take_message(subscription.msg_type, True)
+            if taken is None:
+                return
+            self.bag.write(topic, taken[0], self._stamp())
+
+    def _stamp(self) -> int:
+        return self._log_time.stamp(lambda: self.count_publishers(recording.CLOCK_TOPIC) > 0)
+
+    def _on_clock(self, msg: Clock) -> None:
+        self._log_time.on_clock(msg.clock.sec * 1_000_000_000 + msg.clock.nanosec)
+
+    def _flush(self) -> None:
+        if not self.bag.closed:
+            self.bag.flush()
+
+    def drain(self, executor: SingleThreadedExecutor, abort: threading.Event) -> None:
+        """Keep receiving until DRAIN_QUIET s without a message, DRAIN_MAX s or `abort`."""
+        start = time.monotonic()
+        while not abort.is_set() and rclpy.ok():
+            now = time.monotonic()
+            if now - max(start, self.last_receive) >= DRAIN_QUIET or now - start >= DRAIN_MAX:
+                return
+            executor.spin_once(timeout_sec=0.05)
+
+    def close(self) -> None:
+        """Add the subscribed topics that stayed silent, then close the bag."""
+        if self.bag.closed:
+            return
+        for topic in self._types:
+            if topic not in self._in_bag:
+                self._add_to_bag(topic)
+        self.bag.close()
+        self.get_logger().info(f'closed {self.bag.directory}: {self.bag.message_count} messages '
+                               f'on {len(self.bag.topics)} topics')
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the recorder until SIGINT/SIGTERM; 0 on a clean close, 2 on bad parameters."""
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    stop, abort = threading.Event(), threading.Event()
+
+    def on_signal(signum: int, frame: object) -> None:
+        (abort if stop.is_set() else stop).set()
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    node = None
+    try:
+        node = RecorderNode()
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        while not stop.is_set() and rclpy.ok():
+            executor.spin_once(timeout_sec=0.1)
+        node.drain(executor, abort)
+    except (BagError, ValueError) as error:  # bad parameters or bag directory
+        print(f'recorder_node: {error}', file=sys.stderr)
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.close()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

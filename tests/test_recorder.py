@@ -18,7 +18,7 @@ import pytest
 import rclpy
 import yaml
 from mcap.exceptions import McapError
-from mcap.reader import NonSeekingReader
+from mcap.reader import NonSeekingReader, make_reader
 from mcap_ros2.decoder import DecoderFactory
 from multilift_msgs.msg import RotorCommand
 from rclpy.executors import SingleThreadedExecutor
@@ -228,6 +228,10 @@ def test_sigterm_closes_the_bag_with_wall_times(ros, publish, start_recorder, tm
     got = _read(bag_dir)
     assert [m.data for _, m in got['/rec_test/wall']] == list(range(50))
     assert all(before <= t <= after for t, _ in got['/rec_test/wall'])
+    # publish_time: the sender's source timestamp, as rosbag2 stores it.
+    with open(next(bag_dir.glob('*.mcap')), 'rb') as stream:
+        sent = [m.publish_time for _, _, m in make_reader(stream).iter_messages()]
+    assert len(sent) == 50 and all(before <= t <= after for t in sent)
 
 
 def test_sigkill_keeps_every_finished_chunk(ros, publish, start_recorder, tmp_path):

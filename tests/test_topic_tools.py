@@ -17,7 +17,7 @@ import yaml
 from multilift_msgs.msg import RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from std_msgs.msg import Int64
+from std_msgs.msg import Byte, ByteMultiArray, Int64
 
 from multilift_sim.introspection import message_to_ordered, message_to_yaml
 
@@ -64,6 +64,9 @@ def test_yaml_like_ros2_topic_echo():
     assert list(as_dict) == ['header', 'child_frame_id', 'pose', 'twist']
     assert as_dict['pose']['covariance'] == [2.0] + [0.0] * 35
     assert yaml.safe_load(message_to_yaml(odom))['twist']['covariance'] == [0.0] * 36
+    assert message_to_ordered(Byte(data=b'\x07')) == {'data': 7}
+    blob = yaml.safe_load(message_to_yaml(ByteMultiArray(data=[b'\x01', b'\xff'])))
+    assert blob['data'] == [1, 255]
 
 
 @pytest.fixture(scope='module')

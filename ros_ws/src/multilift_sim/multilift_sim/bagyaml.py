@@ -21,7 +21,8 @@ import yaml
 
 INFINITE_NS = 2**63 - 1  # RMW_DURATION_INFINITE [ns]
 
-_PLAIN = re.compile(r'^[A-Za-z0-9_/.][A-Za-z0-9_/.\-]*$')
+# Strings yaml-cpp leaves unquoted (our names, types, hashes, words separated by single spaces).
+_PLAIN = re.compile(r'^[A-Za-z0-9_/.]+(?:[ \-][A-Za-z0-9_/.]+)*-?$')
 
 
 def _scalar(value: Any) -> str:

@@ -49,8 +49,8 @@ def _value(value: Any) -> Any:
         return [_value(v) for v in value]
     if isinstance(value, array.array) or hasattr(value, 'tolist'):
         return value.tolist()
-    if isinstance(value, bytes):
-        return list(value)
+    if isinstance(value, bytes):  # a `byte` field (or element) is a bytes object of length 1
+        return value[0] if len(value) == 1 else list(value)
     return value
 
 

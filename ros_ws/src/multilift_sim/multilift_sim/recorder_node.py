@@ -8,9 +8,21 @@
   publisher is added when it appears (graph polled every 0.5 s), except /rosout,
   /parameter_events and hidden topics.
 - Subscriptions are raw (the CDR bytes go into the bag untouched), keep_last 1000, reliable +
-  transient_local, downgraded per topic only where a publisher offers less (see
-  `introspection.adapted_qos`).
-- Log time: simulated time of the latest /clock message (see `recording` for the rule).
+  transient_local (our publishers are reliable + transient_local, so a recorder that starts late
+  still gets their startup messages). Where publishers already offer less when the topic is
+  subscribed, the request is lowered to match them, as rosbag2 does (`introspection.adapted_qos`);
+  a volatile or best-effort publisher that appears only later on a listed topic does not match
+  (rclpy logs the incompatible QoS).
+- Log time: rosbag2 stamps receive (wall) time. Our simulation runs in lockstep on simulated time,
+  usually faster than real time, so wall times would stretch or squeeze the run and differ from
+  run to run. With `time_source` auto (default) a bag whose first message finds /clock published
+  is stamped with the simulated time of the latest /clock message received (0 before the first
+  one, as ROS time with use_sim_time), else with wall time; chosen once per bag so log times never
+  jump between clocks (`recording.LogTime`). The exact time of a message is its header.stamp; the
+  log time can trail it by a step, since /clock and the data arrive on different topics.
+  (`ros2 bag record --use-sim-time` stamps the same way: node time, which then follows /clock.)
+- `publish_time` of each MCAP message is the sender's source timestamp (wall time [ns]), as
+  rosbag2 stores it.
 - Every `flush_period` [s] the chunk in progress is finished, so a crash loses at most that much;
   `bag.recover()` turns what a killed recorder left into a complete bag.
 - SIGINT or SIGTERM: keep receiving until 0.3 s pass without a message (3 s at most; a second
@@ -19,6 +31,7 @@
 
 from __future__ import annotations
 
+import functools
 import signal
 import sys
 import threading
@@ -98,7 +111,7 @@ class RecorderNode(Node):
         qos = introspection.adapted_qos(self.get_publishers_info_by_topic(topic))
         self._types[topic] = type_name
         self._recorded[topic] = self.create_subscription(
-            msg_type, topic, lambda data, t=topic: self._on_message(t, data), qos, raw=True)
+            msg_type, topic, functools.partial(self._on_message, topic), qos, raw=True)
         self.get_logger().info(f'subscribed to {topic} [{type_name}] '
                                f'({qos.reliability.name.lower()}, {qos.durability.name.lower()})')
 
@@ -116,18 +129,18 @@ class RecorderNode(Node):
         self.bag.add_topic(topic, self._types[topic], qos_yaml(offers))
         self._in_bag.add(topic)
 
-    def _on_message(self, topic: str, data: bytes) -> None:
+    def _on_message(self, topic: str, data: bytes, info: dict) -> None:
         self.last_receive = time.monotonic()
         if topic not in self._in_bag:
             self._add_to_bag(topic)
-        self.bag.write(topic, data, self._stamp())
+        self.bag.write(topic, data, self._stamp(), info['source_timestamp'])
         subscription = self._recorded[topic]
         for _ in range(TAKE_BATCH):
             with subscription.handle:
                 taken = subscription.handle.take_message(subscription.msg_type, True)
             if taken is None:
                 return
-            self.bag.write(topic, taken[0], self._stamp())
+            self.bag.write(topic, taken[0], self._stamp(), taken[1]['source_timestamp'])
 
     def _stamp(self) -> int:
         return self._log_time.stamp(lambda: self.count_publishers(recording.CLOCK_TOPIC) > 0)

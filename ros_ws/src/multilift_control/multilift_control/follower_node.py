@@ -19,7 +19,7 @@ from multilift_control.formation import FormationFollower
 from multilift_sim import scenario as scenario_io
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      odometry_arrays, run_node, uav_frame, uav_topic,
+                                      odometry_arrays, run_node, spin, uav_frame, uav_topic,
                                       wait_until, write_summary)
 
 STARTUP_TIMEOUT = 60.0  # [s] wall
@@ -131,7 +131,7 @@ class FollowerNode(Node):
     def run(self) -> None:
         wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
         try:
-            self.executor.spin()
+            spin(self)
         finally:
             write_summary(self.summary_dir, f'follower{self.index}', {
                 'max_abs_formation_error': self.max_abs_error,

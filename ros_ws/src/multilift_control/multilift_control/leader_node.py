@@ -19,7 +19,7 @@ from multilift_control.controllers import make_controller
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
                                       odometry_arrays,
-                                      run_node, uav_frame, uav_topic, wait_until, write_summary)
+                                      run_node, spin, uav_frame, uav_topic, wait_until, write_summary)
 
 STARTUP_TIMEOUT = 60.0  # [s] wall
 
@@ -89,7 +89,7 @@ class LeaderNode(Node):
     def run(self) -> None:
         wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
         try:
-            self.executor.spin()
+            spin(self)
         finally:
             rms = math.sqrt(self.sum_sq_tracking_error / self.samples) if self.samples else 0.0
             write_summary(self.summary_dir, 'leader', {

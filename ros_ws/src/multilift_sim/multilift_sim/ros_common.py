@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import signal
 import sys
 import time
@@ -132,6 +133,25 @@ class Fatal(Exception):
     """A node must stop; the message is printed as one line and the exit code is 1."""
 
 
+def make_executor():
+    """rclpy's EventsExecutor (about 3x the message rate of the default executor on these
+    machines), or the default one where it is missing (MULTILIFT_EXECUTOR=default forces it)."""
+    if os.environ.get('MULTILIFT_EXECUTOR', 'events') == 'events':
+        try:
+            from rclpy.experimental import EventsExecutor
+            return EventsExecutor()
+        except ImportError:
+            pass
+    return SingleThreadedExecutor()
+
+
+def spin(node: Node) -> None:
+    """Spin in short slices so SIGINT and SIGTERM (raised as KeyboardInterrupt by `run_node`)
+    are seen promptly whatever the executor."""
+    while rclpy.ok():
+        node.executor.spin_once(timeout_sec=0.1)
+
+
 def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
@@ -149,12 +169,12 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
     signal.signal(signal.SIGTERM, _interrupt)
     node = None
     code = 0
-    executor = SingleThreadedExecutor()
+    executor = make_executor()
     try:
         node = make_node()
         executor.add_node(node)
         if body is None:
-            executor.spin()
+            spin(node)
         else:
             body(node)
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -3,6 +3,7 @@
     multilift run SCENARIO [--bag DIR] [--duration S] [--realtime]
     multilift node PKG EXECUTABLE [args...]
     multilift topic list | echo TOPIC [--once] | info TOPIC
+    multilift plot BAG [--out DIR] | animate BAG [--out FILE.gif] | compare BAG_A BAG_B
 
 Exit codes: 0 done, 1 the run failed, 2 bad input, 130 interrupted.
 """
@@ -188,6 +189,21 @@ def cmd_topic(args: argparse.Namespace) -> int:
     return topic_main(args.rest)
 
 
+# Subcommands whose parsing lives with their module: name -> (module, function, help)
+DELEGATED = {
+    'plot': ('multilift_sim.plotting', 'plot_main', 'PNG figures from a bag'),
+    'animate': ('multilift_sim.plotting', 'animate_main', 'GIF of the formation from a bag'),
+    'compare': ('multilift_sim.plotting', 'compare_main',
+                'seed Fig. 4.15-4.17 comparisons of two bags'),
+}
+
+
+def _delegate(args: argparse.Namespace) -> int:
+    import importlib
+    module, function, _ = DELEGATED[args.command]
+    return getattr(importlib.import_module(module), function)(args.rest)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog='multilift', description=__doc__.split('\n')[0])
     sub = parser.add_subparsers(dest='command', required=True)
@@ -206,6 +222,10 @@ def build_parser() -> argparse.ArgumentParser:
                            add_help=False)
     topic.add_argument('rest', nargs=argparse.REMAINDER)
     topic.set_defaults(func=cmd_topic)
+    for name, (_, _, text) in DELEGATED.items():
+        delegated = sub.add_parser(name, help=text, add_help=False)
+        delegated.add_argument('rest', nargs=argparse.REMAINDER)
+        delegated.set_defaults(func=_delegate)
     return parser
 
 

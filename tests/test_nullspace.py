@@ -1,0 +1,194 @@
+"""Null-space integrator (seed Eq. 2.71-2.72 with Eq. 2.57): the same accelerations as the
+multiplier form, |g| held at rounding level by its projection, the same trajectories as the
+Baumgarte DAE and the reduced model, and the Baumgarte study (seed Fig. 4.2-4.3)."""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+
+from conftest import SCENARIOS
+from multilift_sim import scenario as scenario_io
+from multilift_sim.disturbances import Gust
+from multilift_sim.dynamics import FormationModel, initial_state_single_lift
+from multilift_sim.modal import scenario_equilibrium
+from multilift_sim.nullspace import NullSpaceModel, make_model
+from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
+from multilift_sim.simulation import initial_state
+from multilift_sim.studies import study_main
+
+SWING = str(SCENARIOS / 'single_lift_swing.yaml')
+ALPHA0, BETA0 = math.radians(15.0), math.radians(25.0)          # seed Sec. 4.1 release
+
+
+def load(name: str) -> scenario_io.Scenario:
+    return scenario_io.load(str(SCENARIOS / f'{name}.yaml'))
+
+
+def simulate(model, x0: np.ndarray, rotor_speeds, duration: float, dt: float) -> np.ndarray:
+    steps = int(round(duration / dt))
+    states = np.empty((steps + 1, x0.size))
+    states[0] = x = x0
+    for k in range(steps):
+        x = model.step(k * dt, x, rotor_speeds, dt)
+        states[k + 1] = x
+    return states
+
+
+@pytest.fixture(scope='module')
+def swing():
+    """single_lift_swing: params, release state, weight-balancing rotor speeds."""
+    scenario = load('single_lift_swing')
+    x0 = initial_state(scenario, FormationModel(scenario.formation_params()))
+    return scenario, x0, list(scenario_equilibrium(scenario).rotor_speeds)
+
+
+@pytest.mark.parametrize('name', ['single_lift_swing', 'twin_lift', 'multi_lift', 'v5'])
+def test_accelerations_equal_the_multiplier_form(name):
+    # Eq. 2.72 + 2.57 and Eq. 2.58 are the same equations: at any state (on the manifold,
+    # moving, tilted, with drag and a gust on the payload) q_ddot and Lambda agree.
+    scenario = load(name)
+    rng = np.random.default_rng(7)
+    x = initial_state(scenario, FormationModel(scenario.formation_params()))
+    payload = x[6 * scenario.n_uavs:6 * scenario.n_uavs + 2]
+    gust = Gust(center=tuple(payload + 0.5), direction=(0.0, 1.0, 0.0), gradient_distance=2.0,
+                reference_speed=3.0)                            # ~2 m/s at the payload
+    params = dataclasses.replace(scenario.formation_params(0.0, 0.0),
+                                 payload_drag_coefficient=0.3, gusts=(gust,))
+    nullspace, multiplier = NullSpaceModel(params), FormationModel(params)
+    size = x.size // 2
+    for _ in range(3):
+        state = x.copy()
+        state[:size] += 0.05 * rng.standard_normal(size)
+        state[size:] = rng.standard_normal(size)
+        state = nullspace.project(state)
+        wrenches = np.column_stack((rng.uniform(20, 40, scenario.n_uavs),
+                                    rng.uniform(-0.5, 0.5, (scenario.n_uavs, 3))))
+        q_ddot, lam = nullspace.accelerations_from_wrenches(state, wrenches)
+        q_ddot_ref, lam_ref = multiplier.accelerations_from_wrenches(state, wrenches)
+        assert q_ddot == pytest.approx(q_ddot_ref, abs=1e-10 * np.abs(q_ddot_ref).max())
+        assert lam == pytest.approx(lam_ref, rel=1e-10)
+
+
+def test_projection_puts_a_state_on_the_manifold():
+    scenario = load('twin_lift')
+    model = NullSpaceModel(scenario.formation_params())
+    x = initial_state(scenario, model.formation)
+    size = x.size // 2
+    rng = np.random.default_rng(3)
+    x[:size] += 1e-3 * rng.standard_normal(size)
+    x[size:] = rng.standard_normal(size)
+    projected = model.project(x)
+    g, g_dot = model.constraint_residuals(projected)
+    assert np.abs(g).max() < 1e-12 and np.abs(g_dot).max() < 1e-12
+    attitudes = [3, 4, 5, 9, 10, 11]
+    attitudes += [size + k for k in attitudes]
+    assert np.array_equal(projected[attitudes], x[attitudes])       # only translations move
+
+
+def test_projection_holds_the_residual_where_the_unstabilised_dae_drifts(swing):
+    # seed Fig. 4.2 at a coarse 10 ms step: alpha_f = 0 drifts, the projected null-space
+    # integrator stays at rounding level, and without its projection it IS alpha_f = 0.
+    scenario, x0, speeds = swing
+    projected = simulate(NullSpaceModel(scenario.formation_params()), x0, speeds, 20.0, 0.01)
+    free = simulate(NullSpaceModel(scenario.formation_params(), projection=False), x0, speeds,
+                    20.0, 0.01)
+    unstabilised = FormationModel(scenario.formation_params(0.0, 0.0))
+    baumgarte = simulate(unstabilised, x0, speeds, 20.0, 0.01)
+    residual = np.array([unstabilised.constraint_residuals(x) for x in projected])
+    assert np.abs(residual).max() < 1e-12                          # g and g_dot
+    drift = abs(unstabilised.constraint_residuals(baumgarte[-1])[0][0])
+    assert drift > 1e-6
+    assert np.abs(free - baumgarte).max() < 1e-9                    # the same ODE
+
+
+def test_agrees_with_the_reduced_model_and_the_baumgarte_dae(swing):
+    scenario, x0, speeds = swing
+    dt, duration = 0.002, 6.0
+    nullspace = NullSpaceModel(scenario.formation_params())
+    states = simulate(nullspace, x0, speeds, duration, dt)
+    baumgarte = simulate(FormationModel(scenario.formation_params(20.0, 20.0)), x0, speeds,
+                         duration, dt)
+    uav = scenario.uavs[0]
+    reduced = ReducedSingleLiftModel(uav.vehicle, scenario.payload.mass, uav.cable_length,
+                                     scenario.simulation.gravity)
+    t = np.arange(states.shape[0]) * dt
+    reference = reduced.simulate(rest_state([0, 0, 0], [0, 0, 0], ALPHA0, BETA0), speeds[0],
+                                 duration, t_eval=t).y.T
+    uav_ref, payload_ref = reduced.to_world_positions(reference)
+    assert np.abs(states[:, 0:3] - uav_ref).max() < 1e-7
+    assert np.abs(states[:, 6:9] - payload_ref).max() < 1e-7
+    assert np.abs(states - baumgarte).max() < 1e-7
+    assert np.abs(states[:, 6:9] - states[:, 0:3]).max() > 0.5    # it does swing
+    # energy with the thrust's work (level, constant thrust) is conserved
+    thrust = nullspace.wrenches(speeds)[0, 0]
+    invariant = np.array([nullspace.mechanical_energy(x) for x in states]) \
+        - thrust * states[:, 2]
+    swing_energy = (scenario.payload.mass * scenario.simulation.gravity * uav.cable_length
+                    * (1 - math.cos(ALPHA0) * math.cos(BETA0)))
+    assert np.ptp(invariant) < 1e-8 * swing_energy
+
+
+def test_twin_lift_matches_the_baumgarte_dae():
+    scenario = load('twin_lift')
+    speeds = list(scenario_equilibrium(scenario).rotor_speeds)
+    nullspace = NullSpaceModel(scenario.formation_params())
+    x0 = initial_state(scenario, nullspace.formation)                # 15 deg swing release
+    states = simulate(nullspace, x0, speeds, 5.0, 0.005)
+    baumgarte = simulate(FormationModel(scenario.formation_params()), x0, speeds, 5.0, 0.005)
+    assert np.abs(states - baumgarte).max() < 1e-6
+    assert np.abs(states[-1, 12:15] - x0[12:15]).max() > 0.1          # the payload moved
+    # at the projection's tolerance, 1e-14 l^2 (1e-12 m^2 for the 10.26 m cables)
+    worst = max(np.abs(nullspace.constraint_residuals(x)[0]).max() for x in states)
+    assert worst <= 1.01e-14 * scenario.uavs[0].cable_length ** 2
+
+
+def test_static_tension_and_the_model_registry():
+    scenario = load('single_lift_swing')
+    params = scenario.formation_params()
+    x = initial_state_single_lift([0.0, 0.0, 5.0], [0.0, 0.0, 0.3], 2.5, 0.0, 0.0)
+    speeds = list(scenario_equilibrium(scenario).rotor_speeds)
+    model = make_model(params, 'nullspace')
+    assert isinstance(model, NullSpaceModel) and model.params is params
+    assert model.cable_tension(0.0, x, speeds)[0] == pytest.approx(0.4 * 9.81, rel=1e-12)
+    assert np.abs(model.accelerations(0.0, x, speeds)[0]).max() < 1e-12
+    baumgarte = make_model(params, 'baumgarte')
+    assert isinstance(baumgarte, FormationModel) and baumgarte.params is params
+    with pytest.raises(ValueError, match='baumgarte, nullspace'):
+        make_model(params, 'euler')
+
+
+def test_study_main_writes_its_files(tmp_path, capsys):
+    out = tmp_path / 'study'
+    code = study_main(['baumgarte', '--out', str(out), '--duration', '2', '--scenario', SWING])
+    printed = capsys.readouterr().out
+    assert code == 0
+    table = (out / 'baumgarte.md').read_text()
+    assert 'dt = 10 ms' in table and table.strip() in printed
+    rows = [line for line in table.splitlines() if line.startswith('| ')]
+    assert len(rows) == 2 + 5                           # header, rule, one per integrator
+    data = json.loads((out / 'baumgarte.json').read_text())
+    by_name = {row['integrator']: row for row in data['rows']}
+    assert set(by_name) == {'Baumgarte alpha_f = 0', 'Baumgarte alpha_f = 20',
+                            'Baumgarte alpha_f = 100', 'null space + projection',
+                            'null space, no projection'}
+    assert by_name['null space + projection']['max_abs_g'] < 1e-12
+    assert by_name['null space, no projection']['max_abs_g'] == pytest.approx(
+        by_name['Baumgarte alpha_f = 0']['max_abs_g'], rel=1e-6)
+    for row in data['rows']:
+        assert 0 < row['max_payload_error'] < 1e-3                   # all track the reference
+        assert row['wall_per_simulated_second'] > 0
+    for name in ('baumgarte_constraint.png', 'baumgarte_position_error.png'):
+        assert (out / name).read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+@pytest.mark.parametrize('argv', [['nosuch'], ['baumgarte', '--dt', '0'],
+                                  ['baumgarte', '--scenario', str(SCENARIOS / 'twin_lift.yaml')],
+                                  ['baumgarte', '--scenario', 'no_such_scenario']])
+def test_study_main_bad_input_is_one_line_and_exit_2(tmp_path, capsys, argv):
+    assert study_main(argv + ['--out', str(tmp_path / 'x')]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and err.startswith('error: ')

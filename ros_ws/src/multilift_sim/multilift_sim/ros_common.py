@@ -22,14 +22,14 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 
 WORLD_FRAME = 'world'
 
-# Publishers keep their last messages for late joiners (a recorder that matched a moment late
-# still gets the start of the run); subscribers are plain reliable.
+# Publishers keep their last messages for late joiners and our subscribers ask for them: a
+# controller or recorder whose subscription matched a moment after t = 0 was published still
+# gets it (discovery of each endpoint pair is independent; the lockstep would otherwise wait for
+# an answer to a state the controller never saw).
 PUBLISHER_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                            reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
-SUBSCRIBER_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
-                            reliability=ReliabilityPolicy.RELIABLE,
-                            durability=DurabilityPolicy.VOLATILE)
+SUBSCRIBER_QOS = PUBLISHER_QOS
 
 
 class StartupError(RuntimeError):

@@ -15,6 +15,7 @@ import numpy as np
 from geometry_msgs.msg import Vector3Stamped
 from multilift_msgs.msg import FormationState, RotorCommand
 from nav_msgs.msg import Odometry
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 
@@ -138,8 +139,18 @@ class SimNode(Node):
                     self._progress(wall)
         except SimulationStopped as exc:
             self._finish(time.monotonic() - wall_start, str(exc))
+            self.flush()
             raise Fatal(str(exc)) from None
         self._finish(time.monotonic() - wall_start, None)
+        self.flush()
+
+    def flush(self, timeout: float = 5.0) -> None:
+        """Wait until every subscriber acknowledged our messages: a reliable writer that is
+        destroyed first takes its unacknowledged history with it (the recorder would miss the
+        last ticks of the run)."""
+        for pub in [self.clock_pub, self.payload_pub, self.formation_pub, self.gust_pub,
+                    *self.odom_pubs]:
+            pub.wait_for_all_acked(Duration(seconds=timeout))
 
     def _progress(self, wall: float) -> None:
         t_max = self.sim.tick_count * self.sim.period_ns * 1e-9

@@ -109,3 +109,19 @@ def test_virtual_constraint_offset_bounded_and_smaller_for_the_v(twin, multi):
     print(f'persistent virtual-constraint offset: twin {offsets["twin"]:.3f} m, '
           f'V {offsets["multi"]:.3f} m')
     assert offsets['multi'] < offsets['twin']
+
+
+@pytest.mark.parametrize('name,domain', [('v5', '45'), ('circle3', '46')])
+def test_other_geometries_fly_30_s_with_bounded_errors(name, domain, tmp_path_factory):
+    env = dict(os.environ, ROS_DOMAIN_ID=domain, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    bag = tmp_path_factory.mktemp(name) / 'bag'
+    out = subprocess.run([MULTILIFT, 'run', name, '--duration', '30', '--bag', str(bag)],
+                         capture_output=True, text=True, timeout=900, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    run = load_run(bag)
+    assert run.formation_time[-1] == pytest.approx(30.0)
+    worst = max(np.abs(run.formation_errors(i)).max() for i in range(2, run.n_uavs + 1))
+    print(f'{name}: largest virtual-constraint row error in 30 s: {worst:.3f} '
+          '(m, or m^2 for distance rows)')
+    assert worst < 5.0
+    assert np.abs(run.g()).max() < 2e-2

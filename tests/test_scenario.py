@@ -67,6 +67,23 @@ BAD = [
 ]
 
 
+FORMATION_BAD = [
+    (lambda d: d.update(cable_length=1.0), 'formation: cable 1 (1 m) is shorter than'),
+    (lambda d: d['payload'].update(mass=8.0), 'payload.mass: 8.0 kg is too heavy'),
+    (lambda d: d['formation'].update(geometry='star'), "formation.geometry: 'star' must be one"),
+    (lambda d: d['formation'].update(offsets=[]), 'formation.offsets'),
+    (lambda d: d['formation'].update(n=3), 'uavs: 2 entries but formation.n is 3'),
+    (lambda d: d['uavs'][1].update(position=[1, 2, 3]), 'uavs[1].position'),
+]
+
+
+@pytest.mark.parametrize('edit,message', FORMATION_BAD, ids=[m for _, m in FORMATION_BAD])
+def test_formations_that_cannot_fly_fail_at_load(edit, message):
+    with pytest.raises(scenario_io.ScenarioError) as err:
+        scenario_io.loads(_edited('twin_lift', edit), 'x.yaml')
+    assert message in str(err.value)
+
+
 @pytest.mark.parametrize('edit,message', BAD, ids=[m for _, m in BAD])
 def test_bad_values_name_key_and_rule(edit, message):
     with pytest.raises(scenario_io.ScenarioError) as err:

@@ -4,6 +4,7 @@
     multilift node PKG EXECUTABLE [args...]
     multilift topic list | echo TOPIC [--once] | info TOPIC
     multilift plot BAG [--out DIR] | animate BAG [--out FILE.gif] | compare BAG_A BAG_B
+    multilift modal SCENARIO [--out DIR] | study baumgarte [--out DIR]
 
 Exit codes: 0 done, 1 the run failed, 2 bad input, 130 interrupted.
 """
@@ -195,6 +196,9 @@ DELEGATED = {
     'animate': ('multilift_sim.plotting', 'animate_main', 'GIF of the formation from a bag'),
     'compare': ('multilift_sim.plotting', 'compare_main',
                 'seed Fig. 4.15-4.17 comparisons of two bags'),
+    'modal': ('multilift_sim.modal', 'modal_main',
+              'eigenvalues and pendulum periods at the static equilibrium (seed §2.8)'),
+    'study': ('multilift_sim.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
 }
 
 

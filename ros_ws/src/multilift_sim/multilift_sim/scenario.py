@@ -20,6 +20,7 @@ from multilift_sim.disturbances import Gust
 from multilift_sim.dynamics import FormationParams
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.multirotor import MultirotorParams
+from multilift_sim.nullspace import INTEGRATORS
 
 
 class ScenarioError(ValueError):
@@ -41,6 +42,7 @@ class SimulationConfig:
     constraint_tolerance: float      # eps_g of Algorithm 1 [m^2]
     constraint_rate_tolerance: float  # eps_gdot of Algorithm 1 [m^2/s]
     command_timeout: float           # wall time the simulator waits for a rotor command [s]
+    integrator: str = 'baumgarte'    # 'baumgarte' (Eq. 2.59-2.70) or 'nullspace' (Eq. 2.71-2.72)
 
     @property
     def physics_steps_per_tick(self) -> int:
@@ -281,7 +283,8 @@ def _scenario(data: Any, where: str) -> Scenario:
         baumgarte_beta=s.non_negative('baumgarte_beta'),
         constraint_tolerance=s.positive('constraint_tolerance'),
         constraint_rate_tolerance=s.positive('constraint_rate_tolerance'),
-        command_timeout=s.positive('command_timeout', 5.0))
+        command_timeout=s.positive('command_timeout', 5.0),
+        integrator=s.text('integrator', 'baumgarte', choices=INTEGRATORS))
     s.done()
 
     v = top.section('vehicle')

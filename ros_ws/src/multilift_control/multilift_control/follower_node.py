@@ -16,10 +16,11 @@ from rclpy.node import Node
 
 from multilift_control.cascade import UavState
 from multilift_control.formation import FormationFollower
+from multilift_sim import messages
 from multilift_sim import scenario as scenario_io
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      odometry_arrays, run_node, spin, uav_frame, uav_topic,
+                                      odometry_arrays, run_node, spin, uav_topic,
                                       wait_until, write_summary)
 
 STARTUP_TIMEOUT = 60.0  # [s] wall
@@ -106,24 +107,9 @@ class FollowerNode(Node):
         out, errors, rates = self.controller.update(t_ns * 1e-9, states, thrust_vectors)
         self.thrusts[self.index - 1] = self.thrust_coefficients[self.index - 1] * float(
             np.sum(out.rotor_speeds ** 2))
-        stamp = leader.header.stamp
-        cmd = RotorCommand()
-        cmd.header.stamp = stamp
-        cmd.header.frame_id = uav_frame(self.index)
-        cmd.angular_velocity = out.rotor_speeds.tolist()
-        cmd.saturated = [bool(s) for s in out.saturated]
-        self.cmd_pub.publish(cmd)
-        setpoint = AttitudeSetpoint()
-        setpoint.header = cmd.header
-        setpoint.roll, setpoint.pitch, setpoint.yaw = (float(a) for a in out.attitude_setpoint)
-        setpoint.thrust = float(out.thrust)
-        self.setpoint_pub.publish(setpoint)
-        error = VirtualConstraintError()
-        error.header.stamp = stamp
-        error.header.frame_id = 'world'
-        error.error = [float(e) for e in errors]
-        error.error_rate = [float(e) for e in rates]
-        self.error_pub.publish(error)
+        self.cmd_pub.publish(messages.rotor_command(t_ns, self.index, out))
+        self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, self.index, out))
+        self.error_pub.publish(messages.formation_error(t_ns, errors, rates))
         self.max_abs_error = max(self.max_abs_error, float(np.max(np.abs(errors))))
         self.error_sum += float(np.linalg.norm(errors))
         self.samples += 1

@@ -9,17 +9,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from geometry_msgs.msg import Point, Vector3
 from multilift_msgs.msg import AttitudeSetpoint, RotorCommand, TrackingReference
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 
 from multilift_control.cascade import UavState
 from multilift_control.controllers import make_controller
+from multilift_sim import messages
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      odometry_arrays,
-                                      run_node, spin, uav_frame, uav_topic, wait_until, write_summary)
+                                      odometry_arrays, run_node, spin, uav_topic, wait_until,
+                                      write_summary)
 
 STARTUP_TIMEOUT = 60.0  # [s] wall
 
@@ -57,30 +57,10 @@ class LeaderNode(Node):
         t_ns = ns_from_stamp(msg.header.stamp)
         state = UavState(*odometry_arrays(msg))
         out, reference = self.controller.update(t_ns * 1e-9, state)
-        cmd = RotorCommand()
-        cmd.header.stamp = msg.header.stamp
-        cmd.header.frame_id = uav_frame(1)
-        cmd.angular_velocity = out.rotor_speeds.tolist()
-        cmd.saturated = [bool(s) for s in out.saturated]
-        self.cmd_pub.publish(cmd)
-        setpoint = AttitudeSetpoint()
-        setpoint.header = cmd.header
-        setpoint.roll, setpoint.pitch, setpoint.yaw = (float(a) for a in out.attitude_setpoint)
-        setpoint.thrust = float(out.thrust)
-        self.setpoint_pub.publish(setpoint)
+        self.cmd_pub.publish(messages.rotor_command(t_ns, 1, out))
+        self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, 1, out))
         if reference is not None:
-            ref = TrackingReference()
-            ref.header.stamp = msg.header.stamp
-            ref.header.frame_id = 'world'
-            ref.position = Point(x=float(reference.position[0]), y=float(reference.position[1]),
-                                 z=float(reference.position[2]))
-            ref.velocity = Vector3(x=float(reference.velocity[0]),
-                                   y=float(reference.velocity[1]),
-                                   z=float(reference.velocity[2]))
-            ref.acceleration = Vector3(x=float(reference.acceleration[0]),
-                                       y=float(reference.acceleration[1]),
-                                       z=float(reference.acceleration[2]))
-            self.ref_pub.publish(ref)
+            self.ref_pub.publish(messages.tracking_reference(t_ns, reference))
             error = float(np.linalg.norm(reference.position - state.position))
             self.max_tracking_error = max(self.max_tracking_error, error)
             self.sum_sq_tracking_error += error * error

@@ -19,10 +19,10 @@ from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 
+from multilift_sim import messages
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, WORLD_FRAME, Fatal,
-                                      fill_odometry, ns_from_stamp, run_node, stamp_from_ns,
-                                      uav_frame, uav_topic, wait_until, write_summary)
+from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
+                                      run_node, uav_topic, wait_until, write_summary)
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 STARTUP_TIMEOUT = 60.0  # wall seconds for the graph to come together [s]
@@ -54,14 +54,10 @@ class SimNode(Node):
         self.formation_pub = self.create_publisher(FormationState, '/formation/state',
                                                    PUBLISHER_QOS)
         self.gust_pub = self.create_publisher(Vector3Stamped, '/payload/gust', PUBLISHER_QOS)
-        self._gust_msg = Vector3Stamped()
-        self._gust_msg.header.frame_id = WORLD_FRAME
         self.commands: list[RotorCommand | None] = [None] * n
         self.cmd_subs = [self.create_subscription(
             RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
             lambda msg, i=i: self._on_command(i, msg), SUBSCRIBER_QOS) for i in range(n)]
-        self._odom_msgs = [Odometry() for _ in range(n)]
-        self._payload_msg = Odometry()
 
     def _on_command(self, index: int, msg: RotorCommand) -> None:
         if ns_from_stamp(msg.header.stamp) == self.sim.t_ns:
@@ -81,20 +77,14 @@ class SimNode(Node):
 
     def publish_state(self) -> None:
         snap = self.sim.snapshot()
-        stamp = stamp_from_ns(snap.t_ns)
-        self.clock_pub.publish(Clock(clock=stamp))
-        for i, (uav, msg) in enumerate(zip(snap.uavs, self._odom_msgs)):
-            fill_odometry(msg, snap.t_ns, uav_frame(i + 1), uav.position, uav.velocity,
-                          uav.euler, uav.rotation, uav.body_rates)
-            self.odom_pubs[i].publish(msg)
-        fill_odometry(self._payload_msg, snap.t_ns, 'payload', snap.payload_position,
-                      snap.payload_velocity, None, None, None)
-        self.payload_pub.publish(self._payload_msg)
+        t_ns = snap.t_ns
+        self.clock_pub.publish(messages.clock(t_ns))
+        for i, uav in enumerate(snap.uavs):
+            self.odom_pubs[i].publish(messages.uav_odometry(t_ns, i + 1, uav))
+        self.payload_pub.publish(messages.payload_odometry(t_ns, snap.payload_position,
+                                                           snap.payload_velocity))
         gust = self.sim.model.gust_velocity_at_payload(self.sim.t, self.sim.state)
-        self._gust_msg.header.stamp = stamp
-        v = self._gust_msg.vector
-        v.x, v.y, v.z = (float(c) for c in gust)
-        self.gust_pub.publish(self._gust_msg)
+        self.gust_pub.publish(messages.gust(t_ns, gust))
 
     def wait_for_commands(self) -> None:
         deadline = time.monotonic() + self.scenario.simulation.command_timeout
@@ -107,14 +97,8 @@ class SimNode(Node):
             self.executor.spin_once(timeout_sec=0.1)
 
     def publish_formation(self, speeds: list[np.ndarray]) -> None:
-        tension, g, g_dot = self.sim.cable_state(speeds)
-        msg = FormationState()
-        msg.header.stamp = stamp_from_ns(self.sim.t_ns)
-        msg.header.frame_id = WORLD_FRAME
-        msg.cable_tension = tension.tolist()
-        msg.constraint_position = g.tolist()
-        msg.constraint_velocity = g_dot.tolist()
-        self.formation_pub.publish(msg)
+        self.formation_pub.publish(messages.formation_state(self.sim.t_ns,
+                                                            *self.sim.cable_state(speeds)))
 
     def run(self) -> None:
         wait_until(self, self.missing_peers, STARTUP_TIMEOUT)

@@ -1,0 +1,87 @@
+"""The multilift messages, built from model values in one place: the nodes publish them and the
+headless runner writes the very same messages to its bag (so a ROS run and a headless run of a
+scenario can be compared message by message). World frame, SI units.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+from geometry_msgs.msg import Point, Vector3, Vector3Stamped
+from multilift_msgs.msg import (AttitudeSetpoint, FormationState, RotorCommand,
+                                TrackingReference, VirtualConstraintError)
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+
+from multilift_sim.ros_common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
+
+
+def clock(t_ns: int) -> Clock:
+    return Clock(clock=stamp_from_ns(t_ns))
+
+
+def uav_odometry(t_ns: int, index: int, uav) -> Odometry:
+    """UAV `index` (1 = leader) from a simulation.UavSnapshot."""
+    return fill_odometry(Odometry(), t_ns, uav_frame(index), uav.position, uav.velocity,
+                         uav.euler, uav.rotation, uav.body_rates)
+
+
+def payload_odometry(t_ns: int, position: np.ndarray, velocity: np.ndarray) -> Odometry:
+    return fill_odometry(Odometry(), t_ns, 'payload', position, velocity, None, None, None)
+
+
+def _vector(values: Sequence[float]) -> Vector3:
+    return Vector3(x=float(values[0]), y=float(values[1]), z=float(values[2]))
+
+
+def gust(t_ns: int, velocity: np.ndarray) -> Vector3Stamped:
+    msg = Vector3Stamped(vector=_vector(velocity))
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    return msg
+
+
+def formation_state(t_ns: int, tension: np.ndarray, g: np.ndarray,
+                    g_dot: np.ndarray) -> FormationState:
+    msg = FormationState(cable_tension=[float(v) for v in tension],
+                         constraint_position=[float(v) for v in g],
+                         constraint_velocity=[float(v) for v in g_dot])
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    return msg
+
+
+def rotor_command(t_ns: int, index: int, output) -> RotorCommand:
+    """From a cascade.ControlOutput; the stamp is the state time it answers."""
+    msg = RotorCommand(angular_velocity=[float(v) for v in output.rotor_speeds],
+                       saturated=[bool(s) for s in output.saturated])
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = uav_frame(index)
+    return msg
+
+
+def attitude_setpoint(t_ns: int, index: int, output) -> AttitudeSetpoint:
+    roll, pitch, yaw = (float(a) for a in output.attitude_setpoint)
+    msg = AttitudeSetpoint(roll=roll, pitch=pitch, yaw=yaw, thrust=float(output.thrust))
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = uav_frame(index)
+    return msg
+
+
+def tracking_reference(t_ns: int, reference) -> TrackingReference:
+    """From a mission.Reference."""
+    p = reference.position
+    msg = TrackingReference(position=Point(x=float(p[0]), y=float(p[1]), z=float(p[2])),
+                            velocity=_vector(reference.velocity),
+                            acceleration=_vector(reference.acceleration))
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    return msg
+
+
+def formation_error(t_ns: int, errors: np.ndarray, rates: np.ndarray) -> VirtualConstraintError:
+    msg = VirtualConstraintError(error=[float(e) for e in errors],
+                                 error_rate=[float(e) for e in rates])
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    return msg

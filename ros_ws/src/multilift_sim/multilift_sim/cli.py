@@ -1,6 +1,6 @@
 """`scripts/multilift`: the command line of multilift (what ros2cli and launch give elsewhere).
 
-    multilift run SCENARIO [--bag DIR] [--duration S] [--realtime]
+    multilift run SCENARIO [--bag DIR] [--duration S] [--realtime] [--headless]
     multilift node PKG EXECUTABLE [args...]
     multilift topic list | echo TOPIC [--once] | info TOPIC
     multilift plot BAG [--out DIR] | animate BAG [--out FILE.gif] | compare BAG_A BAG_B
@@ -124,6 +124,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.duration is not None and args.duration <= 0:
         print(f'error: --duration: {args.duration} must be > 0', file=sys.stderr)
         return 2
+    if args.duration is not None:
+        import dataclasses
+        scenario = dataclasses.replace(scenario, simulation=dataclasses.replace(
+            scenario.simulation, duration=float(args.duration)))
+    if args.headless:
+        return _run_headless(scenario, None if args.bag is None else Path(args.bag))
     scenario_path = str(scenario_io.resolve(args.scenario).resolve())
     work = Path(tempfile.mkdtemp(prefix=f'multilift-{scenario.name}-'))
     summary_dir = work / 'summary'
@@ -180,6 +186,49 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_headless(scenario, bag: Path | None) -> int:
+    """The same scenario, physics and control laws in this process, no ROS graph."""
+    from multilift_control.headless import run_headless
+    from multilift_control.headless_bag import record_headless
+    from multilift_sim.simulation import SimulationStopped
+    work = Path(tempfile.mkdtemp(prefix=f'multilift-{scenario.name}-'))
+    progress = Progress(work / 'progress', sys.stdout.isatty())
+    start = time.monotonic()
+
+    def on_tick(sim, *_) -> None:
+        if sim.tick % 50 == 0:
+            t_max = sim.tick_count * sim.period_ns * 1e-9
+            (work / 'progress').write_text(f'{sim.t} {t_max} {time.monotonic() - start}')
+            progress()
+
+    print(f'multilift run {scenario.name} --headless: {scenario.n_uavs} UAV(s), '
+          f'{scenario.simulation.duration:g} s', flush=True)
+    if bag is not None:
+        _fresh_bag_dir(bag)
+    try:
+        sim = run_headless(scenario, on_tick) if bag is None else \
+            record_headless(scenario, bag, on_tick)
+    except SimulationStopped as exc:
+        progress.close()
+        print(f'error: {exc}', file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        progress.close()
+        print('interrupted' + (f'; bag closed at {bag}' if bag else ''), file=sys.stderr)
+        return 130
+    progress.close()
+    stats = dict(sim.stats.as_dict(), wall_time=time.monotonic() - start, error=None,
+                 scenario=scenario.name)
+    summary = work / 'summary'
+    summary.mkdir(parents=True, exist_ok=True)
+    (summary / 'sim.json').write_text(json.dumps(stats))
+    data = _summary(scenario.name, summary, bag, scenario)
+    shutil.rmtree(work, ignore_errors=True)
+    if bag is not None:
+        (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))
+    return 0
+
+
 def cmd_node(args: argparse.Namespace) -> int:
     from multilift_sim.cli_tools import node_main
     return node_main([args.package, args.executable, *args.rest])
@@ -216,6 +265,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument('--bag', help='record every topic to this rosbag2 (MCAP) directory')
     run.add_argument('--duration', type=float, help='simulated seconds (default: scenario)')
     run.add_argument('--realtime', action='store_true', help='pace to the wall clock')
+    run.add_argument('--headless', action='store_true',
+                     help='no ROS graph: the same physics and control laws in one process, '
+                          'the same bag')
     run.set_defaults(func=cmd_run)
     node = sub.add_parser('node', help='run one node, like `ros2 run`')
     node.add_argument('package')

@@ -1,0 +1,73 @@
+"""A headless run recorded to the same bag a ROS run gives: the same topics, the same messages
+(built by multilift_sim.messages), stamped with simulated time. No ROS graph is involved; rclpy
+is used only to serialise the messages to CDR.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from rclpy.serialization import serialize_message
+
+from multilift_control.formation import FormationGeometry, VirtualConstraints
+from multilift_control.headless import run_headless
+from multilift_control.mission import MissionPath
+from multilift_sim import messages
+from multilift_sim.bag import BagWriter
+from multilift_sim.bagyaml import OfferedQos, qos_yaml
+from multilift_sim.ros_common import run_topics, uav_topic
+from multilift_sim.scenario import Scenario
+from multilift_sim.simulation import FormationSimulator
+
+
+def record_headless(scenario: Scenario, bag_dir: Path,
+                    on_tick: Callable[[FormationSimulator], None] | None = None
+                    ) -> FormationSimulator:
+    """Fly `scenario` without ROS and write every topic of a ROS run to `bag_dir`."""
+    writer = BagWriter(bag_dir)
+    qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
+    for topic, kind in run_topics(scenario.n_uavs):
+        writer.add_topic(topic, kind, qos)
+    path = MissionPath(scenario.mission)
+    constraints = None
+    if scenario.n_uavs > 1:
+        constraints = VirtualConstraints(FormationGeometry.from_config(scenario.formation,
+                                                                       scenario.n_uavs))
+
+    def write(topic: str, msg, t_ns: int) -> None:
+        writer.write(topic, serialize_message(msg), t_ns)
+
+    def tick(sim: FormationSimulator, outputs: list) -> None:
+        snap = sim.snapshot()
+        t_ns = snap.t_ns
+        write('/clock', messages.clock(t_ns), t_ns)
+        for i, uav in enumerate(snap.uavs):
+            write(uav_topic(i + 1, 'odom'), messages.uav_odometry(t_ns, i + 1, uav), t_ns)
+        write('/payload/odom', messages.payload_odometry(t_ns, snap.payload_position,
+                                                         snap.payload_velocity), t_ns)
+        gust = sim.model.gust_velocity_at_payload(sim.t, sim.state)
+        write('/payload/gust', messages.gust(t_ns, gust), t_ns)
+        if scenario.control.mode == 'cascade':
+            write(uav_topic(1, 'reference'), messages.tracking_reference(t_ns, path(sim.t)), t_ns)
+        if constraints is not None:
+            r = np.array([u.position for u in snap.uavs])
+            v = np.array([u.velocity for u in snap.uavs])
+            residual, rate = constraints.residual(r), constraints.rate(r, v)
+        for i, out in enumerate(outputs):
+            write(uav_topic(i + 1, 'rotor_cmd'), messages.rotor_command(t_ns, i + 1, out), t_ns)
+            write(uav_topic(i + 1, 'attitude_setpoint'),
+                  messages.attitude_setpoint(t_ns, i + 1, out), t_ns)
+            if i > 0:
+                rows = constraints.rows_of(i)
+                write(uav_topic(i + 1, 'formation_error'),
+                      messages.formation_error(t_ns, residual[rows], rate[rows]), t_ns)
+        speeds = [o.rotor_speeds for o in outputs]
+        write('/formation/state', messages.formation_state(t_ns, *sim.cable_state(speeds)), t_ns)
+        if on_tick is not None:
+            on_tick(sim)
+
+    try:
+        return run_headless(scenario, tick)
+    finally:
+        writer.close()

@@ -1,0 +1,56 @@
+"""`run --headless` computes what the ROS stack computes: same bag topics, same trajectories to
+rounding. This is what proves the nodes thin."""
+from __future__ import annotations
+
+import os
+import subprocess
+
+import numpy as np
+import pytest
+from rosbags.highlevel import AnyReader
+
+from conftest import ROOT
+from multilift_sim.bagdata import load_run
+
+MULTILIFT = str(ROOT / 'scripts' / 'multilift')
+
+
+@pytest.fixture(scope='module')
+def twin_bags(tmp_path_factory):
+    root = tmp_path_factory.mktemp('headless')
+    env = dict(os.environ, ROS_DOMAIN_ID='51', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    for mode in ('ros', 'headless'):
+        args = [MULTILIFT, 'run', 'twin_lift', '--duration', '6', '--bag', str(root / mode)]
+        if mode == 'headless':
+            args.append('--headless')
+        out = subprocess.run(args, capture_output=True, text=True, timeout=600, env=env)
+        assert out.returncode == 0, out.stderr[-2000:]
+    return root / 'ros', root / 'headless'
+
+
+def test_same_topics_types_and_counts(twin_bags):
+    counts = []
+    for bag in twin_bags:
+        with AnyReader([bag]) as reader:
+            counts.append({c.topic: (c.msgtype, c.msgcount) for c in reader.connections})
+    assert counts[0] == counts[1]
+    assert counts[0]['/uav2/formation_error'] == ('multilift_msgs/msg/VirtualConstraintError', 601)
+
+
+def test_same_trajectories_to_rounding(twin_bags):
+    ros, headless = (load_run(b) for b in twin_bags)
+    assert np.array_equal(ros.t, headless.t)
+    assert np.abs(ros.uav_positions() - headless.uav_positions()).max() < 1e-9
+    assert np.abs(ros.payload_position() - headless.payload_position()).max() < 1e-9
+    for i in (1, 2):
+        assert np.abs(ros.rotor_speeds(i) - headless.rotor_speeds(i)).max() < 1e-6
+    assert np.abs(ros.tensions() - headless.tensions()).max() < 1e-6
+    assert np.abs(ros.formation_errors(2) - headless.formation_errors(2)).max() < 1e-9
+    # and the run is not trivial: the formation moved
+    assert np.ptp(headless.uav_positions()[0][:, 2]) > 1.0
+
+
+def test_headless_bad_scenario_is_exit_2(tmp_path):
+    out = subprocess.run([MULTILIFT, 'run', 'nope', '--headless'], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 2 and 'unknown scenario' in out.stderr

@@ -115,6 +115,13 @@ class CascadeController:
         self.integral = np.zeros(3)
         self.integral_limit = 0.5 * gravity  # [m/s^2] of integral authority
         self._t_prev: float | None = None
+        # the gains as arrays once (not per tick)
+        self._kp = np.asarray(gains.position_kp, dtype=float)
+        self._kd = np.asarray(gains.position_kd, dtype=float)
+        self._ki = np.asarray(gains.position_ki, dtype=float)
+        self._att_kp = np.asarray(gains.attitude_kp, dtype=float)
+        self._att_kd = np.asarray(gains.attitude_kd, dtype=float)
+        self._gravity_vector = gravity * E_Z
 
     def position_force(self, t: float, state: UavState, position_ref: np.ndarray,
                        velocity_ref: np.ndarray, acceleration_ref: np.ndarray) -> np.ndarray:
@@ -122,20 +129,22 @@ class CascadeController:
         dt = 0.0 if self._t_prev is None else max(0.0, t - self._t_prev)
         self._t_prev = t
         error = position_ref - state.position
-        self.integral = np.clip(self.integral + np.asarray(self.gains.position_ki) * error * dt,
+        self.integral = np.clip(self.integral + self._ki * error * dt,
                                 -self.integral_limit, self.integral_limit)
-        accel = (acceleration_ref + np.asarray(self.gains.position_kp) * error
-                 + np.asarray(self.gains.position_kd) * (velocity_ref - state.velocity)
+        accel = (acceleration_ref + self._kp * error
+                 + self._kd * (velocity_ref - state.velocity)
                  + self.integral)
-        return self.hover_mass * (accel + self.gravity * E_Z)
+        return self.hover_mass * (accel + self._gravity_vector)
 
     def attitude_torque(self, state: UavState, setpoint: np.ndarray) -> np.ndarray:
         """Body torque [N m] driving the Euler angles to `setpoint`."""
         error = wrap_angle(np.asarray(setpoint) - state.euler)
         rates = state.body_rates
-        accel = np.asarray(self.gains.attitude_kp) * error - np.asarray(self.gains.attitude_kd) \
-            * rates
-        return self.inertia * accel + np.cross(rates, self.inertia * rates)
+        accel = self._att_kp * error - self._att_kd * rates
+        p, q, r = rates.tolist()
+        jp, jq, jr = (self.inertia * rates).tolist()
+        gyro = np.array([q * jr - r * jq, r * jp - p * jr, p * jq - q * jp])  # omega x J omega
+        return self.inertia * accel + gyro
 
     def command(self, state: UavState, force: np.ndarray, yaw: float) -> ControlOutput:
         """Rotor speeds that produce `force` (world) at heading `yaw`."""

@@ -15,7 +15,6 @@ import numpy as np
 
 from multilift_control.cascade import CascadeController, ControlOutput, UavState
 from multilift_sim import formation_geometry  # start places and the V offsets v_1i, world
-from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario import ControlConfig
 
@@ -145,6 +144,15 @@ class VirtualConstraints:
         self.axes = np.array(axes, dtype=int)
         self.targets = np.array(targets, dtype=float)
         self.m = len(self.pairs)
+        self._constant_jacobian: np.ndarray | None = None   # linear rows: J_vc (Eq. 3.7)
+        self._free_motions: dict[float, np.ndarray] = {}    # linear rows: by tol
+        if self.linear:
+            jac = np.zeros((self.m, 3 * self.n))
+            rows = np.arange(self.m)
+            jac[rows, 3 * self.pairs[:, 0] + self.axes] = 1.0
+            jac[rows, 3 * self.pairs[:, 1] + self.axes] = -1.0
+            jac.flags.writeable = False
+            self._constant_jacobian = jac
 
     def offsets(self) -> np.ndarray:
         """(n-1, 3) desired r_1 - r_i per follower [m], world (linear and v only)."""
@@ -179,13 +187,11 @@ class VirtualConstraints:
     def jacobian(self, r: np.ndarray) -> np.ndarray:
         """J_vc = d g_vc / d r_f, shape (m, 3n); constant (Eq. 3.7) for linear rows."""
         r = self._check(r)
+        if self._constant_jacobian is not None:
+            return self._constant_jacobian.copy()
         jac = np.zeros((self.m, 3 * self.n))
         rows = np.arange(self.m)
         i, j = self.pairs[:, 0], self.pairs[:, 1]
-        if self.linear:
-            jac[rows, 3 * i + self.axes] = 1.0
-            jac[rows, 3 * j + self.axes] = -1.0
-            return jac
         diff = 2.0 * (r[i] - r[j])
         for axis in range(3):
             jac[rows, 3 * i + axis] = diff[:, axis]
@@ -194,7 +200,10 @@ class VirtualConstraints:
 
     def rate(self, r: np.ndarray, v: np.ndarray) -> np.ndarray:
         """g_vc_dot = J_vc r_f_dot (m,): [m/s] or [m^2/s]."""
-        return self.jacobian(r) @ self._check(v, 'v').reshape(-1)
+        jac = self._constant_jacobian if self.linear else self.jacobian(r)
+        if self.linear:
+            self._check(r)
+        return jac @ self._check(v, 'v').reshape(-1)
 
     def jacobian_rate_product(self, r: np.ndarray, v: np.ndarray) -> np.ndarray:
         """J_vc_dot r_f_dot (m,): zero for linear rows, 2 |v_i - v_j|^2 for distance rows
@@ -217,11 +226,17 @@ class VirtualConstraints:
         row unchanged to first order with the leader held: the null space of J_vc's follower
         x, y columns (stacked x_2, y_2, .., x_n, y_n). Empty (k = 0) for linear rows; for a
         circle the rotation about the leader, for 'distance' each follower's tangent."""
+        if self.linear and tol in self._free_motions:  # J_vc is constant: so is its null space
+            self._check(r)
+            return self._free_motions[tol].copy()
         cols = [3 * i + axis for i in range(1, self.n) for axis in (0, 1)]
         follower_jac = self.jacobian(r)[:, cols]
         _, sv, vt = np.linalg.svd(follower_jac)
         rank = int(np.sum(sv > tol * max(float(sv.max(initial=0.0)), 1e-300)))
-        return vt[rank:].T
+        basis = vt[rank:].T
+        if self.linear:
+            self._free_motions[tol] = basis.copy()
+        return basis
 
     def nominal_positions(self, leader_position: np.ndarray) -> np.ndarray:
         """(n, 3) positions [m], world, satisfying every row, all at the leader's altitude
@@ -239,6 +254,15 @@ class VirtualConstraints:
         return formation_geometry.nominal_positions(
             g.kind, self.n, np.asarray(leader_position, dtype=float).reshape(3),
             g.offsets, g.distance, g.half_angle)
+
+
+def _thrust_axis(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """R(eta) e_z, the third column of kinematics.rotation_matrix, for one attitude [rad]."""
+    s_phi, c_phi = math.sin(roll), math.cos(roll)
+    s_theta, c_theta = math.sin(pitch), math.cos(pitch)
+    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
+    return np.array([c_psi * s_theta * c_phi + s_psi * s_phi,
+                     s_psi * s_theta * c_phi - c_psi * s_phi, c_theta * c_phi])
 
 
 def virtual_forces(constraints: VirtualConstraints, r: np.ndarray, v: np.ndarray,
@@ -345,6 +369,7 @@ class FormationFollower:
         self.beta_vc = beta_vc
         self.yaw = yaw
         self.rows = constraints.rows_of(index)
+        self._linear_law = self._linear_law_matrices() if constraints.linear else None
         if altitude_offset is None:  # d_z of a linear geometry, else 0
             nominal = constraints.nominal_positions(np.zeros(3))
             altitude_offset = nominal[index, 2] - nominal[0, 2]
@@ -385,6 +410,25 @@ class FormationFollower:
                    float(masses[index]), scenario.simulation.gravity, config.alpha_vc,
                    config.beta_vc, **options)
 
+    def _linear_law_matrices(self) -> tuple[np.ndarray, ...]:
+        """For linear (and V) rows J_vc and M are constant, so this follower's row of
+        u_vf = -J^T (J M^-1 J^T)^-1 rhs (`virtual_forces`) is a fixed linear map of rhs:
+        u_vf,i = P rhs with P = -J_i^T A^+ (A^+ = A^-1, or the pseudo-inverse when A is
+        ill-conditioned: the least-squares, minimum-norm Lambda of `virtual_forces`). With
+        rhs = J (M^-1 (u - f) + 2 alpha v) + beta^2 g_vc (J_dot = 0) this is
+        u_vf,i = Q (M^-1 (u - f) + 2 alpha v) + beta^2 P g_vc, Q = P J: O(n) per tick instead
+        of the O(n^3) solve (and cond) of the general law.
+        Returns (P (3, m), Q (3, 3n), M^-1 diagonal (3n,), f = m g e_z stacked (3n,),
+        this follower's rows of J (len(rows), 3n))."""
+        c = self.constraints
+        jac = c.jacobian(np.zeros((c.n, 3)))
+        inv_m = np.repeat(1.0 / self.masses, 3)
+        a = (jac * inv_m) @ jac.T
+        a_plus = np.linalg.inv(a) if np.linalg.cond(a) < _COND_LIMIT else np.linalg.pinv(a)
+        p = -(jac[:, 3 * self.index:3 * self.index + 3].T @ a_plus)
+        weights = (self.masses[:, None] * self.gravity * E_Z).reshape(-1)
+        return p, p @ jac, inv_m, weights, jac[self.rows]
+
     def desired_force(self, t: float, states: list[UavState], thrust_vectors: np.ndarray
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(F world [N], errors g_vc[rows_of(i)], error rates J r_dot[rows_of(i)]).
@@ -398,8 +442,17 @@ class FormationFollower:
         u = np.array(thrust_vectors, dtype=float)
         if self.own_thrust == 'commanded' and self.lift is not None:
             u[i] = self.lift
-        u_vf, _ = virtual_forces(self.constraints, r, v, u, self.masses, self.gravity,
-                                 self.alpha_vc, self.beta_vc)
+        if self._linear_law is not None:  # the same law, O(n): see _linear_law_matrices
+            p, q, inv_m, weights, own_rows = self._linear_law
+            residual = self.constraints.residual(r)
+            rates = own_rows @ v.reshape(-1)
+            u_vf_i = (q @ (inv_m * (u.reshape(-1) - weights) + 2.0 * self.alpha_vc * v.reshape(-1))
+                      + self.beta_vc ** 2 * (p @ residual))
+        else:
+            u_vf, _ = virtual_forces(self.constraints, r, v, u, self.masses, self.gravity,
+                                     self.alpha_vc, self.beta_vc)
+            u_vf_i = u_vf[i]
+            residual = rates = None
         dt = 0.0 if self._t_prev is None else max(0.0, t - self._t_prev)
         self._t_prev = t
         error = r[0, 2] + self.altitude_offset - r[i, 2]   # z_d,i = z_1 (seed §3.2)
@@ -407,14 +460,15 @@ class FormationFollower:
         self.integral = float(np.clip(self.integral + self.gains.position_ki[2] * error * dt,
                                       -self.integral_limit, self.integral_limit))
         force = np.empty(3)
-        force[:2] = u[i, :2] + u_vf[i, :2]
+        force[:2] = u[i, :2] + u_vf_i[:2]
         if self.free_mode_gain is not None:  # not in the seed: see the class docstring
             force[:2] += self._free_mode_correction(r, v, u)
         force[2] = self.hover_mass * (self.gravity + self.gains.position_kp[2] * error
                                       + self.gains.position_kd[2] * error_rate + self.integral)
-        errors = self.constraints.residual(r)[self.rows]
-        rates = self.constraints.rate(r, v)[self.rows]
-        return force, errors, rates
+        if residual is None:
+            residual = self.constraints.residual(r)
+            rates = self.constraints.rate(r, v)[self.rows]
+        return force, residual[self.rows], rates
 
     def _free_mode_correction(self, r: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Horizontal force [N] that replaces, in the free follower motions, the followers'
@@ -443,5 +497,5 @@ class FormationFollower:
         out = self.cascade.command(state, force, self.yaw)  # Eq. 3.13, attitude loop, mixer
         # what the rotors will give after saturation, along the thrust axis asked for
         thrust = self.thrust_coefficient * float(np.sum(out.rotor_speeds ** 2))
-        self.lift = rotation_matrix(out.attitude_setpoint)[:, 2] * thrust
+        self.lift = _thrust_axis(*out.attitude_setpoint.tolist()) * thrust
         return out, errors, rates

@@ -12,7 +12,6 @@ import numpy as np
 from multilift_control.cascade import UavState
 from multilift_control.controllers import make_controller
 from multilift_control.formation import FormationFollower
-from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
 
@@ -33,14 +32,18 @@ def run_headless(scenario: Scenario,
     thrusts = [(u.vehicle.mass + share) * scenario.simulation.gravity for u in scenario.uavs]
     k_t = [u.vehicle.thrust_coefficient for u in scenario.uavs]
     while True:
-        states = uav_states(sim.snapshot())
+        snapshot = sim.snapshot()
+        states = uav_states(snapshot)
         output, _ = leader.update(sim.t, states[0])
         outputs = [output]
-        thrusts[0] = k_t[0] * float(np.sum(output.rotor_speeds ** 2))
-        # as the follower nodes: the leader's thrust at t, the other followers' of the last tick
-        vectors = np.array([rotation_matrix(s.euler)[:, 2] * u for s, u in zip(states, thrusts)])
-        outputs += [f.update(sim.t, states, vectors)[0] for f in followers]
-        thrusts = [k * float(np.sum(o.rotor_speeds ** 2)) for k, o in zip(k_t, outputs)]
+        if followers:
+            thrusts[0] = k_t[0] * float(np.sum(output.rotor_speeds ** 2))
+            # as the follower nodes: the leader's thrust at t, the other followers' of the last
+            # tick; R(eta) e_z is the snapshot's rotation (kinematics.rotation_matrix)
+            axes = np.array([u.rotation[:, 2] for u in snapshot.uavs])
+            vectors = axes * np.array(thrusts)[:, None]
+            outputs += [f.update(sim.t, states, vectors)[0] for f in followers]
+            thrusts = [k * float(np.sum(o.rotor_speeds ** 2)) for k, o in zip(k_t, outputs)]
         if on_tick is not None:
             on_tick(sim, outputs)
         if sim.finished:

@@ -221,6 +221,15 @@ class _Section:
             raise self.fail(name, value, f'must be one of {", ".join(choices)}')
         return value
 
+    def sequence(self, name: str, default: Any = ...) -> list:
+        """A list (a missing or null key gives `default`)."""
+        value = self.raw(name, default)
+        if value is None and default is not ...:
+            value = default
+        if not isinstance(value, list):
+            raise self.fail(name, value, 'must be a list')
+        return value
+
     def section(self, name: str, default: Any = ...) -> '_Section':
         return _Section(self.raw(name, default), self.key(name), self.where)
 
@@ -345,7 +354,7 @@ def _scenario(data: Any, where: str) -> Scenario:
         formation = _formation(top.section('formation'), len(uavs))
 
     gusts = []
-    for i, entry in enumerate(top.raw('gusts', [])):
+    for i, entry in enumerate(top.sequence('gusts', [])):
         g = _Section(entry, f'gusts[{i}]', where)
         direction = g.vector('direction')
         norm = math.sqrt(sum(c * c for c in direction))
@@ -380,7 +389,7 @@ def _scenario(data: Any, where: str) -> Scenario:
     start = m.vector('start', list(uavs[0].position))
     segments = []
     t_prev = 0.0
-    for i, entry in enumerate(m.raw('segments', [])):
+    for i, entry in enumerate(m.sequence('segments', [])):
         seg = _Section(entry, f'mission.segments[{i}]', where)
         velocity = seg.vector('velocity')
         if seg.has('duration') == seg.has('until'):

@@ -14,7 +14,6 @@ import numpy as np
 from multilift_sim.dynamics import FormationModel, StateLayout, initial_state_single_lift
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
-from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.scenario import Scenario
 
 
@@ -102,6 +101,9 @@ class FormationSimulator:
         self.steps_per_tick = sim.physics_steps_per_tick
         self.dt = 1.0 / sim.physics_rate
         self.stats = RunStatistics(self.n)
+        self._lengths = [u.cable_length for u in scenario.uavs]          # l_i [m]
+        rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
+        self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
         self._check(0.0)
 
     @property
@@ -118,20 +120,35 @@ class FormationSimulator:
 
     def snapshot(self) -> Snapshot:
         n = self.n
-        q = self.state[:6 * n + 3]
-        qd = self.state[6 * n + 3:]
-        uavs = []
-        for i in range(n):
-            eta = q[6 * i + 3:6 * i + 6]
-            eta_dot = qd[6 * i + 3:6 * i + 6]
-            s_phi, c_phi = math.sin(eta[0]), math.cos(eta[0])
-            s_th, c_th = math.sin(eta[1]), math.cos(eta[1])
-            w = np.array([[1.0, 0.0, -s_th], [0.0, c_phi, s_phi * c_th],
-                          [0.0, -s_phi, c_phi * c_th]])  # seed Eq. 2.7
-            uavs.append(UavSnapshot(position=q[6 * i:6 * i + 3].copy(),
-                                    velocity=qd[6 * i:6 * i + 3].copy(), euler=eta.copy(),
-                                    rotation=rotation_matrix(eta), body_rates=w @ eta_dot))
-        return Snapshot(self.t_ns, tuple(uavs), q[6 * n:].copy(), qd[6 * n:].copy())
+        nq = 6 * n + 3
+        # one copy of the UAV block; every UavSnapshot field is a view into it
+        uav_q = self.state[:6 * n].reshape(n, 6).copy()
+        uav_qd = self.state[nq:nq + 6 * n].reshape(n, 6).copy()
+        euler = uav_q[:, 3:]
+        sines, cosines = np.sin(euler.T), np.cos(euler.T)
+        s_phi, s_th, s_psi = sines
+        c_phi, c_th, c_psi = cosines
+        # R = Rz(psi) Ry(theta) Rx(phi), body -> world, as kinematics.rotation_matrix
+        rotations = np.empty((n, 3, 3))
+        rotations[:, 0, 0] = c_psi * c_th
+        rotations[:, 0, 1] = c_psi * s_th * s_phi - s_psi * c_phi
+        rotations[:, 0, 2] = c_psi * s_th * c_phi + s_psi * s_phi
+        rotations[:, 1, 0] = s_psi * c_th
+        rotations[:, 1, 1] = s_psi * s_th * s_phi + c_psi * c_phi
+        rotations[:, 1, 2] = s_psi * s_th * c_phi - c_psi * s_phi
+        rotations[:, 2, 0] = -s_th
+        rotations[:, 2, 1] = c_th * s_phi
+        rotations[:, 2, 2] = c_th * c_phi
+        phi_dot, theta_dot, psi_dot = uav_qd[:, 3], uav_qd[:, 4], uav_qd[:, 5]
+        rates = np.empty((n, 3))  # omega = W(eta) eta_dot, seed Eq. 2.7
+        rates[:, 0] = phi_dot - s_th * psi_dot
+        rates[:, 1] = c_phi * theta_dot + s_phi * c_th * psi_dot
+        rates[:, 2] = -s_phi * theta_dot + c_phi * c_th * psi_dot
+        uavs = tuple(UavSnapshot(position=uav_q[i, :3], velocity=uav_qd[i, :3],
+                                 euler=euler[i], rotation=rotations[i], body_rates=rates[i])
+                     for i in range(n))
+        return Snapshot(self.t_ns, uavs, self.state[6 * n:nq].copy(),
+                        self.state[nq + 6 * n:].copy())
 
     def cable_state(self, rotor_speeds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray,
                                                                     np.ndarray]:
@@ -142,7 +159,97 @@ class FormationSimulator:
 
     def advance(self, rotor_speeds: list[np.ndarray], saturated: list[np.ndarray]) -> None:
         """Hold `rotor_speeds` over one control period and integrate to the next tick."""
-        for i, (speeds, flags) in enumerate(zip(rotor_speeds, saturated)):
+        speeds = self._checked_speeds(rotor_speeds)
+        stats = self.stats
+        peaks = np.max(np.abs(speeds), axis=1) if isinstance(speeds, np.ndarray) \
+            else [float(np.max(np.abs(s))) for s in speeds]
+        period = self.period_ns * 1e-9
+        for i, (peak, flags) in enumerate(zip(peaks, saturated)):
+            if peak > stats.max_rotor_speed[i]:
+                stats.max_rotor_speed[i] = float(peak)
+            if np.any(flags):
+                stats.saturated_time[i] += period
+        model = self.model
+        t0 = self.t
+        if isinstance(model, FormationModel) and model.uses_float_kernel:
+            # FormationModel.step's RK4 on plain floats, the wrenches formed once per tick (the
+            # speeds are held) and the tension taken from the first stage of the first step
+            # (the multipliers at this state): the same arithmetic without 2 conversions and
+            # one solve per step
+            wrenches = model.wrenches(speeds).tolist()
+            x = self.state.tolist()
+            solve, nq, dt = model._solve_floats, model.layout.n_coordinates, self.dt
+            half, sixth = 0.5 * dt, dt / 6.0
+            multipliers = None
+            for _ in range(self.steps_per_tick):
+                acc, lam = solve(x, wrenches)
+                if multipliers is None:
+                    multipliers = lam
+                k1 = x[nq:] + acc
+                x2 = [xi + half * ki for xi, ki in zip(x, k1)]
+                k2 = x2[nq:] + solve(x2, wrenches)[0]
+                x3 = [xi + half * ki for xi, ki in zip(x, k2)]
+                k3 = x3[nq:] + solve(x3, wrenches)[0]
+                x4 = [xi + dt * ki for xi, ki in zip(x, k3)]
+                k4 = x4[nq:] + solve(x4, wrenches)[0]
+                x = [xi + sixth * (a + 2.0 * (b + c) + d)
+                     for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
+            self.state = np.array(x)
+            tension = [2.0 * length * lam for length, lam in zip(self._lengths, multipliers)]
+            residuals = self._residuals_floats(x)
+        elif isinstance(model, FormationModel):
+            residuals = None
+            wrenches = model.wrenches(speeds)
+            _, multipliers = model.accelerations_from_wrenches(self.state, wrenches)
+            tension = 2.0 * model.cable_lengths * multipliers
+            x = self.state
+            for _ in range(self.steps_per_tick):
+                x = model._rk4_arrays(x, wrenches, self.dt)
+            self.state = x
+        else:
+            residuals = None
+            tension = np.asarray(model.cable_tension(t0, self.state, speeds))
+            for k in range(self.steps_per_tick):
+                self.state = model.step(t0 + k * self.dt, self.state, speeds, self.dt)
+        stats.min_tension = min(stats.min_tension, float(min(tension)))
+        stats.max_tension = max(stats.max_tension, float(max(tension)))
+        self.tick += 1
+        stats.simulated_time = self.t
+        self._check(self.t, residuals)
+
+    def _residuals_floats(self, x: list[float]) -> tuple[list[float], list[float]] | None:
+        """(g [m^2], g_dot [m^2/s]) per cable from the state as a list (the arithmetic of
+        FormationModel.constraint_residuals in floats), or None when x is not finite."""
+        if not all(map(math.isfinite, x)):
+            return None
+        n = self.n
+        nq, p = 6 * n + 3, 6 * n
+        px, py, pz = x[p:p + 3]
+        pvx, pvy, pvz = x[nq + p:nq + p + 3]
+        g, g_dot = [], []
+        for i, length in enumerate(self._lengths):
+            b = 6 * i
+            dx, dy, dz = px - x[b], py - x[b + 1], pz - x[b + 2]
+            dvx, dvy, dvz = pvx - x[nq + b], pvy - x[nq + b + 1], pvz - x[nq + b + 2]
+            g.append(dx * dx + dy * dy + dz * dz - length * length)
+            g_dot.append(2.0 * (dx * dvx + dy * dvy + dz * dvz))
+        return g, g_dot
+
+    def _checked_speeds(self, rotor_speeds: list[np.ndarray]) -> np.ndarray | list[np.ndarray]:
+        """The commands as one (n, n_r) array (a list when the rotor counts differ), or
+        SimulationStopped naming the UAV whose command has the wrong size or is not finite."""
+        stacked = None
+        if self._uniform_rotors is not None and len(rotor_speeds) == self.n:
+            try:
+                stacked = np.asarray(rotor_speeds, dtype=float)
+            except (ValueError, TypeError):  # ragged: the loop below names the UAV
+                stacked = None
+            if stacked is not None and stacked.shape != (self.n, self._uniform_rotors):
+                stacked = None
+            if stacked is not None and np.all(np.isfinite(stacked)):
+                return stacked
+        out = []
+        for i, speeds in enumerate(rotor_speeds):
             speeds = np.asarray(speeds, dtype=float)
             if speeds.shape != (self.scenario.uavs[i].vehicle.n_rotors,):
                 raise SimulationStopped(
@@ -151,42 +258,39 @@ class FormationSimulator:
             if not np.all(np.isfinite(speeds)):
                 raise SimulationStopped(f'uav{i + 1}: rotor command is not finite '
                                         f'({speeds.tolist()}) at t = {self.t:.3f} s')
-            self.stats.max_rotor_speed[i] = max(self.stats.max_rotor_speed[i],
-                                                float(np.max(np.abs(speeds))))
-            if np.any(flags):
-                self.stats.saturated_time[i] += self.period_ns * 1e-9
-        tension, _, _ = self.cable_state(rotor_speeds)
-        self.stats.min_tension = min(self.stats.min_tension, float(np.min(tension)))
-        self.stats.max_tension = max(self.stats.max_tension, float(np.max(tension)))
-        t0 = self.t
-        for k in range(self.steps_per_tick):
-            self.state = self.model.step(t0 + k * self.dt, self.state, rotor_speeds, self.dt)
-        self.tick += 1
-        self.stats.simulated_time = self.t
-        self._check(self.t)
+            out.append(speeds)
+        if len(out) != self.n:
+            raise SimulationStopped(f'{len(out)} rotor commands for {self.n} UAVs '
+                                    f'(t = {self.t:.3f} s)')
+        return out
 
-    def _check(self, t: float) -> None:
-        """Algorithm 1, lines 10-13: stop when a cable leaves its tolerance."""
-        if not np.all(np.isfinite(self.state)):
-            raise SimulationStopped(f'the formation state became non-finite at t = {t:.3f} s')
-        g, g_dot = self.model.constraint_residuals(self.state)
+    def _check(self, t: float, residuals: tuple[list[float], list[float]] | None = None
+               ) -> None:
+        """Algorithm 1, lines 10-13: stop when a cable leaves its tolerance. `residuals`:
+        (g, g_dot) already computed from a finite state (`_residuals_floats`)."""
+        if residuals is None:
+            if not np.all(np.isfinite(self.state)):
+                raise SimulationStopped(f'the formation state became non-finite at '
+                                        f't = {t:.3f} s')
+            g, g_dot = (a.tolist() for a in self.model.constraint_residuals(self.state))
+        else:
+            g, g_dot = residuals
         sim = self.scenario.simulation
         if self.scenario.gusts:
             gust = self.model.gust_velocity_at_payload(t, self.state)
             self.stats.max_gust_speed = max(self.stats.max_gust_speed,
                                             float(np.linalg.norm(gust)))
-        self.stats.max_abs_constraint = max(self.stats.max_abs_constraint,
-                                            float(np.max(np.abs(g))))
-        self.stats.max_abs_constraint_rate = max(self.stats.max_abs_constraint_rate,
-                                                 float(np.max(np.abs(g_dot))))
-        worst = int(np.argmax(np.abs(g)))
-        if abs(g[worst]) > sim.constraint_tolerance:
+        abs_g, abs_g_dot = [abs(v) for v in g], [abs(v) for v in g_dot]
+        peak, peak_rate = max(abs_g), max(abs_g_dot)
+        worst, worst_rate = abs_g.index(peak), abs_g_dot.index(peak_rate)
+        self.stats.max_abs_constraint = max(self.stats.max_abs_constraint, peak)
+        self.stats.max_abs_constraint_rate = max(self.stats.max_abs_constraint_rate, peak_rate)
+        if peak > sim.constraint_tolerance:
             raise SimulationStopped(
-                f'cable {worst + 1}: constraint residual |g| = {abs(g[worst]):.3g} m^2 exceeds '
+                f'cable {worst + 1}: constraint residual |g| = {peak:.3g} m^2 exceeds '
                 f'the tolerance {sim.constraint_tolerance:g} m^2 at t = {t:.3f} s '
                 '(Algorithm 1: change the step or the Baumgarte gains)')
-        worst = int(np.argmax(np.abs(g_dot)))
-        if abs(g_dot[worst]) > sim.constraint_rate_tolerance:
+        if peak_rate > sim.constraint_rate_tolerance:
             raise SimulationStopped(
-                f'cable {worst + 1}: constraint rate |g_dot| = {abs(g_dot[worst]):.3g} m^2/s '
+                f'cable {worst_rate + 1}: constraint rate |g_dot| = {peak_rate:.3g} m^2/s '
                 f'exceeds the tolerance {sim.constraint_rate_tolerance:g} m^2/s at t = {t:.3f} s')

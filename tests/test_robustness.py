@@ -1,0 +1,559 @@
+"""Robustness for unattended runs: the scenario loader under random valid and invalid values
+(hypothesis), determinism headless and through ROS, isolation of runs on different ROS domains,
+a non-finite rotor command, rotor saturation, SIGTERM, and `multilift sweep`.
+
+The ROS tests use ROS_DOMAIN_ID 12..17 (conftest.ros_env hands out 20..99) with discovery
+limited to this machine."""
+from __future__ import annotations
+
+import copy
+import csv
+import io
+import math
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+from rosbags.highlevel import AnyReader
+
+from conftest import ROOT, SCENARIOS
+from multilift_control.headless import run_headless
+from multilift_control.sweep import sweep_main
+from multilift_sim import scenario as scenario_io
+from multilift_sim.allocation import FRAME_TYPES
+from multilift_sim.simulation import FormationSimulator, SimulationStopped
+
+MULTILIFT = str(ROOT / 'scripts' / 'multilift')
+ROTORS = {'quad': 4, 'hexa': 6, 'octo': 8}
+SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
+                    suppress_health_check=[HealthCheck.too_slow])
+
+
+def _base(name: str) -> dict:
+    return yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
+
+
+def _set(data: dict, key: str, value) -> None:
+    """data[key] = value for a dotted key with [i] indices ('uavs[0].cable_length')."""
+    node = data
+    parts = key.replace('[', '.[').split('.')
+    steps = [int(p[1:-1]) if p.startswith('[') else p for p in parts]
+    for step in steps[:-1]:
+        node = node[step]
+    node[steps[-1]] = value
+
+
+def _delete(data: dict, key: str) -> None:
+    node = data
+    parts = key.replace('[', '.[').split('.')
+    steps = [int(p[1:-1]) if p.startswith('[') else p for p in parts]
+    for step in steps[:-1]:
+        node = node[step]
+    del node[steps[-1]]
+
+
+def _load(data: dict) -> scenario_io.Scenario:
+    return scenario_io.loads(yaml.safe_dump(data), 'fuzz.yaml')
+
+
+# --------------------------------------------------------------------------- value strategies
+finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
+positive = st.one_of(st.floats(min_value=1e-6, max_value=1e6), st.integers(1, 10 ** 6))
+non_negative = st.one_of(st.floats(min_value=0.0, max_value=1e6), st.integers(0, 10 ** 6))
+wrong_type = st.one_of(st.text(max_size=8), st.booleans(), st.none(),
+                       st.lists(st.integers(), max_size=3), st.dictionaries(
+                           st.sampled_from('abc'), st.integers(), max_size=2))
+non_finite = st.sampled_from([math.nan, math.inf, -math.inf])
+
+# single-field rules of scenarios/single_lift.yaml: key -> (valid values, invalid values)
+NUMBER_RULES = {
+    'simulation.duration': (positive, st.floats(max_value=0.0)),
+    'simulation.gravity': (st.floats(min_value=0.1, max_value=9.81), st.floats(max_value=0.0)),
+    'simulation.baumgarte_alpha': (non_negative, st.floats(max_value=-1e-9)),
+    'simulation.baumgarte_beta': (non_negative, st.floats(max_value=-1e-9)),
+    'simulation.constraint_tolerance': (positive, st.floats(max_value=0.0)),
+    'simulation.constraint_rate_tolerance': (positive, st.floats(max_value=0.0)),
+    'simulation.command_timeout': (positive, st.floats(max_value=0.0)),
+    'vehicle.arm_length': (positive, st.floats(max_value=0.0)),
+    'vehicle.moment_coefficient': (positive, st.floats(max_value=0.0)),
+    'uavs[0].cable_length': (positive, st.floats(max_value=0.0)),
+    'uavs[0].yaw': (finite, st.nothing()),
+    'payload.drag_coefficient': (non_negative, st.floats(max_value=-1e-9)),
+    'payload.alpha_deg': (st.floats(min_value=-89.9, max_value=89.9),
+                          st.one_of(st.floats(min_value=90.0), st.floats(max_value=-90.0))),
+    'payload.beta_deg': (st.floats(min_value=-89.9, max_value=89.9),
+                         st.one_of(st.floats(min_value=90.0), st.floats(max_value=-90.0))),
+    'control.max_tilt_deg': (st.floats(min_value=0.1, max_value=89.9),
+                             st.one_of(st.floats(min_value=90.0), st.floats(max_value=0.0))),
+}
+VECTOR_RULES = {  # key -> element rule for valid values (None: any finite), invalid element
+    'vehicle.inertia': (st.floats(min_value=1e-4, max_value=1e3), st.floats(max_value=0.0)),
+    'control.position_gains.kp': (non_negative, st.floats(max_value=-1e-9)),
+    'control.position_gains.kd': (non_negative, st.floats(max_value=-1e-9)),
+    'control.position_gains.ki': (non_negative, st.floats(max_value=-1e-9)),
+    'control.attitude_gains.kp': (non_negative, st.floats(max_value=-1e-9)),
+    'control.attitude_gains.kd': (non_negative, st.floats(max_value=-1e-9)),
+    'uavs[0].position': (finite, st.nothing()),
+    'mission.start': (finite, st.nothing()),
+    'mission.segments[0].velocity': (finite, st.nothing()),
+}
+CHOICE_RULES = {'vehicle.frame_type': FRAME_TYPES, 'control.mode': scenario_io.CONTROL_MODES}
+REQUIRED = ['name', 'simulation', 'simulation.duration', 'simulation.physics_rate',
+            'simulation.control_rate', 'simulation.baumgarte_alpha',
+            'simulation.baumgarte_beta', 'simulation.constraint_tolerance',
+            'simulation.constraint_rate_tolerance', 'vehicle', 'vehicle.mass',
+            'vehicle.inertia', 'vehicle.frame_type', 'vehicle.arm_length',
+            'vehicle.thrust_coefficient', 'vehicle.moment_coefficient',
+            'vehicle.rotor_speed_min', 'vehicle.rotor_speed_max', 'uavs[0].cable_length',
+            'payload', 'payload.mass', 'control', 'control.mode', 'control.position_gains',
+            'control.position_gains.kp', 'control.attitude_gains.kd', 'mission',
+            'mission.segments[0].velocity']
+SECTIONS = ['', 'simulation', 'vehicle', 'uavs[0]', 'payload', 'control',
+            'control.position_gains', 'control.attitude_gains', 'mission',
+            'mission.segments[0]']
+MAPPINGS = ['simulation', 'vehicle', 'payload', 'control', 'control.position_gains', 'mission',
+            'uavs[0]', 'mission.segments[1]']
+LISTS = ['uavs', 'mission.segments', 'gusts']
+
+
+def _get(data: dict, key: str):
+    node = data
+    for part in key.replace('[', '.[').split('.'):
+        node = node[int(part[1:-1])] if part.startswith('[') else node[part]
+    return node
+
+
+@st.composite
+def valid_edits(draw) -> list[tuple[str, object]]:
+    keys = draw(st.lists(st.sampled_from(sorted(NUMBER_RULES) + sorted(VECTOR_RULES)
+                                         + sorted(CHOICE_RULES)), unique=True, max_size=6))
+    edits = []
+    for key in keys:
+        if key in NUMBER_RULES:
+            edits.append((key, draw(NUMBER_RULES[key][0])))
+        elif key in VECTOR_RULES:
+            edits.append((key, draw(st.lists(VECTOR_RULES[key][0], min_size=3, max_size=3))))
+        else:
+            edits.append((key, draw(st.sampled_from(CHOICE_RULES[key]))))
+    return edits
+
+
+@st.composite
+def invalid_edit(draw):
+    """(key the message must name, function that breaks the data)."""
+    kind = draw(st.sampled_from(['number', 'vector', 'choice', 'unknown', 'missing',
+                                 'not_mapping', 'not_list']))
+    if kind == 'number':
+        key = draw(st.sampled_from(sorted(NUMBER_RULES)))
+        value = draw(st.one_of(NUMBER_RULES[key][1], wrong_type, non_finite))
+        return key, lambda d: _set(d, key, value)
+    if kind == 'vector':
+        key = draw(st.sampled_from(sorted(VECTOR_RULES)))
+        good, bad = VECTOR_RULES[key]
+        value = draw(st.one_of(
+            st.lists(good, max_size=6).filter(lambda v: len(v) != 3),   # wrong length
+            st.tuples(good, good, st.one_of(bad, wrong_type, non_finite)).map(list),
+            wrong_type.filter(lambda v: not isinstance(v, list)), finite))
+        return key, lambda d: _set(d, key, value)
+    if kind == 'choice':
+        key = draw(st.sampled_from(sorted(CHOICE_RULES)))
+        value = draw(st.one_of(st.text(max_size=10).filter(lambda v: v not in CHOICE_RULES[key]),
+                               st.integers(), st.none(), st.booleans()))
+        return key, lambda d: _set(d, key, value)
+    if kind == 'unknown':
+        section = draw(st.sampled_from(SECTIONS))
+        name = draw(st.from_regex(r'[a-z][a-z_]{0,10}', fullmatch=True))
+        key = f'{section}.{name}' if section else name
+        return key, lambda d: (_get(d, section) if section else d).setdefault(name, 1.0)
+    if kind == 'missing':
+        key = draw(st.sampled_from(REQUIRED))
+        return key, lambda d: _delete(d, key)
+    if kind == 'not_mapping':
+        key = draw(st.sampled_from(MAPPINGS))
+        value = draw(st.one_of(st.integers(), st.text(max_size=5),
+                               st.lists(st.integers(), max_size=2)))
+        return key, lambda d: _set(d, key, value)
+    key = draw(st.sampled_from(LISTS))
+    value = draw(st.one_of(st.integers(), st.text(min_size=1, max_size=5), st.floats(),
+                           st.dictionaries(st.sampled_from('ab'), st.integers(), min_size=1)))
+    return key, lambda d: _set(d, key, value)
+
+
+# --------------------------------------------------------------------------- loader properties
+@SETTINGS
+@given(edits=valid_edits())
+def test_random_valid_values_load_and_are_kept(edits):
+    data = _base('single_lift')
+    for key, value in edits:
+        _set(data, key, value)
+    s = _load(data)
+    for key, value in edits:
+        if key.startswith('payload.') and key.endswith('_deg'):
+            assert math.degrees(getattr(s.payload, key[8:-4])) == pytest.approx(value)
+        elif key == 'control.max_tilt_deg':
+            assert math.degrees(s.control.max_tilt) == pytest.approx(value)
+        elif key == 'simulation.duration':
+            assert s.simulation.duration == value
+        elif key == 'vehicle.inertia':
+            assert s.uavs[0].vehicle.inertia == tuple(float(v) for v in value)
+        elif key == 'vehicle.frame_type':
+            assert s.uavs[0].vehicle.frame_type == value
+        elif key == 'uavs[0].cable_length':
+            assert s.uavs[0].cable_length == value
+        elif key == 'control.position_gains.kp':
+            assert s.control.position_kp == tuple(float(v) for v in value)
+
+
+@SETTINGS
+@given(mass=st.floats(min_value=0.1, max_value=20.0), payload=st.floats(min_value=1e-3,
+                                                                        max_value=20.0),
+       k_t=st.floats(min_value=1e-7, max_value=1e-5), w_max=st.floats(min_value=100, max_value=5e3),
+       frame=st.sampled_from(FRAME_TYPES), rates=st.tuples(st.floats(min_value=1.0,
+                                                                     max_value=500.0),
+                                                           st.integers(1, 20)))
+def test_payload_feasibility_and_rates_follow_the_rules(mass, payload, k_t, w_max, frame, rates):
+    """Cross-field rules: a payload the rotors cannot lift names payload.mass; a control rate
+    dividing the physics rate loads."""
+    data = _base('single_lift')
+    data['vehicle'].update(mass=mass, thrust_coefficient=k_t, rotor_speed_max=w_max,
+                           frame_type=frame)
+    data['payload']['mass'] = payload
+    control, steps = rates
+    data['simulation'].update(control_rate=control, physics_rate=control * steps)
+    lift = ROTORS[frame.split('_')[0]] * k_t * w_max ** 2
+    weight = (mass + payload) * data['simulation']['gravity']
+    assume(abs(weight - lift) > 1e-9 * lift)
+    ratio = (control * steps) / control
+    assume(abs(ratio - round(ratio)) <= 1e-9)
+    if weight >= lift:
+        with pytest.raises(scenario_io.ScenarioError, match=r'payload\.mass: .* too heavy'):
+            _load(data)
+    else:
+        s = _load(data)
+        assert s.simulation.physics_steps_per_tick == steps
+        assert s.payload.mass == payload
+
+
+@SETTINGS
+@given(broken=invalid_edit())
+def test_random_invalid_values_raise_scenario_error_naming_the_key(broken):
+    key, edit = broken
+    data = _base('single_lift')
+    edit(data)
+    try:
+        _load(data)
+    except scenario_io.ScenarioError as exc:
+        message = str(exc)
+    except Exception as exc:  # noqa: BLE001 - the property: nothing but ScenarioError
+        pytest.fail(f'{key}: {type(exc).__name__}: {exc} (expected a ScenarioError)')
+    else:
+        pytest.fail(f'{key}: the broken scenario loaded')
+    assert message.startswith('fuzz.yaml: ')
+    assert '\n' not in message
+    assert key in message, message
+
+
+@SETTINGS
+@given(n=st.integers(2, 6), geometry=st.sampled_from(['v', 'distance', 'circle']),
+       distance=st.floats(min_value=0.5, max_value=30.0), cable=st.floats(min_value=0.5,
+                                                                         max_value=60.0),
+       half_angle=st.floats(min_value=1.0, max_value=89.0))
+def test_formation_values_load_or_name_the_formation(n, geometry, distance, cable, half_angle):
+    """Formation sizes and cable lengths: a formation loads or is one ScenarioError naming the
+    formation (wider than its cables) -- never another exception."""
+    data = _base('multi_lift')
+    data['formation'].update(n=n, geometry=geometry, distance=distance)
+    if geometry == 'v':
+        data['formation']['half_angle_deg'] = half_angle
+    else:
+        del data['formation']['half_angle_deg']
+    data['cable_length'] = cable
+    if geometry == 'circle' and n < 3:
+        with pytest.raises(scenario_io.ScenarioError, match='formation.geometry'):
+            _load(data)
+        return
+    try:
+        s = _load(data)
+    except scenario_io.ScenarioError as exc:
+        assert 'formation' in str(exc) and 'cable' in str(exc)
+        return
+    assert s.n_uavs == n and s.formation.geometry == geometry
+
+
+# --------------------------------------------------------------------------- determinism
+def _trajectory(scenario) -> np.ndarray:
+    states = []
+    run_headless(scenario, on_tick=lambda sim, outputs: states.append(
+        np.concatenate([sim.state, *[o.rotor_speeds for o in outputs]])))
+    return np.array(states)
+
+
+@pytest.mark.parametrize('name', ['single_lift', 'twin_lift', 'multi_lift', 'circle3'])
+def test_headless_runs_are_identical(name):
+    text = (SCENARIOS / f'{name}.yaml').read_text()
+    first = _trajectory(_short(scenario_io.loads(text), 4.0))
+    second = _trajectory(_short(scenario_io.loads(text), 4.0))
+    assert first.shape[0] == 401
+    assert np.array_equal(first, second)  # bit for bit, rotor commands included
+
+
+def _short(scenario, duration: float):
+    from dataclasses import replace
+    return replace(scenario, simulation=replace(scenario.simulation, duration=duration))
+
+
+def _ros_env(domain: int) -> dict:
+    return dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+
+
+def _raw_messages(bag: Path) -> dict[str, list[bytes]]:
+    out: dict[str, list[bytes]] = {}
+    with AnyReader([bag]) as reader:
+        for conn, _, raw in reader.messages():
+            out.setdefault(conn.topic, []).append(bytes(raw))
+    return out
+
+
+STATE_TOPICS = ['/uav1/odom', '/payload/odom', '/formation/state', '/uav1/rotor_cmd']
+
+
+def test_ros_runs_give_byte_identical_state_messages(tmp_path):
+    bags = []
+    for k in range(2):
+        bag = tmp_path / f'run{k}'
+        out = subprocess.run([MULTILIFT, 'run', 'single_lift', '--duration', '3', '--bag',
+                              str(bag)], capture_output=True, text=True, timeout=300,
+                             env=_ros_env(12))
+        assert out.returncode == 0, out.stderr
+        bags.append(_raw_messages(bag))
+    for topic in STATE_TOPICS:
+        assert len(bags[0][topic]) == 301, topic
+        assert bags[0][topic] == bags[1][topic], topic  # CDR payloads, byte for byte
+
+
+def test_two_runs_on_different_domains_do_not_see_each_other(tmp_path):
+    runs = []
+    for domain, (name, n) in zip((13, 14), (('single_lift', 1), ('twin_lift', 2))):
+        bag = tmp_path / name
+        proc = subprocess.Popen([MULTILIFT, 'run', name, '--duration', '3', '--bag', str(bag)],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                env=_ros_env(domain))
+        runs.append((proc, bag, n))
+    for proc, bag, n in runs:
+        _, err = proc.communicate(timeout=300)
+        assert proc.returncode == 0, err
+    for proc, bag, n in runs:
+        data = _raw_messages(bag)
+        topics = ['/clock', '/payload/odom', '/formation/state'] + \
+            [f'/uav{i}/{leaf}' for i in range(1, n + 1) for leaf in ('odom', 'rotor_cmd')]
+        for topic in topics:
+            assert len(data[topic]) == 301, (bag.name, topic, len(data[topic]))
+        # a twin-lift's second UAV must not appear in the single-lift's bag
+        assert ('/uav2/odom' in data) == (n == 2)
+
+
+# --------------------------------------------------------------------------- failures
+@pytest.mark.parametrize('bad', [math.nan, math.inf, -math.inf])
+def test_non_finite_rotor_command_stops_the_simulator_naming_the_uav(bad):
+    sim = FormationSimulator(scenario_io.load('twin_lift'))
+    speeds = [np.full(4, 1500.0), np.full(4, 1500.0)]
+    flags = [np.zeros(4, bool)] * 2
+    sim.advance(speeds, flags)
+    before = sim.state.copy()
+    speeds[1][2] = bad
+    with pytest.raises(SimulationStopped) as err:
+        sim.advance(speeds, flags)
+    message = str(err.value)
+    assert message.startswith('uav2: rotor command is not finite') and 't = 0.010 s' in message
+    assert np.array_equal(sim.state, before) and sim.tick == 1  # nothing integrated
+
+
+def test_nan_from_a_controller_stops_a_headless_run(monkeypatch):
+    from multilift_control import controllers
+    original = controllers.MissionLeader.update
+
+    def broken(self, t, state):
+        out, ref = original(self, t, state)
+        if t >= 0.5:
+            out.rotor_speeds[0] = math.nan
+        return out, ref
+    monkeypatch.setattr(controllers.MissionLeader, 'update', broken)
+    with pytest.raises(SimulationStopped, match=r'uav1: rotor command is not finite .* '
+                                                r'at t = 0\.500 s'):
+        run_headless(scenario_io.load('single_lift'))
+
+
+FAKE_LEADER = """
+import sys, time
+import rclpy
+from multilift_msgs.msg import RotorCommand
+from nav_msgs.msg import Odometry
+from multilift_sim.ros_common import PUBLISHER_QOS, SUBSCRIBER_QOS
+rclpy.init()
+node = rclpy.create_node('fake_leader')
+pub = node.create_publisher(RotorCommand, '/uav1/rotor_cmd', PUBLISHER_QOS)
+def answer(msg):
+    t = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+    cmd = RotorCommand()
+    cmd.header.stamp = msg.header.stamp
+    cmd.header.frame_id = 'uav1/base_link'
+    cmd.angular_velocity = [float('nan') if t >= 0.5 else 1700.0, 1700.0, 1700.0, 1700.0]
+    cmd.saturated = [False] * 4
+    pub.publish(cmd)
+node.create_subscription(Odometry, '/uav1/odom', answer, SUBSCRIBER_QOS)
+end = time.monotonic() + float(sys.argv[1])
+while rclpy.ok() and time.monotonic() < end:
+    rclpy.spin_once(node, timeout_sec=0.05)
+rclpy.try_shutdown()
+"""
+
+
+def test_nan_command_over_ros_stops_sim_node_with_one_line(tmp_path):
+    """sim_node in lockstep with a controller that answers t >= 0.5 s with a NaN speed."""
+    env = _ros_env(16)
+    summary = tmp_path / 'summary'
+    leader = subprocess.Popen([str(ROOT / '.venv' / 'bin' / 'python'), '-c', FAKE_LEADER, '90'],
+                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        sim = subprocess.run([MULTILIFT, 'node', 'multilift_sim', 'sim_node', '--ros-args', '-p',
+                              'scenario:=single_lift', '-p', f'summary_dir:={summary}'],
+                             env=env, capture_output=True, text=True, timeout=120)
+    finally:
+        leader.kill()
+        leader.wait()
+    assert sim.returncode == 1, sim.stderr
+    lines = [line for line in sim.stderr.splitlines() if line.startswith('error:')]
+    assert lines == ['error: uav1: rotor command is not finite ([nan, 1700.0, 1700.0, 1700.0]) '
+                     'at t = 0.500 s']
+    stats = yaml.safe_load((summary / 'sim.json').read_text())
+    assert stats['simulated_time'] == pytest.approx(0.5)
+    assert 'not finite' in stats['error']
+
+
+def test_rotor_command_of_the_wrong_size_is_named():
+    sim = FormationSimulator(scenario_io.load('single_lift'))
+    with pytest.raises(SimulationStopped, match='uav1: rotor command has 3 speeds, the vehicle '
+                                                'has 4 rotors'):
+        sim.advance([np.full(3, 1000.0)], [np.zeros(3, bool)])
+
+
+def test_saturating_payload_runs_and_stays_within_rotor_limits():
+    """The seed's 0.79 kg payload on the single-lift: hover needs ~2100 rad/s, the limit."""
+    data = _base('single_lift')
+    data['payload']['mass'] = 0.79
+    scenario = _load(data)
+    hover = math.sqrt((2.5 + 0.79) * 9.81 / (4 * 1.83e-6))
+    assert 2090 < hover < 2100
+    low, high = [math.inf], [-math.inf]
+
+    def watch(sim, outputs):
+        low[0] = min(low[0], float(outputs[0].rotor_speeds.min()))
+        high[0] = max(high[0], float(outputs[0].rotor_speeds.max()))
+    sim = run_headless(_short(scenario, 30.0), on_tick=watch)
+    assert sim.t == pytest.approx(30.0)
+    assert sim.stats.saturated_time[0] > 0
+    assert 0.0 <= low[0] and high[0] <= 2100.0
+    assert sim.stats.max_rotor_speed[0] == pytest.approx(2100.0)
+
+
+def _pids_with(marker: str) -> list[int]:
+    out = subprocess.run(['pgrep', '-f', marker], capture_output=True, text=True)
+    return [int(p) for p in out.stdout.split()]
+
+
+def test_sigterm_leaves_no_process_and_a_closed_bag(tmp_path):
+    scenario = tmp_path / f'sigterm_{os.getpid()}_{time.monotonic_ns()}.yaml'
+    scenario.write_text((SCENARIOS / 'twin_lift.yaml').read_text())
+    bag = tmp_path / 'bag'
+    proc = subprocess.Popen([MULTILIFT, 'run', str(scenario), '--bag', str(bag)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=_ros_env(15))
+    deadline = time.monotonic() + 60
+    while len(_pids_with(scenario.name)) < 4 and time.monotonic() < deadline:
+        time.sleep(0.2)   # the command (cli), sim, leader, follower name the scenario file
+    assert len(_pids_with(scenario.name)) == 4
+    time.sleep(4.0)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert 'interrupted' in err
+    assert _pids_with(scenario.name) == []
+    assert _pids_with(str(bag)) == []            # the recorder (its argv names the bag)
+    assert (bag / 'metadata.yaml').is_file()
+    mcap = next(bag.glob('*.mcap'))
+    assert mcap.read_bytes()[-8:] == b'\x89MCAP0\r\n'   # footer magic: the file was closed
+    data = _raw_messages(bag)
+    assert len(data['/uav1/odom']) > 50
+    assert abs(len(data['/uav1/odom']) - len(data['/uav2/rotor_cmd'])) <= 1
+
+
+# --------------------------------------------------------------------------- sweep
+def test_sweep_writes_one_row_per_variant_in_product_order(tmp_path, capsys):
+    out = tmp_path / 'sweep.csv'
+    code = sweep_main(['twin_lift', '--set', 'payload.mass=0.4,0.8', '--set',
+                       'formation.alpha_vc=1.0,2.1', '--duration', '2', '--jobs', '2',
+                       '--out', str(out), '--no-progress'])
+    assert code == 0
+    rows = list(csv.DictReader(io.StringIO(out.read_text())))
+    assert [(r['payload.mass'], r['formation.alpha_vc']) for r in rows] == \
+        [('0.4', '1.0'), ('0.4', '2.1'), ('0.8', '1.0'), ('0.8', '2.1')]
+    for row in rows:
+        assert row['error'] == '' and float(row['simulated_time']) == pytest.approx(2.0)
+        assert 0 < float(row['max_rotor_speed']) <= 2100
+        assert float(row['max_abs_g']) < 0.02
+        assert float(row['tracking_error_rms']) <= float(row['tracking_error_max'])
+        assert float(row['formation_error_max']) >= 0
+    # a row computed in a worker process equals the same variant run here
+    data = _base('twin_lift')
+    data['payload']['mass'] = 0.8
+    data['formation']['alpha_vc'] = 2.1
+    sim = run_headless(_short(_load(data), 2.0))
+    assert float(rows[3]['max_abs_g']) == sim.stats.max_abs_constraint
+    assert float(rows[3]['max_rotor_speed']) == max(sim.stats.max_rotor_speed)
+
+
+def test_sweep_reports_a_stopped_run_in_its_row(tmp_path):
+    out = tmp_path / 'sweep.csv'
+    code = sweep_main(['single_lift_swing', '--set', 'simulation.baumgarte_alpha=0.0,20.0',
+                       '--set', 'simulation.baumgarte_beta=0.0', '--set',
+                       'simulation.constraint_tolerance=1e-12', '--duration', '2', '--jobs',
+                       '1', '--out', str(out), '--no-progress'])
+    assert code == 0
+    rows = list(csv.DictReader(io.StringIO(out.read_text())))
+    assert len(rows) == 2
+    assert rows[0]['error'].startswith('cable 1: constraint residual |g|')
+    assert float(rows[0]['simulated_time']) < 2.0
+
+
+@pytest.mark.parametrize('args,message', [
+    (['--set', 'payload.mas=0.4'], 'payload.mas: unknown key'),
+    (['--set', 'payload.mass=0.4,-1'], 'payload.mass: -1.0 must be > 0'),
+    (['--set', 'vehicle.frame_type=quad_x,tri'], "vehicle.frame_type: 'tri' must be one of"),
+    (['--set', 'uavs[7].cable_length=3'], 'uavs[7].cable_length: index 7 is out of range'),
+    (['--set', 'payload.mass'], 'expected KEY=V1,V2'),
+    (['--set', 'payload.mass=0.4', '--set', 'payload.mass=0.5'], 'given twice'),
+    (['--set', 'payload..mass=1'], 'is not a key'),
+    (['--set', 'payload.mass=1', '--jobs', '0'], '--jobs: 0 must be >= 1'),
+])
+def test_sweep_bad_input_is_one_line_and_exit_2(args, message, capsys):
+    assert sweep_main(['twin_lift', *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count('\n') == 0 and err.startswith('error: ') and message in err, err
+
+
+def test_sweep_makes_the_uav_list_for_per_uav_keys(tmp_path):
+    out = tmp_path / 'sweep.csv'
+    assert sweep_main(['multi_lift', '--set', 'uavs[2].cable_length=10.26,10.5',
+                       '--duration', '0.5', '--jobs', '1', '--out', str(out),
+                       '--no-progress']) == 0
+    rows = list(csv.DictReader(io.StringIO(out.read_text())))
+    assert [r['uavs[2].cable_length'] for r in rows] == ['10.26', '10.5']
+    assert all(r['error'] == '' for r in rows)
+    assert copy.deepcopy(_base('multi_lift')).get('uavs') is None  # the file is untouched

@@ -14,6 +14,7 @@ import numpy as np
 from multilift_sim.dynamics import FormationModel, StateLayout, initial_state_single_lift
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
+from multilift_sim.nullspace import make_model
 from multilift_sim.scenario import Scenario
 
 
@@ -92,7 +93,8 @@ class FormationSimulator:
                  baumgarte_beta: float | None = None):
         self.scenario = scenario
         sim = scenario.simulation
-        self.model = FormationModel(scenario.formation_params(baumgarte_alpha, baumgarte_beta))
+        self.model = make_model(scenario.formation_params(baumgarte_alpha, baumgarte_beta),
+                                sim.integrator)
         self.n = scenario.n_uavs
         self.state = initial_state(scenario, model=self.model)
         self.tick = 0

@@ -64,7 +64,20 @@ BAD = [
     (lambda d: d['mission']['segments'][1].update(until=5.0), 'mission.segments[1]'),
     (lambda d: d['vehicle'].update(mass='heavy'), "vehicle.mass: 'heavy' must be a number"),
     (lambda d: d['vehicle'].update(mass=float('nan')), 'vehicle.mass: nan must be finite'),
+    (lambda d: d['simulation'].update(integrator='euler'),
+     "simulation.integrator: 'euler' must be one of baumgarte, nullspace"),
 ]
+
+
+def test_nullspace_integrator_is_selectable_and_holds_the_cable():
+    from multilift_control.headless import run_headless
+    text = _edited('single_lift_swing', lambda d: d['simulation'].update(integrator='nullspace',
+                                                                          duration=2.0))
+    s = scenario_io.loads(text)
+    assert s.simulation.integrator == 'nullspace'
+    sim = run_headless(s)
+    assert type(sim.model).__name__ == 'NullSpaceModel'
+    assert sim.stats.max_abs_constraint < 1e-10
 
 
 FORMATION_BAD = [

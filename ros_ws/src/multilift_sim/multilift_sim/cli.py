@@ -96,6 +96,10 @@ def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
             lines.append(f'  uav{i + 1} rotors      max {w:.1f} rad/s (limit {limit:g}), '
                          f'saturated {s:.2f} s')
         lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} N')
+        if 'max_payload_swing' in sim:
+            lines.append(f'  payload swing    max {sim["max_payload_swing"]:.3f} m, '
+                         f'rms {sim["rms_payload_swing"]:.3f} m (horizontal, from its rest '
+                         'place under the UAVs)')
         if scenario.gusts:
             lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} m/s')
     leader = data.get('leader')
@@ -248,13 +252,20 @@ DELEGATED = {
     'modal': ('multilift_sim.modal', 'modal_main',
               'eigenvalues and pendulum periods at the static equilibrium (seed §2.8)'),
     'study': ('multilift_sim.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
+    'reproduce': ('multilift_control.reproduce', 'reproduce_main',
+                  "the seed's §2.8 and Ch. 4 results, figures and docs/reproduction.md"),
 }
 
 
 def _delegate(args: argparse.Namespace) -> int:
     import importlib
     module, function, _ = DELEGATED[args.command]
-    return getattr(importlib.import_module(module), function)(args.rest)
+    try:
+        entry = getattr(importlib.import_module(module), function)
+    except ModuleNotFoundError as exc:
+        print(f'error: {args.command}: {exc} (run scripts/setup)', file=sys.stderr)
+        return 2
+    return entry(args.rest)
 
 
 def build_parser() -> argparse.ArgumentParser:

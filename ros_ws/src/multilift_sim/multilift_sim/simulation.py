@@ -52,13 +52,27 @@ class RunStatistics:
     max_tension: float = -math.inf         # [N]
     simulated_time: float = 0.0            # [s]
     max_gust_speed: float = 0.0            # peak gust speed met by the payload [m/s]
+    # payload swing: horizontal distance of the payload from where it hung at t = 0 relative
+    # to the UAVs' centroid (the payload's tracking error with respect to the formation) [m]
+    max_payload_swing: float = 0.0
+    sum_sq_payload_swing: float = 0.0
+    swing_samples: int = 0
 
     def __post_init__(self) -> None:
         self.max_rotor_speed = [0.0] * self.n_uavs
         self.saturated_time = [0.0] * self.n_uavs
 
+    def add_swing(self, swing: float) -> None:
+        self.max_payload_swing = max(self.max_payload_swing, swing)
+        self.sum_sq_payload_swing += swing * swing
+        self.swing_samples += 1
+
     def as_dict(self) -> dict:
-        return {k: v for k, v in self.__dict__.items()}
+        out = {k: v for k, v in self.__dict__.items()
+               if k not in ('sum_sq_payload_swing', 'swing_samples')}
+        out['rms_payload_swing'] = math.sqrt(self.sum_sq_payload_swing
+                                             / max(self.swing_samples, 1))
+        return out
 
 
 def initial_state(scenario: Scenario, model: FormationModel) -> np.ndarray:
@@ -103,6 +117,7 @@ class FormationSimulator:
         self.steps_per_tick = sim.physics_steps_per_tick
         self.dt = 1.0 / sim.physics_rate
         self.stats = RunStatistics(self.n)
+        self._rest_offset: tuple[float, float] | None = None
         self._lengths = [u.cable_length for u in scenario.uavs]          # l_i [m]
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
@@ -266,6 +281,13 @@ class FormationSimulator:
                                     f'(t = {self.t:.3f} s)')
         return out
 
+    def _payload_offset(self) -> tuple[float, float]:
+        """Horizontal payload position relative to the UAVs' centroid [m]."""
+        n, x = self.n, self.state
+        cx = sum(x[6 * i] for i in range(n)) / n
+        cy = sum(x[6 * i + 1] for i in range(n)) / n
+        return float(x[6 * n] - cx), float(x[6 * n + 1] - cy)
+
     def _check(self, t: float, residuals: tuple[list[float], list[float]] | None = None
                ) -> None:
         """Algorithm 1, lines 10-13: stop when a cable leaves its tolerance. `residuals`:
@@ -278,6 +300,11 @@ class FormationSimulator:
         else:
             g, g_dot = residuals
         sim = self.scenario.simulation
+        offset = self._payload_offset()
+        if self._rest_offset is None:
+            self._rest_offset = offset
+        self.stats.add_swing(math.hypot(offset[0] - self._rest_offset[0],
+                                        offset[1] - self._rest_offset[1]))
         if self.scenario.gusts:
             gust = self.model.gust_velocity_at_payload(t, self.state)
             self.stats.max_gust_speed = max(self.stats.max_gust_speed,

@@ -283,14 +283,17 @@ class FormationModel:
         wrenches = self.wrenches(rotor_speeds)
         x = np.asarray(x, dtype=float)
         if self.uses_float_kernel:
-            return np.array(self._rk4_floats(x.tolist(), wrenches.tolist(), dt))
+            return np.array(self.rk4_floats(x.tolist(), wrenches.tolist(), dt)[0])
         return self._rk4_arrays(x, wrenches, dt)
 
-    def _rk4_floats(self, x: list[float], wrenches: list[list[float]],
-                    dt: float) -> list[float]:
+    def rk4_floats(self, x: list[float], wrenches: list[list[float]],
+                   dt: float) -> tuple[list[float], list[float]]:
+        """One RK4 step on plain floats (float kernel) with the body wrenches held:
+        (the new state, the cable multipliers at the start state)."""
         nq, solve, half = self._nq, self._solve_floats, 0.5 * dt
         # k = q_dot + q_ddot is list concatenation: the state derivative (q_dot, q_ddot)
-        k1 = x[nq:] + solve(x, wrenches)[0]
+        acc, multipliers = solve(x, wrenches)
+        k1 = x[nq:] + acc
         x2 = [xi + half * ki for xi, ki in zip(x, k1)]
         k2 = x2[nq:] + solve(x2, wrenches)[0]
         x3 = [xi + half * ki for xi, ki in zip(x, k2)]
@@ -298,8 +301,8 @@ class FormationModel:
         x4 = [xi + dt * ki for xi, ki in zip(x, k3)]
         k4 = x4[nq:] + solve(x4, wrenches)[0]
         sixth = dt / 6.0
-        return [xi + sixth * (a + 2.0 * (b + c) + d)
-                for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
+        return ([xi + sixth * (a + 2.0 * (b + c) + d)
+                 for xi, a, b, c, d in zip(x, k1, k2, k3, k4)], multipliers)
 
     def _rk4_arrays(self, x: np.ndarray, wrenches: np.ndarray, dt: float) -> np.ndarray:
         nq, solve = self._nq, self._solve_arrays

@@ -189,28 +189,12 @@ class FormationSimulator:
         model = self.model
         t0 = self.t
         if isinstance(model, FormationModel) and model.uses_float_kernel:
-            # FormationModel.step's RK4 on plain floats, the wrenches formed once per tick (the
-            # speeds are held) and the tension taken from the first stage of the first step
-            # (the multipliers at this state): the same arithmetic without 2 conversions and
-            # one solve per step
+            # the wrenches formed once per tick (the speeds are held) and the tension taken
+            # from the first stage of the first step (the multipliers at this state)
             wrenches = model.wrenches(speeds).tolist()
-            x = self.state.tolist()
-            solve, nq, dt = model._solve_floats, model.layout.n_coordinates, self.dt
-            half, sixth = 0.5 * dt, dt / 6.0
-            multipliers = None
-            for _ in range(self.steps_per_tick):
-                acc, lam = solve(x, wrenches)
-                if multipliers is None:
-                    multipliers = lam
-                k1 = x[nq:] + acc
-                x2 = [xi + half * ki for xi, ki in zip(x, k1)]
-                k2 = x2[nq:] + solve(x2, wrenches)[0]
-                x3 = [xi + half * ki for xi, ki in zip(x, k2)]
-                k3 = x3[nq:] + solve(x3, wrenches)[0]
-                x4 = [xi + dt * ki for xi, ki in zip(x, k3)]
-                k4 = x4[nq:] + solve(x4, wrenches)[0]
-                x = [xi + sixth * (a + 2.0 * (b + c) + d)
-                     for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
+            x, multipliers = model.rk4_floats(self.state.tolist(), wrenches, self.dt)
+            for _ in range(self.steps_per_tick - 1):
+                x = model.rk4_floats(x, wrenches, self.dt)[0]
             self.state = np.array(x)
             tension = [2.0 * length * lam for length, lam in zip(self._lengths, multipliers)]
             residuals = self._residuals_floats(x)

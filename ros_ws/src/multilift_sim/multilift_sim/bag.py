@@ -33,6 +33,11 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
 from multilift_sim import bagyaml, msgdefs
 
+try:
+    from zstandard import ZstdError
+except ImportError:  # no zstd support installed: mcap raises UnsupportedCompressionError
+    ZstdError = McapError
+
 DEFAULT_CHUNK_SIZE = 256 * 1024  # [B] uncompressed
 METADATA_VERSION = 9
 ROS_DISTRO = 'jazzy'
@@ -40,6 +45,9 @@ STORAGE_IDENTIFIER = 'mcap'
 MESSAGE_ENCODING = 'cdr'
 LIBRARY = f'multilift bag.py ({LIBRARY_IDENTIFIER})'
 _NO_TIME = 2**63 - 1  # rosbag2's starting_time of a bag without messages [ns]
+# What reading the torn end of an MCAP file can raise: a record cut short (EndOfFile, struct),
+# a bad CRC, or garbage where a record should start (e.g. blocks a crash left zero-filled).
+TORN_RECORD_ERRORS = (McapError, struct.error, EOFError, ValueError, ZstdError)
 _COMPRESSION = {'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4,
                 'none': CompressionType.NONE}
 
@@ -105,12 +113,14 @@ class BagWriter:
 
     `directory` must not exist or be empty, as `ros2 bag record` demands. `compression` is
     'zstd', 'lz4' or 'none'; `chunk_size` [B] the uncompressed size at which a chunk is finished;
-    `custom_data` string pairs for `metadata.yaml`'s `custom_data`.
+    `custom_data` string pairs for `metadata.yaml`'s `custom_data`; `file_name` the MCAP file's
+    name (default `<directory name>_0.mcap`, as rosbag2 names it).
     """
 
     def __init__(self, directory: str | os.PathLike, *, compression: str = 'zstd',
                  chunk_size: int = DEFAULT_CHUNK_SIZE,
-                 custom_data: dict[str, str] | None = None) -> None:
+                 custom_data: dict[str, str] | None = None,
+                 file_name: str | None = None) -> None:
         self.directory = Path(directory)
         if self.directory.exists() and (
                 not self.directory.is_dir() or any(self.directory.iterdir())):
@@ -120,8 +130,10 @@ class BagWriter:
             raise BagError(f'compression {compression!r} is not one of {sorted(_COMPRESSION)}')
         if chunk_size <= 0:
             raise BagError(f'chunk_size must be positive, got {chunk_size} B')
+        self.file_name = file_name or f'{self.directory.resolve().name}_0.mcap'
+        if Path(self.file_name).name != self.file_name or not self.file_name.endswith('.mcap'):
+            raise BagError(f'file_name {self.file_name!r} must be a plain name ending in .mcap')
         self.directory.mkdir(parents=True, exist_ok=True)
-        self.file_name = f'{self.directory.resolve().name}_0.mcap'
         self.mcap_path = self.directory / self.file_name
         self.custom_data = dict(custom_data or {})
         self._file = _DirectFile(self.mcap_path)
@@ -271,13 +283,15 @@ class BagWriter:
         self.close()
 
 
-def recover(directory: str | os.PathLike, output: str | os.PathLike) -> int:
+def recover(directory: str | os.PathLike, output: str | os.PathLike, *,
+            file_name: str | None = None, custom_data: dict[str, str] | None = None) -> int:
     """Copy what is readable of a bag whose recorder died into a new, closed bag `output`.
 
     Reads `directory`'s MCAP file front to back (as `ros2 bag reindex` and `mcap recover` do) and
     keeps every message of every complete chunk; a torn record at the end ends the copy. Topics,
     schemas, QoS and type hashes come from the MCAP's own schema and channel records, so the
-    message packages need not be installed. Returns the number of messages recovered.
+    message packages need not be installed. `file_name` and `custom_data` are passed to the
+    output's BagWriter. Returns the number of messages recovered.
     """
     files = sorted(Path(directory).glob('*.mcap'))
     if not files:
@@ -285,7 +299,8 @@ def recover(directory: str | os.PathLike, output: str | os.PathLike) -> int:
     schemas: dict[int, Schema] = {}
     topics: dict[int, str] = {}
     count = 0
-    with open(files[0], 'rb') as stream, BagWriter(output) as out:
+    with open(files[0], 'rb') as stream, BagWriter(output, file_name=file_name,
+                                                   custom_data=custom_data) as out:
         try:
             for record in StreamReader(stream, validate_crcs=True).records:
                 if isinstance(record, Schema):
@@ -301,6 +316,6 @@ def recover(directory: str | os.PathLike, output: str | os.PathLike) -> int:
                     out.write(topics[record.channel_id], record.data, record.log_time,
                               record.publish_time)
                     count += 1
-        except (McapError, struct.error, EOFError):
+        except TORN_RECORD_ERRORS:
             pass  # the torn tail of a file whose writer was killed
     return count

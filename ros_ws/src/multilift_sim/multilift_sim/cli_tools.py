@@ -3,6 +3,8 @@
     topic list [-t]                      topic names (with [types] for -t), sorted
     topic echo TOPIC [TYPE] [--once]     messages as YAML, `---` after each (Ctrl-C ends)
     topic info TOPIC                     type, publisher and subscription counts
+    topic hz TOPIC [-w N] [--wall-time] [--use-sim-time]
+                                         receive rate, as `ros2 topic hz` (Ctrl-C ends)
     node PKG EXECUTABLE [ARGS...]        exec <prefix>/lib/PKG/EXECUTABLE found on AMENT_PREFIX_PATH
 
 The topic tools wait up to DISCOVERY_WAIT [s] for the ROS graph to settle (ros2cli's daemonless mode
@@ -21,6 +23,8 @@ from multilift_sim.msgdefs import ament_prefixes
 
 DISCOVERY_WAIT = 3.0  # [s] longest wait for the graph (Fast DDS may take 2.5 s to discover)
 SETTLE = 0.5  # [s] without graph change, once another node is seen, that ends the wait
+HZ_WINDOW = 10000  # messages `topic hz` averages over by default (ros2 topic hz's default)
+HZ_DEPTH = 100  # keep_last depth of `topic hz`'s subscription
 
 
 def _spin_graph(node, until=None, timeout: float = DISCOVERY_WAIT) -> None:
@@ -101,8 +105,103 @@ def _topic_echo(node, args: argparse.Namespace) -> int:
     return 0
 
 
+class RateWindow:
+    """Receive-rate statistics of one topic, computed as `ros2 topic hz` (Jazzy) does.
+
+    `add(t_ns)` takes the receive time [ns] of each message on the chosen clock; `report()`
+    gives (rate [Hz], min, max, std dev of the intervals [s], intervals in the window) at most
+    once per second of that clock, else None. A time of 0 (ROS time before the first /clock)
+    is ignored, as ros2's. A clock that goes back (a new run, a looping `bag play`) restarts the
+    window and the once-a-second schedule; ros2 keeps the schedule and so stays silent until
+    the new clock passes the old time.
+    """
+
+    def __init__(self, window: int = HZ_WINDOW) -> None:
+        self.window = window
+        self.intervals: list[int] = []  # [ns]
+        self.first_ns = -1
+        self.last_ns = 0
+        self.last_printed_ns = 0
+
+    def add(self, t_ns: int) -> None:
+        """One message received at `t_ns` [ns]."""
+        if t_ns == 0:
+            self.intervals = []
+            return
+        if self.first_ns < 0 or self.first_ns > t_ns or t_ns < self.last_ns:
+            self.first_ns = self.last_ns = t_ns
+            self.intervals = []
+            self.last_printed_ns = 0
+            return
+        self.intervals.append(t_ns - self.last_ns)
+        self.last_ns = t_ns
+        if len(self.intervals) > self.window:
+            self.intervals.pop(0)
+
+    def report(self) -> tuple[float, float, float, float, int] | None:
+        """(rate [Hz], min [s], max [s], std dev [s], window) once a second, else None."""
+        if not self.intervals:
+            return None
+        if self.last_printed_ns == 0:
+            self.last_printed_ns = self.last_ns
+            return None
+        if self.last_ns < self.last_printed_ns + 1_000_000_000:
+            return None
+        n = len(self.intervals)
+        mean = sum(self.intervals) / n
+        std = (sum((x - mean) ** 2 for x in self.intervals) / n) ** 0.5
+        self.last_printed_ns = self.last_ns
+        rate = 1e9 / mean if mean > 0 else 0.0
+        return rate, min(self.intervals) * 1e-9, max(self.intervals) * 1e-9, std * 1e-9, n
+
+
+def format_hz(rate: float, min_s: float, max_s: float, std_s: float, window: int) -> str:
+    """Two lines as `ros2 topic hz` prints them (rate [Hz], intervals [s])."""
+    return (f'average rate: {rate:.3f}\n\tmin: {min_s:.3f}s max: {max_s:.3f}s '
+            f'std dev: {std_s:.5f}s window: {window}')
+
+
+def _topic_hz(node, args: argparse.Namespace) -> int:
+    import rclpy
+    from rclpy.clock import Clock, ClockType
+    from rclpy.qos import DurabilityPolicy
+    from multilift_sim import introspection
+    _spin_graph(node, until=_has_topic(node, args.topic))
+    if args.topic not in dict(node.get_topic_names_and_types()):
+        print(f'WARNING: topic [{args.topic}] does not appear to be published yet',
+              file=sys.stderr, flush=True)
+        while rclpy.ok() and args.topic not in dict(node.get_topic_names_and_types()):
+            rclpy.spin_once(node, timeout_sec=0.1)
+    type_name = dict(node.get_topic_names_and_types())[args.topic][0]
+    try:
+        msg_type = introspection.import_message_type(type_name)
+    except ValueError as error:
+        print(f'topic hz: {error}', file=sys.stderr)
+        return 1
+    qos = introspection.adapted_qos(node.get_publishers_info_by_topic(args.topic),
+                                    depth=HZ_DEPTH)
+    qos.durability = DurabilityPolicy.VOLATILE  # a latched backlog would be one burst
+    clock = Clock(clock_type=ClockType.SYSTEM_TIME) if args.wall_time else node.get_clock()
+    stats = RateWindow(args.window)
+    node.create_subscription(msg_type, args.topic,
+                             lambda data: stats.add(clock.now().nanoseconds), qos, raw=True)
+    while rclpy.ok():
+        rclpy.spin_once(node, timeout_sec=0.1)
+        result = stats.report()
+        if result is not None:
+            print(format_hz(*result), flush=True)
+    return 0
+
+
+def _window_size(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError('window must be a positive number of messages')
+    return value
+
+
 def topic_main(argv: list[str]) -> int:
-    """`topic list|echo|info ...` (argv without the word `topic`); returns the exit code."""
+    """`topic list|echo|info|hz ...` (argv without the word `topic`); returns the exit code."""
     parser = argparse.ArgumentParser(prog='multilift topic', description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     verbs = parser.add_subparsers(dest='verb', required=True)
@@ -114,15 +213,27 @@ def topic_main(argv: list[str]) -> int:
     echo.add_argument('--once', action='store_true', help='print one message and exit')
     info = verbs.add_parser('info', help='type and endpoint counts of a topic')
     info.add_argument('topic')
+    hz = verbs.add_parser('hz', help='receive rate of a topic, as ros2 topic hz')
+    hz.add_argument('topic')
+    hz.add_argument('-w', '--window', type=_window_size, default=HZ_WINDOW,
+                    help=f'messages to average over (default {HZ_WINDOW})')
+    hz.add_argument('--wall-time', action='store_true',
+                    help='time receipts on the wall clock even with --use-sim-time')
+    hz.add_argument('--use-sim-time', action='store_true',
+                    help='time receipts on /clock (simulated time) instead of the system clock')
     args = parser.parse_args(argv)
 
     import rclpy
     from rclpy.executors import ExternalShutdownException
+    from rclpy.parameter import Parameter
     rclpy.init()
-    node = rclpy.create_node(f'_multilift_topic_{os.getpid()}', start_parameter_services=False)
+    overrides = ([Parameter('use_sim_time', Parameter.Type.BOOL, True)]
+                 if getattr(args, 'use_sim_time', False) else [])
+    node = rclpy.create_node(f'_multilift_topic_{os.getpid()}', start_parameter_services=False,
+                             parameter_overrides=overrides)
     try:
-        return {'list': _topic_list, 'info': _topic_info, 'echo': _topic_echo}[args.verb](
-            node, args)
+        return {'list': _topic_list, 'info': _topic_info, 'echo': _topic_echo,
+                'hz': _topic_hz}[args.verb](node, args)
     except (KeyboardInterrupt, ExternalShutdownException):
         return 0
     finally:

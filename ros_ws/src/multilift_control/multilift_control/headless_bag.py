@@ -16,7 +16,8 @@ from multilift_control.mission import MissionPath
 from multilift_sim import messages
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
-from multilift_sim.ros_common import run_topics, uav_topic
+from multilift_sim.markers import formation_markers
+from multilift_sim.ros_common import MARKER_DECIMATION, run_topics, uav_topic
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator
 
@@ -63,7 +64,11 @@ def record_headless(scenario: Scenario, bag_dir: Path,
                 write(uav_topic(i + 1, 'formation_error'),
                       messages.formation_error(t_ns, residual[rows], rate[rows]), t_ns)
         speeds = [o.rotor_speeds for o in outputs]
-        write('/formation/state', messages.formation_state(t_ns, *sim.cable_state(speeds)), t_ns)
+        tension, g, g_dot = sim.cable_state(speeds)
+        write('/formation/state', messages.formation_state(t_ns, tension, g, g_dot), t_ns)
+        if sim.tick % MARKER_DECIMATION == 0:
+            write('/visualization/markers',
+                  formation_markers(snap, tension, scenario, t_ns), t_ns)
         if on_tick is not None:
             on_tick(sim)
 

@@ -5,6 +5,7 @@
     multilift topic list | echo TOPIC [--once] | info TOPIC
     multilift plot BAG [--out DIR] | animate BAG [--out FILE.gif] | compare BAG_A BAG_B
     multilift modal SCENARIO [--out DIR] | study baumgarte [--out DIR]
+    multilift bag info|play|reindex DIR | foxglove [--port P] | sweep | reproduce
 
 Exit codes: 0 done, 1 the run failed, 2 bad input, 130 interrupted.
 """
@@ -109,8 +110,9 @@ def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
     for i in range(2, scenario.n_uavs + 1):
         follower = data.get(f'follower{i}')
         if follower and follower.get('answered_states'):
-            lines.append(f'  uav{i} formation  max |g_vc| {follower["max_abs_formation_error"]:.3f}, '
-                         f'mean |g_vc| {follower["mean_formation_error_norm"]:.3f} (m)')
+            lines.append(f'  uav{i} formation  max |g_vc| '
+                         f'{follower["max_abs_formation_error"]:.3f}, mean |g_vc| '
+                         f'{follower["mean_formation_error_norm"]:.3f} (m)')
     if bag is not None:
         lines.append(f'  bag              {bag}')
     print('\n'.join(lines))
@@ -252,6 +254,12 @@ DELEGATED = {
     'modal': ('multilift_sim.modal', 'modal_main',
               'eigenvalues and pendulum periods at the static equilibrium (seed §2.8)'),
     'study': ('multilift_sim.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
+    'bag': ('multilift_sim.bag_tools', 'bag_main',
+            'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),
+    'foxglove': ('multilift_sim.foxglove_bridge', 'foxglove_main',
+                 'serve the live graph to Foxglove over WebSocket (ws://localhost:8765)'),
+    'sweep': ('multilift_control.sweep', 'sweep_main',
+              'headless variants of a scenario in parallel, one CSV row each'),
     'reproduce': ('multilift_control.reproduce', 'reproduce_main',
                   "the seed's §2.8 and Ch. 4 results, figures and docs/reproduction.md"),
 }

@@ -16,9 +16,11 @@ import numpy as np
 import rclpy
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
+from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 
 WORLD_FRAME = 'world'
 
@@ -26,7 +28,7 @@ WORLD_FRAME = 'world'
 # controller or recorder whose subscription matched a moment after t = 0 was published still
 # gets it (discovery of each endpoint pair is independent; the lockstep would otherwise wait for
 # an answer to a state the controller never saw).
-PUBLISHER_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+PUBLISHER_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                            reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
 SUBSCRIBER_QOS = PUBLISHER_QOS
@@ -117,6 +119,24 @@ def write_summary(directory: str, name: str, data: dict) -> None:
         (path / f'{name}.json').write_text(json.dumps(data, indent=1, sort_keys=True))
 
 
+RECORDER_NODE = 'recorder'
+MARKER_DECIMATION = 10  # /visualization/markers every this many control ticks
+
+
+def recorder_missing(node: Node, publishers) -> str | None:
+    """The first of our publishers' topics the recorder does not subscribe to yet, or None.
+
+    Counting subscriptions is not enough: a controller subscribing to the same topic would
+    satisfy the count while the recorder is still starting, and the start of the run would be
+    missing from the bag. So the recorder's own endpoint is looked for by node name.
+    """
+    for pub in publishers:
+        infos = node.get_subscriptions_info_by_topic(pub.topic_name)
+        if not any(info.node_name == RECORDER_NODE for info in infos):
+            return f'the recorder to subscribe to {pub.topic_name}'
+    return None
+
+
 def wait_until(node: Node, ready: Callable[[], str | None], timeout: float) -> None:
     """Spin until `ready()` returns None (it returns what is still missing), or raise."""
     deadline = time.monotonic() + timeout
@@ -152,6 +172,21 @@ def spin(node: Node) -> None:
         node.executor.spin_once(timeout_sec=0.1)
 
 
+def flush_publishers(node: Node, timeout: float = 3.0) -> None:
+    """Wait until every subscriber acknowledged this node's messages. A reliable writer that
+    is destroyed first takes its unacknowledged history with it: a recorder lagging behind
+    would lose the last messages of the run."""
+    deadline = time.monotonic() + timeout
+    for pub in list(node.publishers):
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return
+        try:
+            pub.wait_for_all_acked(Duration(seconds=left))
+        except Exception:  # noqa: BLE001 - a context already shut down: nothing to wait for
+            return
+
+
 def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
@@ -165,7 +200,10 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
     Errors of kind Fatal, StartupError or ScenarioError print one line; exit code 1.
     """
     from multilift_sim.scenario import ScenarioError
-    rclpy.init(args=args)
+    # our own SIGINT/SIGTERM handling: rclpy's would shut the context down at once, before the
+    # publishers are flushed
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    signal.signal(signal.SIGINT, _interrupt)
     signal.signal(signal.SIGTERM, _interrupt)
     node = None
     code = 0
@@ -184,6 +222,7 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
         code = 1 if not isinstance(exc, ScenarioError) else 2
     finally:
         if node is not None:
+            flush_publishers(node)
             try:
                 node.destroy_node()
             except Exception:  # noqa: BLE001 - shutting down anyway
@@ -197,6 +236,7 @@ def run_topics(n_uavs: int) -> list[tuple[str, str]]:
     topics = [('/clock', 'rosgraph_msgs/msg/Clock'), ('/payload/odom', 'nav_msgs/msg/Odometry'),
               ('/formation/state', 'multilift_msgs/msg/FormationState'),
               ('/payload/gust', 'geometry_msgs/msg/Vector3Stamped'),
+              ('/visualization/markers', 'visualization_msgs/msg/MarkerArray'),
               (uav_topic(1, 'reference'), 'multilift_msgs/msg/TrackingReference')]
     for i in range(1, n_uavs + 1):
         topics += [(uav_topic(i, 'odom'), 'nav_msgs/msg/Odometry'),

@@ -1,7 +1,8 @@
 """Simulator node: integrates the formation DAE in lockstep with the controllers.
 
 Each control tick it publishes `/clock` and the state at t (`/uav{i}/odom`, `/payload/odom`,
-`/payload/gust`: the gust velocity at the payload, world frame),
+`/payload/gust`: the gust velocity at the payload, world frame; `/visualization/markers` every
+tenth tick),
 waits for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes `/formation/state`, and
 integrates to the next tick. No command within `command_timeout` wall seconds stops the run
 naming the silent UAV. Parameters: scenario (name or path), record (wait for a recorder),
@@ -15,14 +16,17 @@ import numpy as np
 from geometry_msgs.msg import Vector3Stamped
 from multilift_msgs.msg import FormationState, RotorCommand
 from nav_msgs.msg import Odometry
-from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
+from visualization_msgs.msg import MarkerArray
 
 from multilift_sim import messages
+from multilift_sim.markers import formation_markers
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      run_node, uav_topic, wait_until, write_summary)
+from multilift_sim.ros_common import (MARKER_DECIMATION, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
+                                      ns_from_stamp, recorder_missing, run_node, uav_topic,
+                                      wait_until,
+                                      write_summary)
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 STARTUP_TIMEOUT = 60.0  # wall seconds for the graph to come together [s]
@@ -54,6 +58,8 @@ class SimNode(Node):
         self.formation_pub = self.create_publisher(FormationState, '/formation/state',
                                                    PUBLISHER_QOS)
         self.gust_pub = self.create_publisher(Vector3Stamped, '/payload/gust', PUBLISHER_QOS)
+        self.marker_pub = self.create_publisher(MarkerArray, '/visualization/markers',
+                                                PUBLISHER_QOS)
         self.commands: list[RotorCommand | None] = [None] * n
         self.cmd_subs = [self.create_subscription(
             RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
@@ -69,10 +75,8 @@ class SimNode(Node):
             if sub.get_publisher_count() < 1:
                 return f'a controller publishing {uav_topic(i + 1, "rotor_cmd")}'
         if self.record:
-            for pub in [self.clock_pub, self.payload_pub, self.formation_pub, self.gust_pub,
-                        *self.odom_pubs]:
-                if pub.get_subscription_count() < 1:
-                    return f'the recorder to subscribe to {pub.topic_name}'
+            return recorder_missing(self, [self.clock_pub, self.payload_pub, self.formation_pub,
+                                           self.gust_pub, self.marker_pub, *self.odom_pubs])
         return None
 
     def publish_state(self) -> None:
@@ -97,8 +101,11 @@ class SimNode(Node):
             self.executor.spin_once(timeout_sec=0.1)
 
     def publish_formation(self, speeds: list[np.ndarray]) -> None:
-        self.formation_pub.publish(messages.formation_state(self.sim.t_ns,
-                                                            *self.sim.cable_state(speeds)))
+        tension, g, g_dot = self.sim.cable_state(speeds)
+        self.formation_pub.publish(messages.formation_state(self.sim.t_ns, tension, g, g_dot))
+        if self.sim.tick % MARKER_DECIMATION == 0:
+            self.marker_pub.publish(formation_markers(self.sim.snapshot(), tension,
+                                                      self.scenario, self.sim.t_ns))
 
     def run(self) -> None:
         wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
@@ -123,18 +130,8 @@ class SimNode(Node):
                     self._progress(wall)
         except SimulationStopped as exc:
             self._finish(time.monotonic() - wall_start, str(exc))
-            self.flush()
             raise Fatal(str(exc)) from None
         self._finish(time.monotonic() - wall_start, None)
-        self.flush()
-
-    def flush(self, timeout: float = 5.0) -> None:
-        """Wait until every subscriber acknowledged our messages: a reliable writer that is
-        destroyed first takes its unacknowledged history with it (the recorder would miss the
-        last ticks of the run)."""
-        for pub in [self.clock_pub, self.payload_pub, self.formation_pub, self.gust_pub,
-                    *self.odom_pubs]:
-            pub.wait_for_all_acked(Duration(seconds=timeout))
 
     def _progress(self, wall: float) -> None:
         t_max = self.sim.tick_count * self.sim.period_ns * 1e-9

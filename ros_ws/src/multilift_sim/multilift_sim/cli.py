@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
+import signal
 import sys
 import tempfile
 import time
@@ -305,6 +306,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `multilift bag info B | head` ends quietly
+    # subcommands that parse their own options get them untouched (argparse's REMAINDER would
+    # reject a leading option such as `foxglove --port 8765`)
+    if argv and argv[0] in (*DELEGATED, 'topic'):
+        return build_parser().parse_args([argv[0]]).func(
+            argparse.Namespace(command=argv[0], rest=argv[1:]))
     args = build_parser().parse_args(argv)
     return args.func(args)
 

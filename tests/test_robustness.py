@@ -557,3 +557,30 @@ def test_sweep_makes_the_uav_list_for_per_uav_keys(tmp_path):
     assert [r['uavs[2].cable_length'] for r in rows] == ['10.26', '10.5']
     assert all(r['error'] == '' for r in rows)
     assert copy.deepcopy(_base('multi_lift')).get('uavs') is None  # the file is untouched
+
+
+def test_sweep_sigterm_stops_the_workers_and_writes_what_finished(tmp_path):
+    out = tmp_path / 'sweep.csv'
+    code = ('import sys; from multilift_control.sweep import sweep_main; '
+            'sys.exit(sweep_main(sys.argv[1:]))')
+    proc = subprocess.Popen([str(ROOT / '.venv' / 'bin' / 'python'), '-c', code, 'multi_lift',
+                             '--set', 'payload.mass=0.5,0.6,0.7,0.8,0.9,1.0', '--jobs', '2',
+                             '--out', str(out), '--no-progress'],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    workers: list[int] = []
+    while len(workers) < 2 and time.monotonic() < deadline:
+        time.sleep(0.5)
+        found = subprocess.run(['pgrep', '-P', str(proc.pid)], capture_output=True, text=True)
+        workers = [int(p) for p in found.stdout.split()]
+    assert len(workers) >= 2
+    time.sleep(3.0)   # the 120 s missions are still running
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert '(interrupted)' in err
+    for pid in workers:
+        assert not Path(f'/proc/{pid}').exists() or \
+            Path(f'/proc/{pid}/stat').read_text().split()[2] == 'Z', pid
+    rows = list(csv.DictReader(io.StringIO(out.read_text())))
+    assert len(rows) < 6   # the header and whatever finished

@@ -14,7 +14,9 @@ stderr and exit code 2.
 
 The variants run headless (`multilift_control.headless.run_headless`: the simulator core and
 every controller in one process, the same laws and tick order as the ROS stack) in `--jobs`
-processes (default: the number of CPUs), with a progress bar on stderr. The CSV (FILE, or
+worker processes (default: the number of CPUs; each with one BLAS thread unless
+OPENBLAS_NUM_THREADS is set), with a progress bar on stderr. Ctrl-C or SIGTERM stops the
+workers and writes the rows finished so far. The CSV (FILE, or
 stdout) has one row per variant, in the order of the product, with the parameters and:
 simulated_time [s], max_abs_g [m^2], max_abs_g_dot [m^2/s], max_rotor_speed [rad/s] (over
 every UAV), saturated_time [s] (summed over the UAVs), min_tension/max_tension [N],
@@ -36,11 +38,12 @@ import io
 import itertools
 import json
 import math
+import multiprocessing
 import os
 import re
+import signal
 import sys
 import time
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -54,6 +57,7 @@ METRICS = ('simulated_time', 'max_abs_g', 'max_abs_g_dot', 'max_rotor_speed', 's
            'min_tension', 'max_tension', 'tracking_error_max', 'tracking_error_rms',
            'formation_error_max', 'formation_error_mean', 'wall_time', 'error')
 
+BLAS_THREAD_VARIABLES = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS')
 _STEP = re.compile(r'([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$')
 
 
@@ -255,9 +259,19 @@ def run_variant(text: str, where: str, duration: float | None = None) -> dict[st
     return row
 
 
-def _run_indexed(index: int, text: str, where: str, duration: float | None
-                 ) -> tuple[int, dict[str, Any]]:
+def _run_indexed(job: tuple[int, str, str, float | None]) -> tuple[int, dict[str, Any]]:
+    index, text, where, duration = job
     return index, run_variant(text, where, duration)
+
+
+def _worker_init() -> None:
+    """Workers leave Ctrl-C and SIGTERM to the parent, which stops them."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
 
 
 # ------------------------------------------------------------------------------------ output
@@ -355,6 +369,8 @@ def sweep_main(argv: list[str] | None = None) -> int:
     progress = _Progress(len(variants), not args.no_progress)
     stopped = 0
     interrupted = False
+    old_term = signal.signal(signal.SIGTERM, _interrupt)  # unattended: SIGTERM as Ctrl-C
+    pool = None
     try:
         if jobs == 1:
             for index, (_, text, where) in enumerate(variants):
@@ -362,25 +378,34 @@ def sweep_main(argv: list[str] | None = None) -> int:
                 stopped += bool(rows[index]['error'])
                 progress.update(stopped)
         else:
-            with ProcessPoolExecutor(max_workers=jobs) as pool:
-                pending = {pool.submit(_run_indexed, i, text, where, args.duration)
-                           for i, (_, text, where) in enumerate(variants)}
-                try:
-                    while pending:
-                        done, pending = wait(pending, return_when=FIRST_COMPLETED)
-                        for future in done:
-                            index, row = future.result()
-                            rows[index] = row
-                            stopped += bool(row['error'])
-                            progress.update(stopped)
-                except KeyboardInterrupt:
-                    for future in pending:
-                        future.cancel()
-                    pool.shutdown(wait=False, cancel_futures=True)
-                    raise
+            # fresh worker processes with one BLAS thread each (unless the caller set it):
+            # --jobs processes already use the cores, and oversubscribed OpenBLAS threads made
+            # the numpy kernel (n > 20) an order of magnitude slower on a busy machine
+            saved = {var: os.environ.get(var) for var in BLAS_THREAD_VARIABLES}
+            for var in BLAS_THREAD_VARIABLES:
+                os.environ.setdefault(var, '1')
+            try:
+                pool = multiprocessing.get_context('spawn').Pool(jobs, initializer=_worker_init)
+            finally:
+                for var, value in saved.items():
+                    if value is None:
+                        os.environ.pop(var, None)
+                    else:
+                        os.environ[var] = value
+            work = [(i, text, where, args.duration) for i, (_, text, where) in enumerate(variants)]
+            for index, row in pool.imap_unordered(_run_indexed, work):
+                rows[index] = row
+                stopped += bool(row['error'])
+                progress.update(stopped)
+            pool.close()
     except KeyboardInterrupt:
         interrupted = True
     finally:
+        if pool is not None:
+            if interrupted:
+                pool.terminate()
+            pool.join()
+        signal.signal(signal.SIGTERM, old_term)
         progress.close()
     text = io.StringIO()
     write_csv(text, keys, variants, rows)

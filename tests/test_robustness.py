@@ -32,7 +32,7 @@ from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 ROTORS = {'quad': 4, 'hexa': 6, 'octo': 8}
-SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
+SETTINGS = settings(max_examples=150, deadline=None, derandomize=True, database=None,
                     suppress_health_check=[HealthCheck.too_slow])
 
 

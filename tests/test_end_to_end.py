@@ -150,16 +150,24 @@ def test_ctrl_c_leaves_closed_readable_bag_and_no_processes(tmp_path, ros_env,
     assert abs(len(data['/uav1/odom']) - len(data['/uav1/rotor_cmd'])) <= 1
 
 
-def test_a_dead_controller_stops_the_run_and_is_named(tmp_path, ros_env, private_scenario):
+@pytest.mark.parametrize('scenario,victim,named', [
+    ('single_lift', 'leader_node', 'leader_node'),
+    ('twin_lift', 'follower_node', 'follower_node (uav2)')])
+def test_a_dead_controller_stops_the_run_and_is_named(tmp_path, ros_env, scenario, victim,
+                                                      named):
+    private = tmp_path / f'{scenario}_{os.getpid()}_{time.monotonic_ns()}.yaml'
+    private.write_text((SCENARIOS / f'{scenario}.yaml').read_text())
     bag = tmp_path / 'bag'
-    proc = _run([str(private_scenario), '--bag', str(bag)], ros_env)
-    pids = _wait_for_processes(f'leader_node.*{private_scenario.name}', 1)
+    proc = _run([str(private), '--bag', str(bag)], ros_env)
+    pids = _wait_for_processes(f'{victim}.*{private.name}', 1)
     time.sleep(3.0)
     os.kill(pids[0], signal.SIGKILL)
+    killed = time.monotonic()
     _, err = proc.communicate(timeout=60)
+    print(f'{victim} killed: the run stopped {time.monotonic() - killed:.2f} s later')
     assert proc.returncode == 1
-    assert 'leader_node' in err
-    assert _children_of(private_scenario.name) == []
+    assert f'error: {named} stopped' in err
+    assert _children_of(private.name) == []
     assert len(read_bag(bag)['/uav1/odom']) > 10
 
 

@@ -92,9 +92,9 @@ class Supervisor:
     def _on_signal(self, signum, frame) -> None:
         self._interrupted = True
 
-    def stop(self, role: str, timeout: float = 10.0) -> None:
-        """SIGINT every child of `role`, then SIGTERM, then SIGKILL as needed."""
-        group = [c for c in self.children if c.role == role]
+    def stop(self, *roles: str, timeout: float = 10.0) -> None:
+        """SIGINT every child of these roles at once, then SIGTERM, then SIGKILL as needed."""
+        group = [c for c in self.children if c.role in roles]
         for sig, wait in ((signal.SIGINT, timeout), (signal.SIGTERM, 3.0),
                           (signal.SIGKILL, 3.0)):
             alive = [c for c in group if c.returncode() is None]
@@ -107,8 +107,8 @@ class Supervisor:
                 time.sleep(0.05)
 
     def stop_all(self) -> None:
-        self.stop('sim')
-        self.stop('controller')
+        """Simulator and controllers together (their flushes overlap), the recorder last."""
+        self.stop('sim', 'controller')
         self.stop('recorder')
 
     def run(self, on_tick=None) -> tuple[str, Child | None]:

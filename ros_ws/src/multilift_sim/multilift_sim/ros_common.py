@@ -172,7 +172,7 @@ def spin(node: Node) -> None:
         node.executor.spin_once(timeout_sec=0.1)
 
 
-def flush_publishers(node: Node, timeout: float = 3.0) -> None:
+def flush_publishers(node: Node, timeout: float = 1.5) -> None:
     """Wait until every subscriber acknowledged this node's messages. A reliable writer that
     is destroyed first takes its unacknowledged history with it: a recorder lagging behind
     would lose the last messages of the run."""

@@ -20,7 +20,7 @@ from multilift_sim import messages
 from multilift_sim import scenario as scenario_io
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      odometry_arrays, recorder_missing, run_node, spin,
+                                      controller_peers_missing, odometry_arrays, run_node, spin,
                                       uav_topic, wait_until, write_summary)
 
 STARTUP_TIMEOUT = 60.0  # [s] wall
@@ -66,11 +66,7 @@ class FollowerNode(Node):
         self.samples = 0
 
     def missing_peers(self) -> str | None:
-        if self.cmd_pub.get_subscription_count() < 1:
-            return f'the simulator to subscribe to {self.cmd_pub.topic_name}'
-        if not self.record:
-            return None
-        return recorder_missing(self, [self.cmd_pub, self.setpoint_pub, self.error_pub])
+        return controller_peers_missing(self, self.cmd_pub, self.record)
 
     def on_command(self, j: int, msg: RotorCommand) -> None:
         t_ns = ns_from_stamp(msg.header.stamp)

@@ -18,7 +18,7 @@ from multilift_control.controllers import make_controller
 from multilift_sim import messages
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      odometry_arrays, recorder_missing, run_node, spin,
+                                      controller_peers_missing, odometry_arrays, run_node, spin,
                                       uav_topic, wait_until, write_summary)
 
 STARTUP_TIMEOUT = 60.0  # [s] wall
@@ -46,11 +46,7 @@ class LeaderNode(Node):
         self.samples = 0
 
     def missing_peers(self) -> str | None:
-        if self.cmd_pub.get_subscription_count() < 1:
-            return f'the simulator to subscribe to {self.cmd_pub.topic_name}'
-        if not self.record:
-            return None
-        return recorder_missing(self, [self.cmd_pub, self.ref_pub, self.setpoint_pub])
+        return controller_peers_missing(self, self.cmd_pub, self.record)
 
     def on_odometry(self, msg: Odometry) -> None:
         t_ns = ns_from_stamp(msg.header.stamp)

@@ -137,6 +137,17 @@ def recorder_missing(node: Node, publishers) -> str | None:
     return None
 
 
+def controller_peers_missing(node: Node, command_publisher, record: bool) -> str | None:
+    """What a controller node waits for before it answers: the simulator subscribed to its rotor
+    commands and, when recording, the recorder subscribed to every topic it publishes."""
+    if command_publisher.get_subscription_count() < 1:
+        return f'the simulator to subscribe to {command_publisher.topic_name}'
+    if not record:
+        return None
+    own = [p for p in node.publishers if p.topic_name not in ('/rosout', '/parameter_events')]
+    return recorder_missing(node, own)
+
+
 def wait_until(node: Node, ready: Callable[[], str | None], timeout: float) -> None:
     """Spin until `ready()` returns None (it returns what is still missing), or raise."""
     deadline = time.monotonic() + timeout

@@ -20,10 +20,8 @@ from multilift_sim import messages
 from multilift_sim import scenario as scenario_io
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      controller_peers_missing, odometry_arrays, run_node, spin,
-                                      uav_topic, wait_until, write_summary)
-
-STARTUP_TIMEOUT = 60.0  # [s] wall
+                                      controller_peers_missing, odometry_arrays, run_node,
+                                      serve_controller, uav_topic)
 
 
 class FollowerNode(Node):
@@ -109,19 +107,15 @@ class FollowerNode(Node):
         self.error_sum += float(np.linalg.norm(errors))
         self.samples += 1
 
-    def run(self) -> None:
-        wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
-        try:
-            spin(self)
-        finally:
-            write_summary(self.summary_dir, f'follower{self.index}', {
-                'max_abs_formation_error': self.max_abs_error,
+    def summary(self) -> dict:
+        return {'max_abs_formation_error': self.max_abs_error,
                 'mean_formation_error_norm': self.error_sum / max(self.samples, 1),
-                'answered_states': self.samples})
+                'answered_states': self.samples}
 
 
 def main(args: list[str] | None = None) -> int:
-    return run_node(FollowerNode, lambda node: node.run(), args)
+    return run_node(FollowerNode, lambda node: serve_controller(
+        node, f'follower{node.index}', node.summary), args)
 
 
 if __name__ == '__main__':

@@ -18,10 +18,8 @@ from multilift_control.controllers import make_controller
 from multilift_sim import messages
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      controller_peers_missing, odometry_arrays, run_node, spin,
-                                      uav_topic, wait_until, write_summary)
-
-STARTUP_TIMEOUT = 60.0  # [s] wall
+                                      controller_peers_missing, odometry_arrays, run_node,
+                                      serve_controller, uav_topic)
 
 
 class LeaderNode(Node):
@@ -61,19 +59,15 @@ class LeaderNode(Node):
             self.sum_sq_tracking_error += error * error
             self.samples += 1
 
-    def run(self) -> None:
-        wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
-        try:
-            spin(self)
-        finally:
-            rms = math.sqrt(self.sum_sq_tracking_error / self.samples) if self.samples else 0.0
-            write_summary(self.summary_dir, 'leader', {
-                'max_tracking_error': self.max_tracking_error, 'rms_tracking_error': rms,
-                'answered_states': self.samples})
+    def summary(self) -> dict:
+        rms = math.sqrt(self.sum_sq_tracking_error / self.samples) if self.samples else 0.0
+        return {'max_tracking_error': self.max_tracking_error, 'rms_tracking_error': rms,
+                'answered_states': self.samples}
 
 
 def main(args: list[str] | None = None) -> int:
-    return run_node(LeaderNode, lambda node: node.run(), args)
+    return run_node(LeaderNode, lambda node: serve_controller(node, 'leader', node.summary),
+                    args)
 
 
 if __name__ == '__main__':

@@ -120,6 +120,7 @@ def write_summary(directory: str, name: str, data: dict) -> None:
 
 
 RECORDER_NODE = 'recorder'
+STARTUP_TIMEOUT = 60.0  # wall seconds a node waits for the graph to come together [s]
 MARKER_DECIMATION = 10  # /visualization/markers every this many control ticks
 
 
@@ -146,6 +147,16 @@ def controller_peers_missing(node: Node, command_publisher, record: bool) -> str
         return None
     own = [p for p in node.publishers if p.topic_name not in ('/rosout', '/parameter_events')]
     return recorder_missing(node, own)
+
+
+def serve_controller(node: Node, summary_name: str, summary: Callable[[], dict]) -> None:
+    """A controller node's life: wait for its peers (`node.missing_peers`), answer states until
+    stopped, then leave `summary()` as `<summary_dir>/<summary_name>.json`."""
+    wait_until(node, node.missing_peers, STARTUP_TIMEOUT)
+    try:
+        spin(node)
+    finally:
+        write_summary(node.summary_dir, summary_name, summary())
 
 
 def wait_until(node: Node, ready: Callable[[], str | None], timeout: float) -> None:

@@ -52,16 +52,21 @@ def _fresh_bag_dir(bag: Path) -> None:
 class Progress:
     """Simulated time and real-time factor, on one terminal line (or a line every 10 %)."""
 
-    def __init__(self, path: Path, tty: bool):
+    def __init__(self, path: Path | None, tty: bool):
         self.path = path
         self.tty = tty
         self.last_decile = -1
 
     def __call__(self) -> None:
+        """Show what the simulator node last wrote to the progress file."""
         try:
             t, t_max, wall = (float(v) for v in self.path.read_text().split())
         except (OSError, ValueError):
             return
+        self.show(t, t_max, wall)
+
+    def show(self, t: float, t_max: float, wall: float) -> None:
+        """Simulated time t of t_max [s] after `wall` seconds."""
         rtf = t / wall if wall > 0 else 0.0
         if self.tty:
             print(f'\r  t = {t:7.2f} / {t_max:.1f} s   {rtf:5.1f}x real time ',
@@ -75,13 +80,19 @@ class Progress:
             print()
 
 
-def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
+def _read_summaries(summary_dir: Path, scenario) -> dict:
+    """What each node of a run left in `summary_dir` (sim, leader, follower2, ...)."""
     data = {}
     parts = ['sim', 'leader'] + [f'follower{i}' for i in range(2, scenario.n_uavs + 1)]
     for part in parts:
         path = summary_dir / f'{part}.json'
         if path.is_file():
             data[part] = json.loads(path.read_text())
+    return data
+
+
+def _summary(name: str, data: dict, bag: Path | None, scenario) -> None:
+    """Print the end-of-run summary; with a bag, also leave it as BAG/summary.json."""
     sim = data.get('sim', {})
     lines = []
     if sim:
@@ -116,8 +127,8 @@ def _summary(name: str, summary_dir: Path, bag: Path | None, scenario) -> dict:
                          f'{follower["mean_formation_error_norm"]:.3f} (m)')
     if bag is not None:
         lines.append(f'  bag              {bag}')
+        (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))
     print('\n'.join(lines))
-    return data
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -186,9 +197,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f'the other processes were stopped; bag closed at {bag}', file=sys.stderr)
         print(f'logs: {work}', file=sys.stderr)
         return 1
-    data = _summary(scenario.name, summary_dir, bag, scenario)
-    if bag is not None:
-        (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))
+    _summary(scenario.name, _read_summaries(summary_dir, scenario), bag, scenario)
     shutil.rmtree(work, ignore_errors=True)
     return 0
 
@@ -198,15 +207,13 @@ def _run_headless(scenario, bag: Path | None) -> int:
     from multilift_control.headless import run_headless
     from multilift_control.headless_bag import record_headless
     from multilift_sim.simulation import SimulationStopped
-    work = Path(tempfile.mkdtemp(prefix=f'multilift-{scenario.name}-'))
-    progress = Progress(work / 'progress', sys.stdout.isatty())
+    progress = Progress(None, sys.stdout.isatty())
     start = time.monotonic()
 
     def on_tick(sim, *_) -> None:
         if sim.tick % 50 == 0:
-            t_max = sim.tick_count * sim.period_ns * 1e-9
-            (work / 'progress').write_text(f'{sim.t} {t_max} {time.monotonic() - start}')
-            progress()
+            progress.show(sim.t, sim.tick_count * sim.period_ns * 1e-9,
+                          time.monotonic() - start)
 
     print(f'multilift run {scenario.name} --headless: {scenario.n_uavs} UAV(s), '
           f'{scenario.simulation.duration:g} s', flush=True)
@@ -226,13 +233,7 @@ def _run_headless(scenario, bag: Path | None) -> int:
     progress.close()
     stats = dict(sim.stats.as_dict(), wall_time=time.monotonic() - start, error=None,
                  scenario=scenario.name)
-    summary = work / 'summary'
-    summary.mkdir(parents=True, exist_ok=True)
-    (summary / 'sim.json').write_text(json.dumps(stats))
-    data = _summary(scenario.name, summary, bag, scenario)
-    shutil.rmtree(work, ignore_errors=True)
-    if bag is not None:
-        (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))
+    _summary(scenario.name, {'sim': stats}, bag, scenario)
     return 0
 
 

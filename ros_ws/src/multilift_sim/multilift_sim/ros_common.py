@@ -194,7 +194,14 @@ def spin(node: Node) -> None:
         node.executor.spin_once(timeout_sec=0.1)
 
 
-def flush_publishers(node: Node, timeout: float = 1.5) -> None:
+# How long a node waits for its messages to be acknowledged before it exits [s]: after a
+# normal end the recorder may lag seconds behind on a loaded machine; when the run is being
+# stopped (a peer died, Ctrl-C) a dead reader never acknowledges, so the wait is kept short.
+FLUSH_TIMEOUT = 5.0
+FLUSH_TIMEOUT_STOPPING = 1.5
+
+
+def flush_publishers(node: Node, timeout: float = FLUSH_TIMEOUT) -> None:
     """Wait until every subscriber acknowledged this node's messages. A reliable writer that
     is destroyed first takes its unacknowledged history with it: a recorder lagging behind
     would lose the last messages of the run."""
@@ -229,6 +236,7 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
     signal.signal(signal.SIGTERM, _interrupt)
     node = None
     code = 0
+    flush_timeout = FLUSH_TIMEOUT
     executor = make_executor()
     try:
         node = make_node()
@@ -238,13 +246,13 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
         else:
             body(node)
     except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        flush_timeout = FLUSH_TIMEOUT_STOPPING
     except (Fatal, StartupError, ScenarioError) as exc:
         print(f'error: {exc}', file=sys.stderr, flush=True)
         code = 1 if not isinstance(exc, ScenarioError) else 2
     finally:
         if node is not None:
-            flush_publishers(node)
+            flush_publishers(node, flush_timeout)
             try:
                 node.destroy_node()
             except Exception:  # noqa: BLE001 - shutting down anyway

@@ -579,9 +579,9 @@ def test_sweep_sigterm_stops_the_workers_and_writes_what_finished(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert '(interrupted)' in err
+
     # the children include multiprocessing's resource tracker, which exits by itself a moment
     # after its parent (when its pipe closes): give each child up to 5 s to be gone
-
     def running(pid: int) -> bool:
         try:
             return Path(f'/proc/{pid}/stat').read_text().split()[2] != 'Z'

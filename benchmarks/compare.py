@@ -54,7 +54,7 @@ import yaml
 from multilift_control.headless import hover_speeds, run_headless
 from multilift_sim import scenario as scenario_io
 from multilift_sim.formation_geometry import nominal_positions
-from multilift_sim.launcher import Child, Supervisor, find_executable
+from multilift_tools.launcher import Child, Supervisor, find_executable
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -253,7 +253,7 @@ def profile_headless(scenario, seconds: float) -> tuple[float, list]:
 
 def profile_ros(scenario_name: str, seconds: float, domain: int, workdir: Path) -> dict:
     """The twin-lift's sim_node, leader_node and follower_node each under cProfile."""
-    from multilift_sim.cli import _ros_args
+    from multilift_tools.cli import _ros_args
     scenario = scenario_io.load(scenario_name)
     path = str(scenario_io.resolve(scenario_name).resolve())
     summary = workdir / 'profile_summary'

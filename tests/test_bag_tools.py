@@ -1,4 +1,4 @@
-"""`multilift bag info|play|reindex` (bag_tools) and `multilift topic hz` (cli_tools).
+"""`multilift bag info|play|reindex` (bag_tools) and `multilift topic hz` (topic_tools).
 
 Bags to start from are built with BagWriter (deterministic, fast) or recorded by a real
 `scripts/multilift run`; the tools run as separate processes (`scripts/multilift bag ...` once
@@ -30,11 +30,11 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import String
 
 from multilift_sim.bag import BagWriter
-from multilift_sim.bag_tools import (CLOCK_TOPIC, PlayEvent, format_file_size, play_events,
+from multilift_tools.bag_tools import (CLOCK_TOPIC, PlayEvent, format_file_size, play_events,
                                      playback_qos_policies, read_summary, wall_offset)
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
-from multilift_sim.cli_tools import RateWindow, format_hz
-from multilift_sim.ros_common import run_topics
+from multilift_tools.topic_tools import RateWindow, format_hz
+from multilift_sim.ros.common import run_topics
 
 ROOT = Path(__file__).resolve().parents[1]
 MULTILIFT = ROOT / 'scripts' / 'multilift'
@@ -48,14 +48,8 @@ LABEL = 'hello multilift: a latched label'
 
 
 def command(tool: str, *args: str) -> list[str]:
-    """argv of `multilift bag|topic|foxglove ...`: the wrapper once cli.py knows the tool."""
-    cli = (ROOT / 'ros_ws' / 'src' / 'multilift_sim' / 'multilift_sim' / 'cli.py').read_text()
-    module = {'bag': 'bag_tools', 'topic': 'cli_tools', 'foxglove': 'foxglove_bridge'}[tool]
-    if module in cli or tool == 'topic':
-        return [str(MULTILIFT), tool, *args]
-    entry = f'{tool}_main'
-    return [sys.executable, '-c', f'import sys; from multilift_sim.{module} import {entry}; '
-            f'sys.exit({entry}(sys.argv[1:]))', *args]
+    """argv of `multilift bag|topic|foxglove ...`."""
+    return [str(MULTILIFT), tool, *args]
 
 
 @pytest.fixture

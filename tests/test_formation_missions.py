@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from multilift_sim.bagdata import load_run
+from multilift_tools.bagdata import load_run
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 K_T = 1.83e-6        # Table 4.2 [N s^2/rad^2]

@@ -29,7 +29,7 @@ from rclpy.serialization import deserialize_message
 from websockets.sync.client import connect
 
 from multilift_sim import msgdefs
-from multilift_sim.foxglove_bridge import SUBPROTOCOL, is_bridged, stamp_ns
+from multilift_tools.foxglove_bridge import SUBPROTOCOL, is_bridged, stamp_ns
 
 ROOT = Path(__file__).resolve().parents[1]
 DOMAIN = 10 + os.getpid() % 8
@@ -42,10 +42,10 @@ TIMEOUT = 30.0  # [s] discovery, advertisement and first messages, on a loaded m
 
 
 def bridge_command(*args: str) -> list[str]:
-    cli = (ROOT / 'ros_ws' / 'src' / 'multilift_sim' / 'multilift_sim' / 'cli.py').read_text()
+    cli = (ROOT / 'ros_ws' / 'src' / 'multilift_tools' / 'multilift_tools' / 'cli.py').read_text()
     if 'foxglove_bridge' in cli:
         return [str(ROOT / 'scripts' / 'multilift'), 'foxglove', *args]
-    return [sys.executable, '-c', 'import sys; from multilift_sim.foxglove_bridge import '
+    return [sys.executable, '-c', 'import sys; from multilift_tools.foxglove_bridge import '
             'foxglove_main; sys.exit(foxglove_main(sys.argv[1:]))', *args]
 
 

@@ -10,7 +10,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from conftest import ROOT
-from multilift_sim.bagdata import load_run
+from multilift_tools.bagdata import load_run
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 

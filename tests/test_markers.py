@@ -13,7 +13,7 @@ from rclpy.serialization import deserialize_message, serialize_message
 from visualization_msgs.msg import Marker, MarkerArray
 
 from multilift_sim import scenario as scenario_io
-from multilift_sim.markers import (BODY_DIAMETER_ARMS, FormationMarkers, formation_markers,
+from multilift_sim.ros.markers import (BODY_DIAMETER_ARMS, FormationMarkers, formation_markers,
                                    mission_corners, tension_color)
 from multilift_sim.simulation import FormationSimulator
 

@@ -18,7 +18,7 @@ from multilift_sim.modal import scenario_equilibrium
 from multilift_sim.nullspace import NullSpaceModel, make_model
 from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.simulation import initial_state
-from multilift_sim.studies import study_main
+from multilift_tools.studies import study_main
 
 SWING = str(SCENARIOS / 'single_lift_swing.yaml')
 ALPHA0, BETA0 = math.radians(15.0), math.radians(25.0)          # seed Sec. 4.1 release

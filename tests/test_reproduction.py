@@ -14,7 +14,7 @@ import re
 import pytest
 
 from conftest import ROOT
-from multilift_control.reproduce import (SEED_EIGENVALUE, SEED_PERIOD, SEED_RELEASE, TABLE_HEAD,
+from multilift_tools.reproduce import (SEED_EIGENVALUE, SEED_PERIOD, SEED_RELEASE, TABLE_HEAD,
                                          render_row, render_table, single_lift_table)
 
 REPORT = ROOT / 'docs' / 'reproduction.md'

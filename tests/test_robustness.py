@@ -25,7 +25,7 @@ from rosbags.highlevel import AnyReader
 
 from conftest import ROOT, SCENARIOS
 from multilift_control.headless import run_headless
-from multilift_control.sweep import sweep_main
+from multilift_tools.sweep import sweep_main
 from multilift_sim import scenario as scenario_io
 from multilift_sim.allocation import FRAME_TYPES
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
@@ -395,7 +395,7 @@ import sys, time
 import rclpy
 from multilift_msgs.msg import RotorCommand
 from nav_msgs.msg import Odometry
-from multilift_sim.ros_common import PUBLISHER_QOS, SUBSCRIBER_QOS
+from multilift_sim.ros.common import PUBLISHER_QOS, SUBSCRIBER_QOS
 rclpy.init()
 node = rclpy.create_node('fake_leader')
 pub = node.create_publisher(RotorCommand, '/uav1/rotor_cmd', PUBLISHER_QOS)
@@ -561,7 +561,7 @@ def test_sweep_makes_the_uav_list_for_per_uav_keys(tmp_path):
 
 def test_sweep_sigterm_stops_the_workers_and_writes_what_finished(tmp_path):
     out = tmp_path / 'sweep.csv'
-    code = ('import sys; from multilift_control.sweep import sweep_main; '
+    code = ('import sys; from multilift_tools.sweep import sweep_main; '
             'sys.exit(sweep_main(sys.argv[1:]))')
     proc = subprocess.Popen([str(ROOT / '.venv' / 'bin' / 'python'), '-c', code, 'multi_lift',
                              '--set', 'payload.mass=0.5,0.6,0.7,0.8,0.9,1.0', '--jobs', '2',

@@ -19,7 +19,7 @@ from nav_msgs.msg import Odometry
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Byte, ByteMultiArray, Int64
 
-from multilift_sim.introspection import message_to_ordered, message_to_yaml
+from multilift_sim.ros.introspection import message_to_ordered, message_to_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 DOMAIN = 75 + os.getpid() % 25
@@ -35,7 +35,7 @@ def multilift(*args: str, timeout: float = 30.0) -> subprocess.CompletedProcess:
         command = [str(wrapper), *args]
     else:
         entry = {'topic': 'topic_main', 'node': 'node_main'}[args[0]]
-        command = [sys.executable, '-c', 'import sys; from multilift_sim.cli_tools import '
+        command = [sys.executable, '-c', 'import sys; from multilift_tools.topic_tools import '
                    f'{entry}; sys.exit({entry}(sys.argv[1:]))', *args[1:]]
     return subprocess.run(command, env=ENV, capture_output=True, text=True, timeout=timeout)
 

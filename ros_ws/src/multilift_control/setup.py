@@ -18,8 +18,8 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'leader_node = multilift_control.leader_node:main',
-            'follower_node = multilift_control.follower_node:main',
+            'leader_node = multilift_control.ros.leader_node:main',
+            'follower_node = multilift_control.ros.follower_node:main',
         ],
     },
 )

@@ -18,8 +18,8 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'sim_node = multilift_sim.sim_node:main',
-            'recorder_node = multilift_sim.recorder_node:main',
+            'sim_node = multilift_sim.ros.sim_node:main',
+            'recorder_node = multilift_sim.ros.recorder_node:main',
         ],
     },
 )

@@ -20,10 +20,10 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from visualization_msgs.msg import MarkerArray
 
-from multilift_sim import messages
-from multilift_sim.markers import formation_markers
+from multilift_sim.ros import messages
+from multilift_sim.ros.markers import formation_markers
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros_common import (MARKER_DECIMATION, PUBLISHER_QOS, STARTUP_TIMEOUT,
+from multilift_sim.ros.common import (MARKER_DECIMATION, PUBLISHER_QOS, STARTUP_TIMEOUT,
                                       SUBSCRIBER_QOS, Fatal, ns_from_stamp, recorder_missing,
                                       run_node, uav_topic, wait_until, write_summary)
 from multilift_sim.simulation import FormationSimulator, SimulationStopped

@@ -115,7 +115,8 @@ class FoxgloveBridge:
             self._add(topic, types[0])
 
     def _add(self, topic: str, type_name: str) -> None:
-        from multilift_sim import introspection, msgdefs
+        from multilift_sim import msgdefs
+        from multilift_sim.ros import introspection
         try:
             msg_type = introspection.import_message_type(type_name)
             definition = msgdefs.message_definition(type_name)
@@ -184,7 +185,7 @@ def foxglove_main(argv: list[str]) -> int:
     from rclpy.executors import ExternalShutdownException
     from rclpy.signals import SignalHandlerOptions
 
-    from multilift_sim.ros_common import make_executor
+    from multilift_sim.ros.common import make_executor
 
     stop = threading.Event()
     signal.signal(signal.SIGINT, lambda signum, frame: stop.set())

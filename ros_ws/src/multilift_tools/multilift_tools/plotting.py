@@ -30,7 +30,7 @@ from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Line3DCollection  # noqa: E402
 
-from multilift_sim.bagdata import (FORMATION_TOPIC, PAYLOAD_GUST, PAYLOAD_ODOM,  # noqa: E402
+from multilift_tools.bagdata import (FORMATION_TOPIC, PAYLOAD_GUST, PAYLOAD_ODOM,  # noqa: E402
                                    REFERENCE_TOPIC, Run, RunDataError, load_run, rotor_limits,
                                    run_scenario)
 

@@ -13,7 +13,7 @@ from multilift_msgs.msg import (AttitudeSetpoint, FormationState, RotorCommand,
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
-from multilift_sim.ros_common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
+from multilift_sim.ros.common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
 
 
 def clock(t_ns: int) -> Clock:

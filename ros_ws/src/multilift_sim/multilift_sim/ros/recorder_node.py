@@ -47,7 +47,8 @@ from rclpy.signals import SignalHandlerOptions
 from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock
 
-from multilift_sim import introspection, recording
+from multilift_sim import recording
+from multilift_sim.ros import introspection
 from multilift_sim.bag import BagError, BagWriter
 from multilift_sim.bagyaml import qos_yaml
 

@@ -1,5 +1,5 @@
 """A headless run recorded to the same bag a ROS run gives: the same topics, the same messages
-(built by multilift_sim.messages), stamped with simulated time. No ROS graph is involved; rclpy
+(built by multilift_sim.ros.messages), stamped with simulated time. No ROS graph is involved; rclpy
 is used only to serialise the messages to CDR.
 """
 from __future__ import annotations
@@ -13,11 +13,11 @@ from rclpy.serialization import serialize_message
 from multilift_control.formation import FormationGeometry, VirtualConstraints
 from multilift_control.headless import run_headless
 from multilift_control.mission import MissionPath
-from multilift_sim import messages
+from multilift_sim.ros import messages
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
-from multilift_sim.markers import formation_markers
-from multilift_sim.ros_common import MARKER_DECIMATION, run_topics, uav_topic
+from multilift_sim.ros.markers import formation_markers
+from multilift_sim.ros.common import MARKER_DECIMATION, run_topics, uav_topic
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator
 

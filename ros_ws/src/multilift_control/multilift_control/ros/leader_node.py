@@ -15,9 +15,9 @@ from rclpy.node import Node
 
 from multilift_control.cascade import UavState
 from multilift_control.controllers import make_controller
-from multilift_sim import messages
+from multilift_sim.ros import messages
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros_common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
+from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
                                       controller_peers_missing, odometry_arrays, run_node,
                                       serve_controller, uav_topic)
 

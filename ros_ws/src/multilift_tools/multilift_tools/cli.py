@@ -21,8 +21,8 @@ import time
 from pathlib import Path
 
 from multilift_sim import scenario as scenario_io
-from multilift_sim.launcher import Child, Supervisor, find_executable
-from multilift_sim.ros_common import run_topics
+from multilift_tools.launcher import Child, Supervisor, find_executable
+from multilift_sim.ros.common import run_topics
 
 
 def _ros_args(params: dict) -> list[str]:
@@ -205,7 +205,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 def _run_headless(scenario, bag: Path | None) -> int:
     """The same scenario, physics and control laws in this process, no ROS graph."""
     from multilift_control.headless import run_headless
-    from multilift_control.headless_bag import record_headless
+    from multilift_tools.headless_bag import record_headless
     from multilift_sim.simulation import SimulationStopped
     progress = Progress(None, sys.stdout.isatty())
     start = time.monotonic()
@@ -238,31 +238,31 @@ def _run_headless(scenario, bag: Path | None) -> int:
 
 
 def cmd_node(args: argparse.Namespace) -> int:
-    from multilift_sim.cli_tools import node_main
+    from multilift_tools.topic_tools import node_main
     return node_main([args.package, args.executable, *args.rest])
 
 
 def cmd_topic(args: argparse.Namespace) -> int:
-    from multilift_sim.cli_tools import topic_main
+    from multilift_tools.topic_tools import topic_main
     return topic_main(args.rest)
 
 
 # Subcommands whose parsing lives with their module: name -> (module, function, help)
 DELEGATED = {
-    'plot': ('multilift_sim.plotting', 'plot_main', 'PNG figures from a bag'),
-    'animate': ('multilift_sim.plotting', 'animate_main', 'GIF of the formation from a bag'),
-    'compare': ('multilift_sim.plotting', 'compare_main',
+    'plot': ('multilift_tools.plotting', 'plot_main', 'PNG figures from a bag'),
+    'animate': ('multilift_tools.plotting', 'animate_main', 'GIF of the formation from a bag'),
+    'compare': ('multilift_tools.plotting', 'compare_main',
                 'seed Fig. 4.15-4.17 comparisons of two bags'),
     'modal': ('multilift_sim.modal', 'modal_main',
               'eigenvalues and pendulum periods at the static equilibrium (seed §2.8)'),
-    'study': ('multilift_sim.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
-    'bag': ('multilift_sim.bag_tools', 'bag_main',
+    'study': ('multilift_tools.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
+    'bag': ('multilift_tools.bag_tools', 'bag_main',
             'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),
-    'foxglove': ('multilift_sim.foxglove_bridge', 'foxglove_main',
+    'foxglove': ('multilift_tools.foxglove_bridge', 'foxglove_main',
                  'serve the live graph to Foxglove over WebSocket (ws://localhost:8765)'),
-    'sweep': ('multilift_control.sweep', 'sweep_main',
+    'sweep': ('multilift_tools.sweep', 'sweep_main',
               'headless variants of a scenario in parallel, one CSV row each'),
-    'reproduce': ('multilift_control.reproduce', 'reproduce_main',
+    'reproduce': ('multilift_tools.reproduce', 'reproduce_main',
                   "the seed's §2.8 and Ch. 4 results, figures and docs/reproduction.md"),
 }
 

@@ -36,7 +36,7 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from multilift_sim.ros_common import WORLD_FRAME, quaternion_from_euler, stamp_from_ns
+from multilift_sim.ros.common import WORLD_FRAME, quaternion_from_euler, stamp_from_ns
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import Snapshot
 

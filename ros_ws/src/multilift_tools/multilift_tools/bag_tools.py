@@ -452,7 +452,7 @@ class BagPlayer:
                                ReliabilityPolicy)
         from rosgraph_msgs.msg import Clock
 
-        from multilift_sim.introspection import import_message_type
+        from multilift_sim.ros.introspection import import_message_type
         self.node = rclpy.create_node(f'multilift_bag_player_{os.getpid()}',
                                       start_parameter_services=False)
         for topic in self.topics:

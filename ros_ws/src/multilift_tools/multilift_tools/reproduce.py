@@ -1,9 +1,9 @@
 """`multilift reproduce [--out DIR] [--jobs N] [--bags DIR]`: the seed's §2.8 and Ch. 4, rerun.
 
 Runs the seed's cases headless (multilift_control.headless: the physics, control laws and bag of
-the ROS stack in one process) in parallel worker processes; multilift_control.reproduce_report
+the ROS stack in one process) in parallel worker processes; multilift_tools.reproduce_report
 then draws a counterpart of every figure of the seed's §2.8 (Fig. 2.12) and Ch. 4 (Fig.
-4.1-4.17) with the figure functions of multilift_sim.plotting, .modal and .studies, measures
+4.1-4.17) with the figure functions of multilift_tools.plotting, .modal and .studies, measures
 every number and qualitative claim of those sections, and writes DIR/reproduction.md (default
 docs/) with the figures as PNG under DIR/figures/ (relative links). World frame, z up, SI units;
 the seed's frame is z down, (x, y, z)_world = (x, -y, -z)_seed (multilift_sim.frames).
@@ -182,7 +182,7 @@ def single_lift_table(study_dir: str | Path | None = None) -> list[dict]:
     from multilift_sim.frames import world_to_seed_vector
     from multilift_sim.modal import scenario_modal_analysis
     from multilift_sim.simulation import initial_state
-    from multilift_sim.studies import baumgarte_study
+    from multilift_tools.studies import baumgarte_study
 
     rows = []
     scenario = _swing_scenario()
@@ -329,7 +329,7 @@ def _ticker(progress: _ProgressFile, total: float) -> Callable[..., None]:
 
 def _record(name: str, bag: Path, progress: _ProgressFile) -> dict:
     """Fly scenario `name` headless into `bag` with its summary.json (as `run --headless`)."""
-    from multilift_control.headless_bag import record_headless
+    from multilift_tools.headless_bag import record_headless
 
     scenario = load(name)
     if bag.exists():
@@ -554,7 +554,7 @@ def reproduce_main(argv: list[str] | None = None) -> int:
     try:
         results = run_cases(CASES, work, figures, jobs)
         print('  figures and report ...', flush=True)
-        from multilift_control.reproduce_report import write_reproduction
+        from multilift_tools.reproduce_report import write_reproduction
         report = write_reproduction(out, results, work, jobs, started)
     except KeyboardInterrupt:
         print('interrupted', file=sys.stderr)

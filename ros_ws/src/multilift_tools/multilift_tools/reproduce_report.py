@@ -1,7 +1,7 @@
 """The report of `multilift reproduce`: measurements on the formation runs, the figures and
-docs/reproduction.md (seed §2.8 and Ch. 4). multilift_control.reproduce runs the cases; this
+docs/reproduction.md (seed §2.8 and Ch. 4). multilift_tools.reproduce runs the cases; this
 module turns their results into numbers, PNG figures (world frame, z up; the seed's caption under
-each) and the markdown report. The figures come from the functions of multilift_sim.plotting,
+each) and the markdown report. The figures come from the functions of multilift_tools.plotting,
 .modal and .studies; what is added here is a caption footer, mission phase marks, the climb zoom
 of Fig. 4.8 and the gust spans of Fig. 4.15.
 """
@@ -17,7 +17,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from multilift_control.reproduce import (BAUMGARTE_DURATION, BAUMGARTE_GAINS, CASES, MULTI,
+from multilift_tools.reproduce import (BAUMGARTE_DURATION, BAUMGARTE_GAINS, CASES, MULTI,
                                          SEED_PERIOD, SEED_RELEASE, SWING, TWIN,
                                          release_amplitude, render_table, table_row,
                                          vector_text)
@@ -65,7 +65,7 @@ HOVER_TAIL = 20.0              # [s] the last seconds of the run: the hover phas
 # =============================================================================================
 def _window_run(run: Any, t0: float, t1: float) -> Any:
     """The run restricted to t0 <= t <= t1 [s] on every topic (a bagdata.Run)."""
-    from multilift_sim.bagdata import Run, Series
+    from multilift_tools.bagdata import Run, Series
     series = {}
     for name, s in run.series.items():
         keep = (s.t >= t0 - 1e-9) & (s.t <= t1 + 1e-9)
@@ -107,7 +107,7 @@ def delivered_thrust(run: Any, scenario: Scenario, i: int) -> np.ndarray:
 
 def swing_by_phase(run: Any, scenario: Scenario) -> list[tuple[str, float, float, float]]:
     """(phase, start, end, max swing [m]) with plotting.swing_metrics on each mission phase."""
-    from multilift_sim.plotting import swing_metrics
+    from multilift_tools.plotting import swing_metrics
     return [(name, a, b, swing_metrics(_window_run(run, a, b), scenario, b)['max'])
             for name, a, b in phases(scenario)]
 
@@ -173,7 +173,7 @@ def formation_norms(run: Any, i: int, t0: float = 0.0) -> np.ndarray:
 
 def run_metrics(run: Any, scenario: Scenario) -> dict:
     """The numbers of one formation run that the report quotes."""
-    from multilift_sim.plotting import swing_metrics
+    from multilift_tools.plotting import swing_metrics
     m: dict[str, Any] = {}
     g = np.abs(run.g())
     tail = run.formation_time >= run.formation_time[-1] - HOVER_TAIL
@@ -287,7 +287,7 @@ def _mark_phases(axes: Sequence[Any], scenario: Scenario) -> None:
 def _climb_inset(fig: Any, run: Any, scenario: Scenario, excess: float) -> None:
     """Fig. 4.8: a zoom on the climb, where the seed reads its 6.14 %: delivered thrust
     k_T sum(omega^2) [N] of every UAV, in room made above the curves."""
-    from multilift_sim.plotting import uav_color, uav_label
+    from multilift_tools.plotting import uav_color, uav_label
     ax = fig.axes[0]
     low, high = ax.get_ylim()
     ax.set_ylim(low, high + 0.55 * (high - low))
@@ -325,7 +325,7 @@ def make_figures(runs: dict[str, Any], scenarios: dict[str, Scenario], figures: 
     """Every figure of the report: seed number -> PNG file name under `figures`;
     climb_excess [%]: the twin-lift leader's thrust excess over the first 2 s (Fig. 4.8);
     gusts: the V's gust encounters (Fig. 4.15; the twin-lift meets none)."""
-    from multilift_sim import plotting as pl
+    from multilift_tools import plotting as pl
 
     files: dict[str, str] = {'2.12': 'fig2_12_twin_lift_eigenvalues.png'}
     time_figures = (pl.fig_cable_constraints, pl.fig_attitude, pl.fig_formation_errors,
@@ -669,7 +669,7 @@ def build_report(x: ReportInputs) -> str:
         'tools (`modal`, `study baumgarte`); the seed\'s values are quoted from '
         '`../shared/seed/` (§2.8, Ch. 4). Every figure of the seed\'s Ch. 4 (Fig. 4.1-4.17) and '
         'Fig. 2.12 has a counterpart here, drawn by the figure functions of '
-        '`multilift_sim.plotting`, `.modal` and `.studies`.',
+        '`multilift_tools.plotting`, `.modal` and `.studies`.',
         '',
         '**Frames.** Our figures and numbers are in the world frame, **z up**, SI units. The '
         'seed works z down: (x, y, z)_world = (x, -y, -z)_seed, so the seed\'s +j is our -y '
@@ -1002,8 +1002,8 @@ def build_report(x: ReportInputs) -> str:
 def write_reproduction(out: Path, results: dict[str, dict], work: Path, jobs: int,
                        started: float) -> Path:
     """Figures and reproduction.md in `out` from the cases' results; returns the report."""
-    from multilift_sim.bagdata import load_run
-    from multilift_sim.plotting import comparison_numbers
+    from multilift_tools.bagdata import load_run
+    from multilift_tools.plotting import comparison_numbers
 
     figures = out / 'figures'
     scenarios = {name: load(name) for name in (SWING, TWIN, MULTI)}

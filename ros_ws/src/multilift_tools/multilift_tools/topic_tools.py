@@ -73,7 +73,7 @@ def _topic_info(node, args: argparse.Namespace) -> int:
 
 def _topic_echo(node, args: argparse.Namespace) -> int:
     import rclpy
-    from multilift_sim import introspection
+    from multilift_sim.ros import introspection
     type_name = args.type
     if type_name is None:
         _spin_graph(node, until=_has_topic(node, args.topic))
@@ -165,7 +165,7 @@ def _topic_hz(node, args: argparse.Namespace) -> int:
     import rclpy
     from rclpy.clock import Clock, ClockType
     from rclpy.qos import DurabilityPolicy
-    from multilift_sim import introspection
+    from multilift_sim.ros import introspection
     _spin_graph(node, until=_has_topic(node, args.topic))
     if args.topic not in dict(node.get_topic_names_and_types()):
         print(f'WARNING: topic [{args.topic}] does not appear to be published yet',

@@ -162,7 +162,7 @@ def run_headless_case(name: str, scenario, n: int) -> Result:
     wall0, cpu0 = time.perf_counter(), time.process_time()
     note = ''
     try:
-        sim = run_headless(scenario)
+        sim = run_headless(scenario).simulator
         simulated = sim.t
         ticks = sim.tick
     except SimulationStopped as exc:

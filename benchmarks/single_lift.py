@@ -38,7 +38,7 @@ def physics_only(name: str) -> float:
 def headless(name: str) -> float:
     scenario = scenario_io.load(name)
     start = time.perf_counter()
-    sim = run_headless(scenario)
+    sim = run_headless(scenario).simulator
     return sim.t / (time.perf_counter() - start)
 
 

@@ -50,6 +50,21 @@ def test_same_trajectories_to_rounding(twin_bags):
     assert np.ptp(headless.uav_positions()[0][:, 2]) > 1.0
 
 
+def test_same_run_statistics(twin_bags):
+    """`run` and `run --headless` leave the same summary (one statistics module)."""
+    import json
+    ros, headless = (json.loads((b / 'summary.json').read_text()) for b in twin_bags)
+    assert set(ros) == set(headless) == {'sim', 'leader', 'follower2'}
+    for part in ('leader', 'follower2'):
+        assert ros[part].keys() == headless[part].keys()
+        for key, value in ros[part].items():
+            assert headless[part][key] == pytest.approx(value, rel=1e-6, abs=1e-9), key
+    assert headless['leader']['answered_states'] == 601
+    for key in ('max_abs_constraint', 'min_tension', 'max_tension', 'max_payload_swing',
+                'rms_payload_swing', 'simulated_time', 'max_rotor_speed', 'saturated_time'):
+        assert headless['sim'][key] == pytest.approx(ros['sim'][key], rel=1e-6, abs=1e-9), key
+
+
 def test_headless_bad_scenario_is_exit_2(tmp_path):
     out = subprocess.run([MULTILIFT, 'run', 'nope', '--headless'], capture_output=True,
                          text=True, timeout=60)

@@ -15,7 +15,8 @@ from multilift_sim import scenario as scenario_io
 from multilift_sim.disturbances import Gust
 from multilift_sim.dynamics import FormationModel, initial_state_single_lift
 from multilift_sim.modal import scenario_equilibrium
-from multilift_sim.nullspace import NullSpaceModel, make_model
+from multilift_sim.formulations import make_formulation
+from multilift_sim.nullspace import NullSpaceModel
 from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.simulation import initial_state
 from multilift_tools.studies import study_main
@@ -42,7 +43,7 @@ def simulate(model, x0: np.ndarray, rotor_speeds, duration: float, dt: float) ->
 def swing():
     """single_lift_swing: params, release state, weight-balancing rotor speeds."""
     scenario = load('single_lift_swing')
-    x0 = initial_state(scenario, FormationModel(scenario.formation_params()))
+    x0 = initial_state(scenario)
     return scenario, x0, list(scenario_equilibrium(scenario).rotor_speeds)
 
 
@@ -52,7 +53,7 @@ def test_accelerations_equal_the_multiplier_form(name):
     # moving, tilted, with drag and a gust on the payload) q_ddot and Lambda agree.
     scenario = load(name)
     rng = np.random.default_rng(7)
-    x = initial_state(scenario, FormationModel(scenario.formation_params()))
+    x = initial_state(scenario)
     payload = x[6 * scenario.n_uavs:6 * scenario.n_uavs + 2]
     gust = Gust(center=tuple(payload + 0.5), direction=(0.0, 1.0, 0.0), gradient_distance=2.0,
                 reference_speed=3.0)                            # ~2 m/s at the payload
@@ -76,7 +77,7 @@ def test_accelerations_equal_the_multiplier_form(name):
 def test_projection_puts_a_state_on_the_manifold():
     scenario = load('twin_lift')
     model = NullSpaceModel(scenario.formation_params())
-    x = initial_state(scenario, model.formation)
+    x = initial_state(scenario)
     size = x.size // 2
     rng = np.random.default_rng(3)
     x[:size] += 1e-3 * rng.standard_normal(size)
@@ -136,7 +137,7 @@ def test_twin_lift_matches_the_baumgarte_dae():
     scenario = load('twin_lift')
     speeds = list(scenario_equilibrium(scenario).rotor_speeds)
     nullspace = NullSpaceModel(scenario.formation_params())
-    x0 = initial_state(scenario, nullspace.formation)                # 15 deg swing release
+    x0 = initial_state(scenario)  # 15 deg swing release
     states = simulate(nullspace, x0, speeds, 5.0, 0.005)
     baumgarte = simulate(FormationModel(scenario.formation_params()), x0, speeds, 5.0, 0.005)
     assert np.abs(states - baumgarte).max() < 1e-6
@@ -151,14 +152,14 @@ def test_static_tension_and_the_model_registry():
     params = scenario.formation_params()
     x = initial_state_single_lift([0.0, 0.0, 5.0], [0.0, 0.0, 0.3], 2.5, 0.0, 0.0)
     speeds = list(scenario_equilibrium(scenario).rotor_speeds)
-    model = make_model(params, 'nullspace')
+    model = make_formulation('nullspace', params)
     assert isinstance(model, NullSpaceModel) and model.params is params
     assert model.cable_tension(0.0, x, speeds)[0] == pytest.approx(0.4 * 9.81, rel=1e-12)
     assert np.abs(model.accelerations(0.0, x, speeds)[0]).max() < 1e-12
-    baumgarte = make_model(params, 'baumgarte')
+    baumgarte = make_formulation('baumgarte', params)
     assert isinstance(baumgarte, FormationModel) and baumgarte.params is params
     with pytest.raises(ValueError, match='baumgarte, nullspace'):
-        make_model(params, 'euler')
+        make_formulation('euler', params)
 
 
 def test_study_main_writes_its_files(tmp_path, capsys):

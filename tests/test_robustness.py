@@ -290,8 +290,8 @@ def test_formation_values_load_or_name_the_formation(n, geometry, distance, cabl
 # --------------------------------------------------------------------------- determinism
 def _trajectory(scenario) -> np.ndarray:
     states = []
-    run_headless(scenario, on_tick=lambda sim, outputs: states.append(
-        np.concatenate([sim.state, *[o.rotor_speeds for o in outputs]])))
+    run_headless(scenario, on_tick=lambda sim, snap, answers: states.append(
+        np.concatenate([sim.state, *[a.output.rotor_speeds for a in answers]])))
     return np.array(states)
 
 
@@ -453,10 +453,10 @@ def test_saturating_payload_runs_and_stays_within_rotor_limits():
     assert 2090 < hover < 2100
     low, high = [math.inf], [-math.inf]
 
-    def watch(sim, outputs):
-        low[0] = min(low[0], float(outputs[0].rotor_speeds.min()))
-        high[0] = max(high[0], float(outputs[0].rotor_speeds.max()))
-    sim = run_headless(_short(scenario, 30.0), on_tick=watch)
+    def watch(sim, snap, answers):
+        low[0] = min(low[0], float(answers[0].output.rotor_speeds.min()))
+        high[0] = max(high[0], float(answers[0].output.rotor_speeds.max()))
+    sim = run_headless(_short(scenario, 30.0), on_tick=watch).simulator
     assert sim.t == pytest.approx(30.0)
     assert sim.stats.saturated_time[0] > 0
     assert 0.0 <= low[0] and high[0] <= 2100.0
@@ -514,7 +514,7 @@ def test_sweep_writes_one_row_per_variant_in_product_order(tmp_path, capsys):
     data = _base('twin_lift')
     data['payload']['mass'] = 0.8
     data['formation']['alpha_vc'] = 2.1
-    sim = run_headless(_short(_load(data), 2.0))
+    sim = run_headless(_short(_load(data), 2.0)).simulator
     assert float(rows[3]['max_abs_g']) == sim.stats.max_abs_constraint
     assert float(rows[3]['max_rotor_speed']) == max(sim.stats.max_rotor_speed)
 

@@ -75,7 +75,7 @@ def test_nullspace_integrator_is_selectable_and_holds_the_cable():
                                                                           duration=2.0))
     s = scenario_io.loads(text)
     assert s.simulation.integrator == 'nullspace'
-    sim = run_headless(s)
+    sim = run_headless(s).simulator
     assert type(sim.model).__name__ == 'NullSpaceModel'
     assert sim.stats.max_abs_constraint < 1e-10
 

@@ -174,6 +174,15 @@ class StateLayout:
 FLOAT_KERNEL_MAX_UAVS = 20
 
 
+@dataclass(frozen=True)
+class Integration:
+    """What holding the rotor speeds over a control period gives (`Formulation.integrate`)."""
+    state: np.ndarray              # the formation state at the end, (2(6n+3),)
+    cable_tension: np.ndarray      # T_i = 2 l_i lambda_i at the start [N], (n,)
+    constraint: np.ndarray         # g_i at the end [m^2], (n,)
+    constraint_rate: np.ndarray    # g_i_dot at the end [m^2/s], (n,)
+
+
 class FormationModel:
     """The stabilised formation DAE (seed Eq. 2.70) with structure-exploiting solves.
 
@@ -285,6 +294,42 @@ class FormationModel:
         if self.uses_float_kernel:
             return np.array(self.rk4_floats(x.tolist(), wrenches.tolist(), dt)[0])
         return self._rk4_arrays(x, wrenches, dt)
+
+    def integrate(self, x: np.ndarray, rotor_speeds: Sequence[ArrayLike], dt: float,
+                  steps: int) -> Integration:
+        """`steps` RK4 steps of dt [s] from x with the rotor speeds [rad/s] held (one control
+        period of seed Algorithm 1). The wrenches are formed once (the speeds are held) and
+        the tension is that of the first stage of the first step (the multipliers at x)."""
+        wrenches = self.wrenches(rotor_speeds)
+        if self.uses_float_kernel:
+            w = wrenches.tolist()
+            state, multipliers = self.rk4_floats(list(map(float, x)), w, dt)
+            for _ in range(steps - 1):
+                state = self.rk4_floats(state, w, dt)[0]
+            g, g_dot = self._residuals_floats(state)
+            return Integration(np.array(state), 2.0 * self.cable_lengths * multipliers,
+                               np.array(g), np.array(g_dot))
+        x = np.asarray(x, dtype=float)
+        _, multipliers = self._solve_arrays(x, wrenches)
+        for _ in range(steps):
+            x = self._rk4_arrays(x, wrenches, dt)
+        g, g_dot = self.constraint_residuals(x)
+        return Integration(x, 2.0 * self.cable_lengths * multipliers, g, g_dot)
+
+    def _residuals_floats(self, x: list[float]) -> tuple[list[float], list[float]]:
+        """(g [m^2], g_dot [m^2/s]) per cable from a state as floats (the arithmetic of
+        constraint_residuals without numpy's per-call overhead)."""
+        nq, p = self._nq, 6 * self._n
+        px, py, pz = x[p:p + 3]
+        pvx, pvy, pvz = x[nq + p:nq + p + 3]
+        g, g_dot = [], []
+        for i, (_, length_sq, *_rest) in enumerate(self._uav_constants):
+            b = 6 * i
+            dx, dy, dz = px - x[b], py - x[b + 1], pz - x[b + 2]
+            dvx, dvy, dvz = pvx - x[nq + b], pvy - x[nq + b + 1], pvz - x[nq + b + 2]
+            g.append(dx * dx + dy * dy + dz * dz - length_sq)
+            g_dot.append(2.0 * (dx * dvx + dy * dvy + dz * dvz))
+        return g, g_dot
 
     def rk4_floats(self, x: list[float], wrenches: list[list[float]],
                    dt: float) -> tuple[list[float], list[float]]:

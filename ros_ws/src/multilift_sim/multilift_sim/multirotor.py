@@ -65,6 +65,13 @@ class MultirotorParams:
         """Number of rotors n_r of the frame type."""
         return rotor_count(self.frame_type)
 
+    def collective_thrust(self, rotor_speeds: ArrayLike) -> float | np.ndarray:
+        """u_T = k_T sum_k omega_k^2 [N] of rotor speeds [rad/s] (seed Eq. 2.9, along body +z:
+        docs/conventions.md); rotor_speeds (..., n_r) gives shape (...)."""
+        speeds = np.asarray(rotor_speeds, dtype=float)
+        total = self.thrust_coefficient * np.sum(speeds * speeds, axis=-1)
+        return float(total) if total.ndim == 0 else total
+
     @property
     def max_thrust(self) -> float:
         """Total thrust with every rotor at rotor_speed_max [N]: ``n_r k_T omega_max^2``."""

@@ -31,11 +31,9 @@ from numpy.typing import ArrayLike
 from multilift_sim.constraints import (cable_residuals, cable_tension, constraint_jacobian,
                                        constraint_jacobian_rate_term)
 from multilift_sim.disturbances import gust_velocity, payload_drag
-from multilift_sim.dynamics import FormationModel, FormationParams
+from multilift_sim.dynamics import FormationModel, FormationParams, Integration
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.multirotor import euler_acceleration
-
-INTEGRATORS = ('baumgarte', 'nullspace')
 
 
 class NullSpaceModel:
@@ -177,6 +175,16 @@ class NullSpaceModel:
         x_next = x + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
         return self.project(x_next) if self.projection else x_next
 
+    def integrate(self, x: np.ndarray, rotor_speeds: Sequence[ArrayLike], dt: float,
+                  steps: int) -> Integration:
+        """`steps` projected RK4 steps of dt [s] with the rotor speeds [rad/s] held; the
+        tension is the one at x."""
+        tension = self.cable_tension(0.0, x, rotor_speeds)
+        for _ in range(steps):
+            x = self.step(0.0, x, rotor_speeds, dt)
+        g, g_dot = self.constraint_residuals(x)
+        return Integration(x, tension, g, g_dot)
+
     def project(self, x: np.ndarray) -> np.ndarray:
         """x moved onto the constraint manifold: positions by Newton steps
         ``dq = -M^-1 G^T (G M^-1 G^T)^-1 g`` until |g_i| <= projection_tolerance l_i^2 (at most
@@ -231,19 +239,3 @@ class NullSpaceModel:
     def payload_air_velocity(self, t: float, x: np.ndarray) -> np.ndarray:
         """Payload velocity relative to the air [m/s], world, shape (3,)."""
         return self.formation.payload_air_velocity(t, x)
-
-
-def make_model(params: FormationParams,
-               integrator: str = 'baumgarte') -> FormationModel | NullSpaceModel:
-    """The formation model a scenario's ``simulation.integrator`` names.
-
-    'baumgarte': FormationModel (Lagrange multipliers, Baumgarte stabilisation with the
-    params' alpha_f, beta_f, Eq. 2.70); 'nullspace': NullSpaceModel (Eq. 2.71-2.72 with
-    projection). Raises ValueError for any other name.
-    """
-    if integrator == 'baumgarte':
-        return FormationModel(params)
-    if integrator == 'nullspace':
-        return NullSpaceModel(params)
-    raise ValueError(f'unknown integrator {integrator!r}; valid integrators are '
-                     f'{", ".join(INTEGRATORS)}')

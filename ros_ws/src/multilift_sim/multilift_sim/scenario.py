@@ -20,7 +20,7 @@ from multilift_sim.disturbances import Gust
 from multilift_sim.dynamics import FormationParams
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.multirotor import MultirotorParams
-from multilift_sim.nullspace import INTEGRATORS
+from multilift_sim.formulations import FORMULATIONS
 
 
 class ScenarioError(ValueError):
@@ -293,7 +293,7 @@ def _scenario(data: Any, where: str) -> Scenario:
         constraint_tolerance=s.positive('constraint_tolerance'),
         constraint_rate_tolerance=s.positive('constraint_rate_tolerance'),
         command_timeout=s.positive('command_timeout', 5.0),
-        integrator=s.text('integrator', 'baumgarte', choices=INTEGRATORS))
+        integrator=s.text('integrator', 'baumgarte', choices=tuple(FORMULATIONS)))
     s.done()
 
     v = top.section('vehicle')

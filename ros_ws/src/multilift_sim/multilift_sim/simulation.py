@@ -7,15 +7,16 @@ thing. World frame, SI units.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_sim.dynamics import FormationModel, StateLayout, initial_state_single_lift
+from multilift_sim.dynamics import StateLayout, initial_state_single_lift
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
-from multilift_sim.nullspace import make_model
+from multilift_sim.formulations import make_formulation
 from multilift_sim.scenario import Scenario
+from multilift_sim.statistics import RunStatistics, payload_swing_at
 
 
 class SimulationStopped(RuntimeError):
@@ -40,42 +41,7 @@ class Snapshot:
     payload_velocity: np.ndarray  # world [m/s]
 
 
-@dataclass
-class RunStatistics:
-    """What the summary reports, accumulated tick by tick."""
-    n_uavs: int
-    max_abs_constraint: float = 0.0        # max_i,t |g_i| [m^2]
-    max_abs_constraint_rate: float = 0.0   # max_i,t |g_i_dot| [m^2/s]
-    max_rotor_speed: list = field(default_factory=list)   # per UAV [rad/s]
-    saturated_time: list = field(default_factory=list)    # per UAV [s]
-    min_tension: float = math.inf          # [N]
-    max_tension: float = -math.inf         # [N]
-    simulated_time: float = 0.0            # [s]
-    max_gust_speed: float = 0.0            # peak gust speed met by the payload [m/s]
-    # payload swing: horizontal distance of the payload from where it hung at t = 0 relative
-    # to the UAVs' centroid (the payload's tracking error with respect to the formation) [m]
-    max_payload_swing: float = 0.0
-    sum_sq_payload_swing: float = 0.0
-    swing_samples: int = 0
-
-    def __post_init__(self) -> None:
-        self.max_rotor_speed = [0.0] * self.n_uavs
-        self.saturated_time = [0.0] * self.n_uavs
-
-    def add_swing(self, swing: float) -> None:
-        self.max_payload_swing = max(self.max_payload_swing, swing)
-        self.sum_sq_payload_swing += swing * swing
-        self.swing_samples += 1
-
-    def as_dict(self) -> dict:
-        out = {k: v for k, v in self.__dict__.items()
-               if k not in ('sum_sq_payload_swing', 'swing_samples')}
-        out['rms_payload_swing'] = math.sqrt(self.sum_sq_payload_swing
-                                             / max(self.swing_samples, 1))
-        return out
-
-
-def initial_state(scenario: Scenario, model: FormationModel) -> np.ndarray:
+def initial_state(scenario: Scenario) -> np.ndarray:
     """Initial formation state on the constraint manifold, at rest."""
     if scenario.n_uavs == 1:
         uav = scenario.uavs[0]
@@ -107,18 +73,23 @@ class FormationSimulator:
                  baumgarte_beta: float | None = None):
         self.scenario = scenario
         sim = scenario.simulation
-        self.model = make_model(scenario.formation_params(baumgarte_alpha, baumgarte_beta),
-                                sim.integrator)
+        self.model = make_formulation(sim.integrator,
+                                      scenario.formation_params(baumgarte_alpha, baumgarte_beta))
         self.n = scenario.n_uavs
-        self.state = initial_state(scenario, model=self.model)
+        self.state = initial_state(scenario)
         self.tick = 0
         self.tick_count = sim.tick_count
         self.period_ns = int(round(1e9 / sim.control_rate))
         self.steps_per_tick = sim.physics_steps_per_tick
         self.dt = 1.0 / sim.physics_rate
         self.stats = RunStatistics(self.n)
-        self._rest_offset: tuple[float, float] | None = None
-        self._lengths = [u.cable_length for u in scenario.uavs]          # l_i [m]
+        # how far each cable reaches for the swing's equilibrium place: l_i widened by the
+        # constraint tolerance, so cables held within it always meet [m]
+        self._reach = [math.sqrt(u.cable_length ** 2 + sim.constraint_tolerance)
+                       for u in scenario.uavs]
+        # payload swing every tick for one or two UAVs (a closed form); from three on, where
+        # rigid cables hold the payload at its equilibrium place, at 10 Hz of a 100 Hz loop
+        self._swing_every = 1 if self.n <= 2 else 10
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
         self._check(0.0)
@@ -177,64 +148,15 @@ class FormationSimulator:
     def advance(self, rotor_speeds: list[np.ndarray], saturated: list[np.ndarray]) -> None:
         """Hold `rotor_speeds` over one control period and integrate to the next tick."""
         speeds = self._checked_speeds(rotor_speeds)
-        stats = self.stats
         peaks = np.max(np.abs(speeds), axis=1) if isinstance(speeds, np.ndarray) \
             else [float(np.max(np.abs(s))) for s in speeds]
-        period = self.period_ns * 1e-9
-        for i, (peak, flags) in enumerate(zip(peaks, saturated)):
-            if peak > stats.max_rotor_speed[i]:
-                stats.max_rotor_speed[i] = float(peak)
-            if np.any(flags):
-                stats.saturated_time[i] += period
-        model = self.model
-        t0 = self.t
-        if isinstance(model, FormationModel) and model.uses_float_kernel:
-            # the wrenches formed once per tick (the speeds are held) and the tension taken
-            # from the first stage of the first step (the multipliers at this state)
-            wrenches = model.wrenches(speeds).tolist()
-            x, multipliers = model.rk4_floats(self.state.tolist(), wrenches, self.dt)
-            for _ in range(self.steps_per_tick - 1):
-                x = model.rk4_floats(x, wrenches, self.dt)[0]
-            self.state = np.array(x)
-            tension = [2.0 * length * lam for length, lam in zip(self._lengths, multipliers)]
-            residuals = self._residuals_floats(x)
-        elif isinstance(model, FormationModel):
-            residuals = None
-            wrenches = model.wrenches(speeds)
-            _, multipliers = model.accelerations_from_wrenches(self.state, wrenches)
-            tension = 2.0 * model.cable_lengths * multipliers
-            x = self.state
-            for _ in range(self.steps_per_tick):
-                x = model._rk4_arrays(x, wrenches, self.dt)
-            self.state = x
-        else:
-            residuals = None
-            tension = np.asarray(model.cable_tension(t0, self.state, speeds))
-            for k in range(self.steps_per_tick):
-                self.state = model.step(t0 + k * self.dt, self.state, speeds, self.dt)
-        stats.min_tension = min(stats.min_tension, float(min(tension)))
-        stats.max_tension = max(stats.max_tension, float(max(tension)))
+        self.stats.add_commands(peaks, saturated, self.period_ns * 1e-9)
+        step = self.model.integrate(self.state, speeds, self.dt, self.steps_per_tick)
+        self.state = step.state
+        self.stats.add_tensions(step.cable_tension)
         self.tick += 1
-        stats.simulated_time = self.t
-        self._check(self.t, residuals)
-
-    def _residuals_floats(self, x: list[float]) -> tuple[list[float], list[float]] | None:
-        """(g [m^2], g_dot [m^2/s]) per cable from the state as a list (the arithmetic of
-        FormationModel.constraint_residuals in floats), or None when x is not finite."""
-        if not all(map(math.isfinite, x)):
-            return None
-        n = self.n
-        nq, p = 6 * n + 3, 6 * n
-        px, py, pz = x[p:p + 3]
-        pvx, pvy, pvz = x[nq + p:nq + p + 3]
-        g, g_dot = [], []
-        for i, length in enumerate(self._lengths):
-            b = 6 * i
-            dx, dy, dz = px - x[b], py - x[b + 1], pz - x[b + 2]
-            dvx, dvy, dvz = pvx - x[nq + b], pvy - x[nq + b + 1], pvz - x[nq + b + 2]
-            g.append(dx * dx + dy * dy + dz * dz - length * length)
-            g_dot.append(2.0 * (dx * dvx + dy * dvy + dz * dvz))
-        return g, g_dot
+        self.stats.simulated_time = self.t
+        self._check(self.t, (step.constraint, step.constraint_rate))
 
     def _checked_speeds(self, rotor_speeds: list[np.ndarray]) -> np.ndarray | list[np.ndarray]:
         """The commands as one (n, n_r) array (a list when the rotor counts differ), or
@@ -265,39 +187,27 @@ class FormationSimulator:
                                     f'(t = {self.t:.3f} s)')
         return out
 
-    def _payload_offset(self) -> tuple[float, float]:
-        """Horizontal payload position relative to the UAVs' centroid [m]."""
-        n, x = self.n, self.state
-        cx = sum(x[6 * i] for i in range(n)) / n
-        cy = sum(x[6 * i + 1] for i in range(n)) / n
-        return float(x[6 * n] - cx), float(x[6 * n + 1] - cy)
-
-    def _check(self, t: float, residuals: tuple[list[float], list[float]] | None = None
-               ) -> None:
-        """Algorithm 1, lines 10-13: stop when a cable leaves its tolerance. `residuals`:
-        (g, g_dot) already computed from a finite state (`_residuals_floats`)."""
-        if residuals is None:
-            if not np.all(np.isfinite(self.state)):
-                raise SimulationStopped(f'the formation state became non-finite at '
-                                        f't = {t:.3f} s')
-            g, g_dot = (a.tolist() for a in self.model.constraint_residuals(self.state))
-        else:
-            g, g_dot = residuals
-        sim = self.scenario.simulation
-        offset = self._payload_offset()
-        if self._rest_offset is None:
-            self._rest_offset = offset
-        self.stats.add_swing(math.hypot(offset[0] - self._rest_offset[0],
-                                        offset[1] - self._rest_offset[1]))
+    def _check(self, t: float,
+               residuals: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        """Algorithm 1, lines 10-13: stop when a cable leaves its tolerance (or the state is
+        no longer finite); `residuals`: (g, g_dot) at this state when already computed."""
+        if not np.all(np.isfinite(self.state)):
+            raise SimulationStopped(f'the formation state became non-finite at t = {t:.3f} s')
+        g, g_dot = residuals if residuals is not None else \
+            self.model.constraint_residuals(self.state)
+        abs_g, abs_g_dot = np.abs(g), np.abs(g_dot)
+        worst, worst_rate = int(np.argmax(abs_g)), int(np.argmax(abs_g_dot))
+        peak, peak_rate = float(abs_g[worst]), float(abs_g_dot[worst_rate])
+        stats = self.stats
+        stats.add_constraints(peak, peak_rate)
+        if self.tick % self._swing_every == 0:
+            n, x = self.n, self.state
+            stats.swing.add(payload_swing_at(x[:6 * n].reshape(n, 6)[:, :3],
+                                             x[6 * n:6 * n + 3], self._reach))
         if self.scenario.gusts:
             gust = self.model.gust_velocity_at_payload(t, self.state)
-            self.stats.max_gust_speed = max(self.stats.max_gust_speed,
-                                            float(np.linalg.norm(gust)))
-        abs_g, abs_g_dot = [abs(v) for v in g], [abs(v) for v in g_dot]
-        peak, peak_rate = max(abs_g), max(abs_g_dot)
-        worst, worst_rate = abs_g.index(peak), abs_g_dot.index(peak_rate)
-        self.stats.max_abs_constraint = max(self.stats.max_abs_constraint, peak)
-        self.stats.max_abs_constraint_rate = max(self.stats.max_abs_constraint_rate, peak_rate)
+            stats.max_gust_speed = max(stats.max_gust_speed, float(np.linalg.norm(gust)))
+        sim = self.scenario.simulation
         if peak > sim.constraint_tolerance:
             raise SimulationStopped(
                 f'cable {worst + 1}: constraint residual |g| = {peak:.3g} m^2 exceeds '

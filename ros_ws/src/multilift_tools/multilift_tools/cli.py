@@ -220,7 +220,7 @@ def _run_headless(scenario, bag: Path | None) -> int:
     if bag is not None:
         _fresh_bag_dir(bag)
     try:
-        sim = run_headless(scenario, on_tick) if bag is None else \
+        run = run_headless(scenario, on_tick) if bag is None else \
             record_headless(scenario, bag, on_tick)
     except SimulationStopped as exc:
         progress.close()
@@ -231,9 +231,7 @@ def _run_headless(scenario, bag: Path | None) -> int:
         print('interrupted' + (f'; bag closed at {bag}' if bag else ''), file=sys.stderr)
         return 130
     progress.close()
-    stats = dict(sim.stats.as_dict(), wall_time=time.monotonic() - start, error=None,
-                 scenario=scenario.name)
-    _summary(scenario.name, {'sim': stats}, bag, scenario)
+    _summary(scenario.name, run.summary(), bag, scenario)
     return 0
 
 

@@ -7,40 +7,33 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
 from rclpy.serialization import serialize_message
 
-from multilift_control.formation import FormationGeometry, VirtualConstraints
-from multilift_control.headless import run_headless
-from multilift_control.mission import MissionPath
-from multilift_sim.ros import messages
+from multilift_control.headless import HeadlessRun, run_headless
+from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
-from multilift_sim.ros.markers import formation_markers
+from multilift_sim.ros import messages
 from multilift_sim.ros.common import MARKER_DECIMATION, run_topics, uav_topic
+from multilift_sim.ros.markers import formation_markers
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import FormationSimulator
+from multilift_sim.simulation import FormationSimulator, Snapshot
 
 
 def record_headless(scenario: Scenario, bag_dir: Path,
                     on_tick: Callable[[FormationSimulator], None] | None = None
-                    ) -> FormationSimulator:
-    """Fly `scenario` without ROS and write every topic of a ROS run to `bag_dir`."""
+                    ) -> HeadlessRun:
+    """Fly `scenario` without ROS and write every topic of a ROS run to `bag_dir`: the
+    simulator's state and every controller's answer as the nodes publish them."""
     writer = BagWriter(bag_dir)
     qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
     for topic, kind in run_topics(scenario.n_uavs):
         writer.add_topic(topic, kind, qos)
-    path = MissionPath(scenario.mission)
-    constraints = None
-    if scenario.n_uavs > 1:
-        constraints = VirtualConstraints(FormationGeometry.from_config(scenario.formation,
-                                                                       scenario.n_uavs))
 
     def write(topic: str, msg, t_ns: int) -> None:
         writer.write(topic, serialize_message(msg), t_ns)
 
-    def tick(sim: FormationSimulator, outputs: list) -> None:
-        snap = sim.snapshot()
+    def tick(sim: FormationSimulator, snap: Snapshot, answers: list[ControllerAnswer]) -> None:
         t_ns = snap.t_ns
         write('/clock', messages.clock(t_ns), t_ns)
         for i, uav in enumerate(snap.uavs):
@@ -49,22 +42,19 @@ def record_headless(scenario: Scenario, bag_dir: Path,
                                                          snap.payload_velocity), t_ns)
         gust = sim.model.gust_velocity_at_payload(sim.t, sim.state)
         write('/payload/gust', messages.gust(t_ns, gust), t_ns)
-        if scenario.control.mode == 'cascade':
-            write(uav_topic(1, 'reference'), messages.tracking_reference(t_ns, path(sim.t)), t_ns)
-        if constraints is not None:
-            r = np.array([u.position for u in snap.uavs])
-            v = np.array([u.velocity for u in snap.uavs])
-            residual, rate = constraints.residual(r), constraints.rate(r, v)
-        for i, out in enumerate(outputs):
-            write(uav_topic(i + 1, 'rotor_cmd'), messages.rotor_command(t_ns, i + 1, out), t_ns)
-            write(uav_topic(i + 1, 'attitude_setpoint'),
-                  messages.attitude_setpoint(t_ns, i + 1, out), t_ns)
-            if i > 0:
-                rows = constraints.rows_of(i)
-                write(uav_topic(i + 1, 'formation_error'),
-                      messages.formation_error(t_ns, residual[rows], rate[rows]), t_ns)
-        speeds = [o.rotor_speeds for o in outputs]
-        tension, g, g_dot = sim.cable_state(speeds)
+        for answer in answers:
+            i, out = answer.index + 1, answer.output
+            write(uav_topic(i, 'rotor_cmd'), messages.rotor_command(t_ns, i, out), t_ns)
+            write(uav_topic(i, 'attitude_setpoint'), messages.attitude_setpoint(t_ns, i, out),
+                  t_ns)
+            if answer.reference is not None:
+                write(uav_topic(i, 'reference'),
+                      messages.tracking_reference(t_ns, answer.reference), t_ns)
+            if answer.formation_error is not None:
+                write(uav_topic(i, 'formation_error'),
+                      messages.formation_error(t_ns, answer.formation_error,
+                                               answer.formation_error_rate), t_ns)
+        tension, g, g_dot = sim.cable_state([a.output.rotor_speeds for a in answers])
         write('/formation/state', messages.formation_state(t_ns, tension, g, g_dot), t_ns)
         if sim.tick % MARKER_DECIMATION == 0:
             write('/visualization/markers',

@@ -86,9 +86,8 @@ def swing_history(scenario: Scenario) -> SwingHistory:
 
     rows: list[tuple[float, np.ndarray, np.ndarray, float]] = []
 
-    def tick(sim: Any, outputs: list) -> None:
-        snap = sim.snapshot()
-        tension = sim.cable_state([o.rotor_speeds for o in outputs])[0]
+    def tick(sim: Any, snap: Any, answers: list) -> None:
+        tension = sim.cable_state([a.output.rotor_speeds for a in answers])[0]
         rows.append((sim.t, snap.uavs[0].position, snap.payload_position, float(tension[0])))
 
     run_headless(scenario, tick)
@@ -121,7 +120,6 @@ def swing_period(t: np.ndarray, uav: np.ndarray, payload: np.ndarray) -> float:
 def reduced_swing(scenario: Scenario, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(UAV, payload) world positions (T, 3) [m] of the reduced single-lift model (seed Eq.
     2.34, DOP853 rtol 1e-10) from the scenario's release, rotor speeds held at Eq. 2.73."""
-    from multilift_sim.dynamics import FormationModel
     from multilift_sim.frames import world_to_seed_euler, world_to_seed_vector
     from multilift_sim.modal import scenario_equilibrium
     from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
@@ -130,7 +128,7 @@ def reduced_swing(scenario: Scenario, times: np.ndarray) -> tuple[np.ndarray, np
     uav = scenario.uavs[0]
     model = ReducedSingleLiftModel(uav.vehicle, scenario.payload.mass, uav.cable_length,
                                    scenario.simulation.gravity)
-    x0 = initial_state(scenario, FormationModel(scenario.formation_params()))
+    x0 = initial_state(scenario)
     start = rest_state(world_to_seed_vector(x0[0:3]), world_to_seed_euler(x0[3:6]),
                        scenario.payload.alpha, scenario.payload.beta)
     solution = model.simulate(start, scenario_equilibrium(scenario).rotor_speeds[0],
@@ -178,7 +176,7 @@ def single_lift_table(study_dir: str | Path | None = None) -> list[dict]:
     against m_p g. `study_dir`: where the Baumgarte study writes its table and figures (Fig.
     4.2, 4.3); default a temporary directory, removed.
     """
-    from multilift_sim.dynamics import FormationModel, StateLayout
+    from multilift_sim.dynamics import StateLayout
     from multilift_sim.frames import world_to_seed_vector
     from multilift_sim.modal import scenario_modal_analysis
     from multilift_sim.simulation import initial_state
@@ -186,7 +184,7 @@ def single_lift_table(study_dir: str | Path | None = None) -> list[dict]:
 
     rows = []
     scenario = _swing_scenario()
-    x0 = initial_state(scenario, FormationModel(scenario.formation_params()))
+    x0 = initial_state(scenario)
     layout = StateLayout(1)
     release_world = layout.payload_position(x0) - layout.uav_positions(x0)[0]
     release = world_to_seed_vector(release_world)
@@ -335,12 +333,9 @@ def _record(name: str, bag: Path, progress: _ProgressFile) -> dict:
     if bag.exists():
         shutil.rmtree(bag)
     bag.parent.mkdir(parents=True, exist_ok=True)
-    start = time.monotonic()
-    sim = record_headless(scenario, bag, _ticker(progress, scenario.simulation.duration))
-    stats = dict(sim.stats.as_dict(), wall_time=time.monotonic() - start, error=None,
-                 scenario=scenario.name)
-    (bag / 'summary.json').write_text(json.dumps({'sim': stats}, indent=1, sort_keys=True))
-    return {'bag': str(bag), 'wall_time': stats['wall_time']}
+    run = record_headless(scenario, bag, _ticker(progress, scenario.simulation.duration))
+    (bag / 'summary.json').write_text(json.dumps(run.summary(), indent=1, sort_keys=True))
+    return {'bag': str(bag), 'wall_time': run.wall_time}
 
 
 def _still_air(name: str, progress: _ProgressFile) -> dict:
@@ -351,9 +346,9 @@ def _still_air(name: str, progress: _ProgressFile) -> dict:
     report = _ticker(progress, scenario.simulation.duration)
     times, payload = [], []
 
-    def tick(sim: Any, outputs: list) -> None:
+    def tick(sim: Any, snap: Any, answers: list) -> None:
         times.append(sim.t)
-        payload.append(sim.snapshot().payload_position)
+        payload.append(snap.payload_position)
         report(sim)
 
     run_headless(scenario, tick)

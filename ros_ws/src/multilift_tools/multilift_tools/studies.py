@@ -106,7 +106,7 @@ def baumgarte_study(out_dir: str | Path, duration: float = DEFAULT_DURATION,
     uav = setup.uavs[0]
     reduced = ReducedSingleLiftModel(uav.vehicle, setup.payload.mass, uav.cable_length,
                                      setup.simulation.gravity)
-    x0 = initial_state(setup, FormationModel(setup.formation_params()))
+    x0 = initial_state(setup)
     start = rest_state(world_to_seed_vector(x0[0:3]), world_to_seed_euler(x0[3:6]),
                        setup.payload.alpha, setup.payload.beta)
     solution = reduced.simulate(start, rotor_speeds[0], times[-1], t_eval=times)

@@ -48,7 +48,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import yaml
 
 from multilift_sim import scenario as scenario_io
@@ -194,68 +193,25 @@ def build_variants(source: str, base: dict, sets: list[tuple[str, list, list]],
 
 # ------------------------------------------------------------------------------------ a run
 def run_variant(text: str, where: str, duration: float | None = None) -> dict[str, Any]:
-    """Fly one scenario headless; the figures of a CSV row (METRICS)."""
-    from multilift_control.formation import FormationGeometry, VirtualConstraints
+    """Fly one scenario headless; the figures of a CSV row (METRICS, from
+    `multilift_sim.statistics.summary_row`: the same as `run` reports)."""
     from multilift_control.headless import run_headless
-    from multilift_control.mission import MissionPath
-    from multilift_sim.simulation import SimulationStopped
+    from multilift_sim.statistics import summary_row
 
     scenario = scenario_io.loads(text, where)
     if duration is not None:
         scenario = replace(scenario, simulation=replace(scenario.simulation, duration=duration))
-    n = scenario.n_uavs
-    track = scenario.control.mode == 'cascade'
-    path = MissionPath(scenario.mission) if track else None
-    constraints = None
-    follower_rows = []
-    if n > 1 and scenario.formation is not None:
-        constraints = VirtualConstraints(FormationGeometry.from_config(scenario.formation, n))
-        follower_rows = [constraints.rows_of(i) for i in range(1, n)]
-    acc = {'sim': None, 'track_max': 0.0, 'track_sq': 0.0, 'samples': 0, 'form_max': 0.0,
-           'form_sum': 0.0, 'form_samples': 0}
-
-    def on_tick(sim, outputs) -> None:
-        acc['sim'] = sim
-        state = sim.state
-        if path is not None:
-            error = float(np.linalg.norm(path(sim.t).position - state[:3]))
-            acc['track_max'] = max(acc['track_max'], error)
-            acc['track_sq'] += error * error
-            acc['samples'] += 1
-        if constraints is not None:
-            r = state[:6 * n].reshape(n, 6)[:, :3]
-            residual = constraints.residual(r)
-            acc['form_max'] = max(acc['form_max'], float(np.max(np.abs(residual))))
-            acc['form_sum'] += sum(float(np.linalg.norm(residual[rows]))
-                                   for rows in follower_rows)
-            acc['form_samples'] += len(follower_rows)
-
-    start = time.perf_counter()
-    error = ''
-    try:
-        run_headless(scenario, on_tick=on_tick)
-    except SimulationStopped as exc:
-        error = str(exc)
-    except Exception as exc:  # noqa: BLE001 - one variant's crash is that row's error
-        error = f'{type(exc).__name__}: {exc}'
-    wall = time.perf_counter() - start
-    sim = acc['sim']
     row: dict[str, Any] = {k: '' for k in METRICS}
-    row.update(wall_time=round(wall, 3), error=error.replace('\n', ' '))
-    if sim is not None:
-        stats = sim.stats
-        row.update(simulated_time=sim.t, max_abs_g=stats.max_abs_constraint,
-                   max_abs_g_dot=stats.max_abs_constraint_rate,
-                   max_rotor_speed=max(stats.max_rotor_speed),
-                   saturated_time=sum(stats.saturated_time),
-                   min_tension=stats.min_tension if math.isfinite(stats.min_tension) else '',
-                   max_tension=stats.max_tension if math.isfinite(stats.max_tension) else '')
-    if acc['samples']:
-        row.update(tracking_error_max=acc['track_max'],
-                   tracking_error_rms=math.sqrt(acc['track_sq'] / acc['samples']))
-    if acc['form_samples']:
-        row.update(formation_error_max=acc['form_max'],
-                   formation_error_mean=acc['form_sum'] / acc['form_samples'])
+    start = time.perf_counter()
+    try:
+        run = run_headless(scenario, raise_on_stop=False)
+    except Exception as exc:  # noqa: BLE001 - one variant's crash is that row's error
+        row.update(wall_time=round(time.perf_counter() - start, 3),
+                   error=f'{type(exc).__name__}: {exc}'.replace('\n', ' '))
+        return row
+    row.update({k: v for k, v in summary_row(run.summary()).items()
+                if k in METRICS and v is not None})
+    row.update(wall_time=round(run.wall_time, 3), error=(run.error or '').replace('\n', ' '))
     return row
 
 

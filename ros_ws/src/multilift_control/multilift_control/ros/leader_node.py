@@ -1,22 +1,21 @@
-"""Leader node: tracks the mission path with the cascade controller (seed Ch. 3).
+"""Leader node: UAV 1 tracks the mission with the controller of `control.mode` (seed Ch. 3).
 
 Subscribes `/uav1/odom`; for every state it answers with `/uav1/rotor_cmd` stamped with the
 state's time, and publishes what it aimed at on `/uav1/reference` (mission reference) and
-`/uav1/attitude_setpoint` (outer-loop output). Parameters: scenario, record, summary_dir.
+`/uav1/attitude_setpoint` (outer-loop output). The control law and the statistics are the
+controller runtime's (multilift_control.runtime), shared with the headless loop.
+Parameters: scenario, record, summary_dir.
 """
 from __future__ import annotations
 
-import math
-
-import numpy as np
 from multilift_msgs.msg import AttitudeSetpoint, RotorCommand, TrackingReference
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 
 from multilift_control.cascade import UavState
-from multilift_control.controllers import make_controller
-from multilift_sim.ros import messages
+from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
+from multilift_sim.ros import messages
 from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
                                       controller_peers_missing, odometry_arrays, run_node,
                                       serve_controller, uav_topic)
@@ -30,8 +29,7 @@ class LeaderNode(Node):
         self.summary_dir = self.declare_parameter('summary_dir', '').value
         if not name:
             raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
-        self.scenario = scenario_io.load(name)
-        self.controller = make_controller(self.scenario, index=0)
+        self.runtime = ControllerRuntime(scenario_io.load(name), 0)
         self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(1, 'rotor_cmd'),
                                              PUBLISHER_QOS)
         self.ref_pub = self.create_publisher(TrackingReference, uav_topic(1, 'reference'),
@@ -39,35 +37,22 @@ class LeaderNode(Node):
         self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
                                                   uav_topic(1, 'attitude_setpoint'), PUBLISHER_QOS)
         self.create_subscription(Odometry, uav_topic(1, 'odom'), self.on_odometry, SUBSCRIBER_QOS)
-        self.max_tracking_error = 0.0
-        self.sum_sq_tracking_error = 0.0
-        self.samples = 0
 
     def missing_peers(self) -> str | None:
         return controller_peers_missing(self, self.cmd_pub, self.record)
 
     def on_odometry(self, msg: Odometry) -> None:
         t_ns = ns_from_stamp(msg.header.stamp)
-        state = UavState(*odometry_arrays(msg))
-        out, reference = self.controller.update(t_ns * 1e-9, state)
-        self.cmd_pub.publish(messages.rotor_command(t_ns, 1, out))
-        self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, 1, out))
-        if reference is not None:
-            self.ref_pub.publish(messages.tracking_reference(t_ns, reference))
-            error = float(np.linalg.norm(reference.position - state.position))
-            self.max_tracking_error = max(self.max_tracking_error, error)
-            self.sum_sq_tracking_error += error * error
-            self.samples += 1
-
-    def summary(self) -> dict:
-        rms = math.sqrt(self.sum_sq_tracking_error / self.samples) if self.samples else 0.0
-        return {'max_tracking_error': self.max_tracking_error, 'rms_tracking_error': rms,
-                'answered_states': self.samples}
+        answer = self.runtime.answer(t_ns, [UavState(*odometry_arrays(msg))])
+        self.cmd_pub.publish(messages.rotor_command(t_ns, 1, answer.output))
+        self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, 1, answer.output))
+        if answer.reference is not None:
+            self.ref_pub.publish(messages.tracking_reference(t_ns, answer.reference))
 
 
 def main(args: list[str] | None = None) -> int:
-    return run_node(LeaderNode, lambda node: serve_controller(node, 'leader', node.summary),
-                    args)
+    return run_node(LeaderNode, lambda node: serve_controller(
+        node, node.runtime.name, node.runtime.summary), args)
 
 
 if __name__ == '__main__':

@@ -1,0 +1,140 @@
+"""The controller runtime: what one UAV's controller needs each tick, written once for the
+controller nodes and the headless loop (pure Python, no ROS).
+
+A tick (seed Algorithm 1, in lockstep with the simulator): the simulator publishes the state
+at t; the leader answers it first; each follower answers once it has every UAV's state at t
+and the leader's answer to it, using as the other followers' thrusts their latest answers to
+earlier states (the previous tick's) and, before any answer, the hover share. `answer_tick`
+runs that sequence in one process; the nodes run it through messages, calling the same
+`ControllerRuntime` methods, so both compute the same numbers (tests/ros/test_headless.py
+compares their bags to 1e-9 m).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from multilift_control.cascade import ControlOutput, UavState
+from multilift_control.controllers import make_controller
+from multilift_control.formation import FormationFollower
+from multilift_control.mission import Reference
+from multilift_sim.kinematics import rotation_matrix
+from multilift_sim.scenario import Scenario
+from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
+
+
+@dataclass(frozen=True)
+class ControllerAnswer:
+    """A controller's answer to the formation state at t: what its node publishes."""
+    index: int                                  # UAV index from 0 (0 = the leader)
+    t_ns: int                                   # the state's time [ns]
+    output: ControlOutput                       # rotor speeds, saturation, set-points
+    reference: Reference | None = None          # the leader's mission reference at t
+    formation_error: np.ndarray | None = None   # a follower's rows of g_vc [m or m^2]
+    formation_error_rate: np.ndarray | None = None  # their rates [m/s or m^2/s]
+
+
+class ThrustBook:
+    """The collective thrusts u_T,j [N] a follower feeds to the virtual constraints
+    (seed Eq. 3.9-3.12: u_f,r holds every UAV's thrust vector R_j e_z u_T,j).
+
+    The leader's thrust is its answer to the same state (a follower waits for it); the other
+    followers' are their latest answers to earlier states (a follower does not wait for its
+    peers, so the result does not depend on who answers first); before any answer, the thrust
+    that carries the UAV and its share of the payload.
+    """
+
+    def __init__(self, scenario: Scenario):
+        share = scenario.payload.mass / scenario.n_uavs
+        gravity = scenario.simulation.gravity
+        self.vehicles = [u.vehicle for u in scenario.uavs]
+        self.thrusts = [(v.mass + share) * gravity for v in self.vehicles]  # [N]
+        self.leader: dict[int, float] = {}               # t_ns -> the leader's u_T [N]
+        self.pending: dict[int, dict[int, float]] = {}   # t_ns -> {follower: u_T [N]}
+
+    def note(self, index: int, t_ns: int, rotor_speeds: np.ndarray) -> None:
+        """UAV `index` (from 0) answered the state at t_ns with these rotor speeds [rad/s]."""
+        thrust = self.vehicles[index].collective_thrust(rotor_speeds)
+        if index == 0:
+            self.leader[t_ns] = thrust
+        else:
+            self.pending.setdefault(t_ns, {})[index] = thrust
+
+    def has_leader(self, t_ns: int) -> bool:
+        return t_ns in self.leader
+
+    def vectors(self, t_ns: int, states: list[UavState]) -> np.ndarray:
+        """Every UAV's thrust vector R_j(t) e_z u_T,j, world [N], shape (n, 3), for the state
+        at t_ns; needs the leader's answer to it."""
+        for stamp in sorted(k for k in self.pending if k < t_ns):
+            for j, thrust in self.pending.pop(stamp).items():
+                self.thrusts[j] = thrust
+        for stamp in [k for k in self.leader if k < t_ns]:
+            del self.leader[stamp]
+        self.thrusts[0] = self.leader.pop(t_ns)
+        return np.array([rotation_matrix(s.euler)[:, 2] * u
+                         for s, u in zip(states, self.thrusts)])
+
+
+class ControllerRuntime:
+    """UAV `index`'s controller (0: the leader of `control.mode`, else a virtual-constraint
+    follower) with its bookkeeping and its run statistics."""
+
+    def __init__(self, scenario: Scenario, index: int):
+        self.index = index
+        self.is_follower = index > 0
+        if self.is_follower:
+            self.follower = FormationFollower.from_scenario(scenario, index)
+            self.thrusts = ThrustBook(scenario)
+            self.statistics = FormationErrorStatistics()
+        else:
+            self.leader = make_controller(scenario, index)
+            self.statistics = TrackingStatistics()
+
+    @property
+    def name(self) -> str:
+        """The node's name and its summary's: `leader`, `follower2`, ..."""
+        return f'follower{self.index + 1}' if self.is_follower else 'leader'
+
+    def note_command(self, index: int, t_ns: int, rotor_speeds: np.ndarray) -> None:
+        """UAV `index` (from 0) answered the state at t_ns (a follower's input)."""
+        if self.is_follower:
+            self.thrusts.note(index, t_ns, rotor_speeds)
+
+    def ready(self, t_ns: int) -> bool:
+        """Whether this controller can answer the state at t_ns (given every UAV's state)."""
+        return not self.is_follower or self.thrusts.has_leader(t_ns)
+
+    def answer(self, t_ns: int, states: list[UavState]) -> ControllerAnswer:
+        """The answer to the formation state at t_ns (`states`: every UAV, from the leader)."""
+        t = t_ns * 1e-9
+        if not self.is_follower:
+            output, reference = self.leader.update(t, states[0])
+            if reference is not None:
+                self.statistics.add(reference.position, states[0].position)
+            return ControllerAnswer(0, t_ns, output, reference=reference)
+        output, errors, rates = self.follower.update(t, states,
+                                                     self.thrusts.vectors(t_ns, states))
+        self.statistics.add(errors)
+        return ControllerAnswer(self.index, t_ns, output, formation_error=errors,
+                                formation_error_rate=rates)
+
+    def summary(self) -> dict:
+        """This controller's run statistics (`multilift_sim.statistics`)."""
+        return self.statistics.as_dict()
+
+
+def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
+                states: list[UavState]) -> list[ControllerAnswer]:
+    """Every controller's answer to the state at t_ns, in the order the ROS graph gives them:
+    the leader first, then the followers, each of which then notes every answer."""
+    leader = runtimes[0].answer(t_ns, states)
+    followers = runtimes[1:]
+    for runtime in followers:
+        runtime.note_command(0, t_ns, leader.output.rotor_speeds)
+    answers = [leader] + [runtime.answer(t_ns, states) for runtime in followers]
+    for runtime in followers:
+        for answer in answers[1:]:
+            runtime.note_command(answer.index, t_ns, answer.output.rotor_speeds)
+    return answers

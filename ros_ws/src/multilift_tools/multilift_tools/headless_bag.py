@@ -30,12 +30,18 @@ def record_headless(scenario: Scenario, bag_dir: Path,
     for topic, kind in run_topics(scenario.n_uavs):
         writer.add_topic(topic, kind, qos)
 
+    rotor_counts = [u.vehicle.n_rotors for u in scenario.uavs]
+    applied: list = [None]  # the rotor speeds held up to this tick (None at t = 0)
+
     def write(topic: str, msg, t_ns: int) -> None:
         writer.write(topic, serialize_message(msg), t_ns)
 
     def tick(sim: FormationSimulator, snap: Snapshot, answers: list[ControllerAnswer]) -> None:
         t_ns = snap.t_ns
         write('/clock', messages.clock(t_ns), t_ns)
+        write('/formation/snapshot',
+              messages.formation_snapshot(snap, applied[0], rotor_counts), t_ns)
+        applied[0] = [a.output.rotor_speeds for a in answers]
         for i, uav in enumerate(snap.uavs):
             write(uav_topic(i + 1, 'odom'), messages.uav_odometry(t_ns, i + 1, uav), t_ns)
         write('/payload/odom', messages.payload_odometry(t_ns, snap.payload_position,

@@ -1,27 +1,28 @@
 """Follower node: UAV i (2..n) keeps the formation through virtual constraints (seed §3.2).
 
-For the state at t it needs every UAV's `/uav{j}/odom` stamped t and the leader's
-`/uav1/rotor_cmd` answering t; the other followers' commands are noted as they come (the
-controller runtime uses them from the next tick on, multilift_control.runtime.ThrustBook).
-It publishes `/uav{i}/rotor_cmd`, `/uav{i}/attitude_setpoint` and `/uav{i}/formation_error`
-(its rows of g_vc and their rates). The law, the bookkeeping and the statistics are the
-controller runtime's, shared with the headless loop. Parameters: scenario, uav_index,
-record, summary_dir.
+For the state at t it needs `/formation/snapshot` stamped t (every UAV's state, and the rotor
+speeds the simulator applied up to t: the other followers' previous answers) and the leader's
+`/uav1/rotor_cmd` answering t: two messages a tick whatever n, so a tick of the graph costs
+O(n) deliveries. It publishes `/uav{i}/rotor_cmd`, `/uav{i}/attitude_setpoint` and
+`/uav{i}/formation_error` (its rows of g_vc and their rates). The law, the thrust
+bookkeeping and the statistics are the controller runtime's (multilift_control.runtime),
+shared with the headless loop. Parameters: scenario, uav_index, record, summary_dir.
 """
 from __future__ import annotations
 
 import numpy as np
-from multilift_msgs.msg import AttitudeSetpoint, RotorCommand, VirtualConstraintError
-from nav_msgs.msg import Odometry
+from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorCommand,
+                                VirtualConstraintError)
 from rclpy.node import Node
 
 from multilift_control.cascade import UavState
+from multilift_control.ros.common import SNAPSHOT_TOPIC, snapshot_input
 from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros import messages
 from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      controller_peers_missing, odometry_arrays, run_node,
-                                      serve_controller, uav_topic)
+                                      controller_peers_missing, run_node, serve_controller,
+                                      uav_topic)
 
 
 class FollowerNode(Node):
@@ -38,15 +39,13 @@ class FollowerNode(Node):
         if not 2 <= self.index <= n:
             raise Fatal(f'uav_index {self.index} must be a follower: 2..{n}')
         self.n = n
+        self.period_ns = int(round(1e9 / scenario.simulation.control_rate))
         self.runtime = ControllerRuntime(scenario, self.index - 1)
-        self.odometry: dict[int, dict[int, Odometry]] = {}   # t_ns -> {uav: odometry}
-        for j in range(1, n + 1):
-            self.create_subscription(Odometry, uav_topic(j, 'odom'),
-                                     lambda msg, j=j: self.on_odometry(j, msg), SUBSCRIBER_QOS)
-            if j != self.index:
-                self.create_subscription(RotorCommand, uav_topic(j, 'rotor_cmd'),
-                                         lambda msg, j=j: self.on_command(j, msg),
-                                         SUBSCRIBER_QOS)
+        self.states: dict[int, list[UavState]] = {}   # t_ns -> every UAV's state
+        self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
+                                 SUBSCRIBER_QOS)
+        self.create_subscription(RotorCommand, uav_topic(1, 'rotor_cmd'), self.on_leader,
+                                 SUBSCRIBER_QOS)
         i = self.index
         self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(i, 'rotor_cmd'),
                                              PUBLISHER_QOS)
@@ -58,26 +57,25 @@ class FollowerNode(Node):
     def missing_peers(self) -> str | None:
         return controller_peers_missing(self, self.cmd_pub, self.record)
 
-    def on_command(self, j: int, msg: RotorCommand) -> None:
+    def on_leader(self, msg: RotorCommand) -> None:
         t_ns = ns_from_stamp(msg.header.stamp)
-        self.runtime.note_command(j - 1, t_ns, np.asarray(msg.angular_velocity, dtype=float))
-        if j == 1:
-            self.try_answer(t_ns)
+        self.runtime.note_command(0, t_ns, np.asarray(msg.angular_velocity, dtype=float))
+        self.try_answer(t_ns)
 
-    def on_odometry(self, j: int, msg: Odometry) -> None:
-        t_ns = ns_from_stamp(msg.header.stamp)
-        self.odometry.setdefault(t_ns, {})[j] = msg
+    def on_snapshot(self, msg: FormationSnapshot) -> None:
+        t_ns, states, previous = snapshot_input(msg)
+        for j, speeds in enumerate(previous[1:], start=1):  # the followers' answers to t - 1
+            self.runtime.note_command(j, t_ns - self.period_ns, speeds)
+        self.states[t_ns] = states
         self.try_answer(t_ns)
 
     def try_answer(self, t_ns: int) -> None:
-        odoms = self.odometry.get(t_ns, {})
-        if len(odoms) < self.n or not self.runtime.ready(t_ns):
+        if t_ns not in self.states or not self.runtime.ready(t_ns):
             return
-        for stamp in [k for k in self.odometry if k <= t_ns]:
-            del self.odometry[stamp]
-        states = [UavState(*odometry_arrays(odoms[j])) for j in range(1, self.n + 1)]
+        states = self.states.pop(t_ns)
+        for stamp in [k for k in self.states if k < t_ns]:
+            del self.states[stamp]
         answer = self.runtime.answer(t_ns, states)
-        self.runtime.note_command(answer.index, t_ns, answer.output.rotor_speeds)
         i = self.index
         self.cmd_pub.publish(messages.rotor_command(t_ns, i, answer.output))
         self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, i, answer.output))

@@ -1,6 +1,6 @@
 """Leader node: UAV 1 tracks the mission with the controller of `control.mode` (seed Ch. 3).
 
-Subscribes `/uav1/odom`; for every state it answers with `/uav1/rotor_cmd` stamped with the
+Subscribes `/formation/snapshot`; for every state it answers with `/uav1/rotor_cmd` stamped with the
 state's time, and publishes what it aimed at on `/uav1/reference` (mission reference) and
 `/uav1/attitude_setpoint` (outer-loop output). The control law and the statistics are the
 controller runtime's (multilift_control.runtime), shared with the headless loop.
@@ -8,17 +8,17 @@ Parameters: scenario, record, summary_dir.
 """
 from __future__ import annotations
 
-from multilift_msgs.msg import AttitudeSetpoint, RotorCommand, TrackingReference
-from nav_msgs.msg import Odometry
+from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorCommand,
+                                TrackingReference)
 from rclpy.node import Node
 
-from multilift_control.cascade import UavState
+from multilift_control.ros.common import SNAPSHOT_TOPIC, snapshot_input
 from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros import messages
-from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      controller_peers_missing, odometry_arrays, run_node,
-                                      serve_controller, uav_topic)
+from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
+                                      controller_peers_missing, run_node, serve_controller,
+                                      uav_topic)
 
 
 class LeaderNode(Node):
@@ -36,14 +36,15 @@ class LeaderNode(Node):
                                              PUBLISHER_QOS)
         self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
                                                   uav_topic(1, 'attitude_setpoint'), PUBLISHER_QOS)
-        self.create_subscription(Odometry, uav_topic(1, 'odom'), self.on_odometry, SUBSCRIBER_QOS)
+        self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
+                                 SUBSCRIBER_QOS)
 
     def missing_peers(self) -> str | None:
         return controller_peers_missing(self, self.cmd_pub, self.record)
 
-    def on_odometry(self, msg: Odometry) -> None:
-        t_ns = ns_from_stamp(msg.header.stamp)
-        answer = self.runtime.answer(t_ns, [UavState(*odometry_arrays(msg))])
+    def on_snapshot(self, msg: FormationSnapshot) -> None:
+        t_ns, states, _ = snapshot_input(msg)
+        answer = self.runtime.answer(t_ns, states)
         self.cmd_pub.publish(messages.rotor_command(t_ns, 1, answer.output))
         self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, 1, answer.output))
         if answer.reference is not None:

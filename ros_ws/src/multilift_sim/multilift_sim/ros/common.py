@@ -265,6 +265,7 @@ def run_topics(n_uavs: int) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records."""
     topics = [('/clock', 'rosgraph_msgs/msg/Clock'), ('/payload/odom', 'nav_msgs/msg/Odometry'),
               ('/formation/state', 'multilift_msgs/msg/FormationState'),
+              ('/formation/snapshot', 'multilift_msgs/msg/FormationSnapshot'),
               ('/payload/gust', 'geometry_msgs/msg/Vector3Stamped'),
               ('/visualization/markers', 'visualization_msgs/msg/MarkerArray'),
               (uav_topic(1, 'reference'), 'multilift_msgs/msg/TrackingReference')]

@@ -8,8 +8,8 @@ from typing import Sequence
 
 import numpy as np
 from geometry_msgs.msg import Point, Vector3, Vector3Stamped
-from multilift_msgs.msg import (AttitudeSetpoint, FormationState, RotorCommand,
-                                TrackingReference, VirtualConstraintError)
+from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, FormationState,
+                                RotorCommand, TrackingReference, VirtualConstraintError)
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
@@ -49,6 +49,39 @@ def formation_state(t_ns: int, tension: np.ndarray, g: np.ndarray,
     msg.header.stamp = stamp_from_ns(t_ns)
     msg.header.frame_id = WORLD_FRAME
     return msg
+
+
+def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | None,
+                       rotor_counts: Sequence[int]) -> FormationSnapshot:
+    """From a simulation.Snapshot and the rotor speeds applied up to it (None at t = 0)."""
+    uavs = snapshot.uavs
+    msg = FormationSnapshot(
+        position=np.concatenate([u.position for u in uavs]),
+        velocity=np.concatenate([u.velocity for u in uavs]),
+        euler=np.concatenate([u.euler for u in uavs]),
+        body_rates=np.concatenate([u.body_rates for u in uavs]),
+        payload_position=np.asarray(snapshot.payload_position, dtype=float),
+        payload_velocity=np.asarray(snapshot.payload_velocity, dtype=float),
+        rotor_count=[int(c) for c in rotor_counts],
+        previous_rotor_speeds=(np.concatenate(previous_rotor_speeds).astype(float)
+                               if previous_rotor_speeds is not None else []))
+    msg.header.stamp = stamp_from_ns(snapshot.t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    return msg
+
+
+def snapshot_arrays(msg: FormationSnapshot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                     np.ndarray, list[np.ndarray]]:
+    """(positions, velocities, euler, body_rates) each (n, 3), and the previous rotor speeds
+    per UAV (an empty list at t = 0) of a FormationSnapshot."""
+    def rows(values) -> np.ndarray:
+        return np.asarray(values, dtype=float).reshape(-1, 3)
+    previous = np.asarray(msg.previous_rotor_speeds, dtype=float)
+    speeds = []
+    if previous.size:
+        edges = np.cumsum(msg.rotor_count)[:-1]
+        speeds = np.split(previous, edges)
+    return rows(msg.position), rows(msg.velocity), rows(msg.euler), rows(msg.body_rates), speeds
 
 
 def rotor_command(t_ns: int, index: int, output) -> RotorCommand:

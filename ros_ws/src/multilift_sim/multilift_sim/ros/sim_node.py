@@ -1,11 +1,12 @@
 """Simulator node: integrates the formation DAE in lockstep with the controllers.
 
-Each control tick it publishes `/clock` and the state at t (`/uav{i}/odom`, `/payload/odom`,
-`/payload/gust`: the gust velocity at the payload, world frame; `/visualization/markers` every
-tenth tick),
-waits for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes `/formation/state`, and
-integrates to the next tick. No command within `command_timeout` wall seconds stops the run
-naming the silent UAV. Parameters: scenario (name or path), record (wait for a recorder),
+Each control tick it publishes `/clock`, `/formation/snapshot` (every UAV's and the payload's
+state at t and the rotor speeds applied up to t: what the controllers read, one message a tick),
+and for users, tools and bags the state at t as `/uav{i}/odom`, `/payload/odom` and
+`/payload/gust` (the gust velocity at the payload, world frame; `/visualization/markers` every
+tenth tick); it waits for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes
+`/formation/state`, and integrates to the next tick. No command within `command_timeout` wall
+seconds stops the run naming the silent UAV. Parameters: scenario (name or path), record (wait for a recorder),
 realtime (pace to the wall clock), duration (override t_max, s), summary_dir, progress_file.
 """
 from __future__ import annotations
@@ -14,7 +15,7 @@ import time
 
 import numpy as np
 from geometry_msgs.msg import Vector3Stamped
-from multilift_msgs.msg import FormationState, RotorCommand
+from multilift_msgs.msg import FormationSnapshot, FormationState, RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
@@ -52,6 +53,10 @@ class SimNode(Node):
         self.odom_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, 'odom'), PUBLISHER_QOS)
                           for i in range(n)]
         self.payload_pub = self.create_publisher(Odometry, '/payload/odom', PUBLISHER_QOS)
+        self.snapshot_pub = self.create_publisher(FormationSnapshot, '/formation/snapshot',
+                                                  PUBLISHER_QOS)
+        self.rotor_counts = [u.vehicle.n_rotors for u in scenario.uavs]
+        self.applied: list[np.ndarray] | None = None  # rotor speeds held up to this tick
         self.formation_pub = self.create_publisher(FormationState, '/formation/state',
                                                    PUBLISHER_QOS)
         self.gust_pub = self.create_publisher(Vector3Stamped, '/payload/gust', PUBLISHER_QOS)
@@ -73,13 +78,17 @@ class SimNode(Node):
                 return f'a controller publishing {uav_topic(i + 1, "rotor_cmd")}'
         if self.record:
             return recorder_missing(self, [self.clock_pub, self.payload_pub, self.formation_pub,
-                                           self.gust_pub, self.marker_pub, *self.odom_pubs])
+                                           self.snapshot_pub, self.gust_pub, self.marker_pub,
+                                           *self.odom_pubs])
         return None
 
     def publish_state(self) -> None:
         snap = self.sim.snapshot()
         t_ns = snap.t_ns
         self.clock_pub.publish(messages.clock(t_ns))
+        # the controllers' one input message first: they answer while the rest goes out
+        self.snapshot_pub.publish(messages.formation_snapshot(snap, self.applied,
+                                                              self.rotor_counts))
         for i, uav in enumerate(snap.uavs):
             self.odom_pubs[i].publish(messages.uav_odometry(t_ns, i + 1, uav))
         self.payload_pub.publish(messages.payload_odometry(t_ns, snap.payload_position,
@@ -119,6 +128,7 @@ class SimNode(Node):
                 if self.sim.finished:
                     break
                 self.sim.advance(speeds, flags)
+                self.applied = speeds
                 wall = time.monotonic() - wall_start
                 if self.realtime and self.sim.t > wall:
                     time.sleep(self.sim.t - wall)

@@ -6,8 +6,9 @@ and for users, tools and bags the state at t as `/uav{i}/odom`, `/payload/odom` 
 `/payload/gust` (the gust velocity at the payload, world frame; `/visualization/markers` every
 tenth tick); it waits for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes
 `/formation/state`, and integrates to the next tick. No command within `command_timeout` wall
-seconds stops the run naming the silent UAV. Parameters: scenario (name or path), record (wait for a recorder),
-realtime (pace to the wall clock), duration (override t_max, s), summary_dir, progress_file.
+seconds stops the run naming the silent UAV. Parameters: scenario (name or path), record
+(wait for a recorder), realtime (pace to the wall clock), duration (override t_max, s),
+summary_dir, progress_file.
 """
 from __future__ import annotations
 

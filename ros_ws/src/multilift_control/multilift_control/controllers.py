@@ -31,11 +31,11 @@ class ConstantRotorSpeed:
             speed = balancing_rotor_speed(vehicle, mass / scenario.n_uavs,
                                           scenario.simulation.gravity)
         clipped = min(max(speed, vehicle.rotor_speed_min), vehicle.rotor_speed_max)
-        self.output = ControlOutput(
-            rotor_speeds=np.full(vehicle.n_rotors, clipped),
-            saturated=np.full(vehicle.n_rotors, clipped != speed),
-            attitude_setpoint=np.zeros(3),
-            thrust=vehicle.n_rotors * vehicle.thrust_coefficient * clipped ** 2)
+        speeds = np.full(vehicle.n_rotors, clipped)
+        self.output = ControlOutput(rotor_speeds=speeds,
+                                    saturated=np.full(vehicle.n_rotors, clipped != speed),
+                                    attitude_setpoint=np.zeros(3),
+                                    thrust=vehicle.collective_thrust(speeds))
 
     def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
         return self.output, None

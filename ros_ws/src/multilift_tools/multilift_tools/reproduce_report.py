@@ -1,9 +1,9 @@
 """The report of `multilift reproduce`: measurements on the formation runs, the figures and
 docs/reproduction.md (seed §2.8 and Ch. 4). multilift_tools.reproduce runs the cases; this
 module turns their results into numbers, PNG figures (world frame, z up; the seed's caption under
-each) and the markdown report. The figures come from the functions of multilift_tools.plotting,
-.modal and .studies; what is added here is a caption footer, mission phase marks, the climb zoom
-of Fig. 4.8 and the gust spans of Fig. 4.15.
+each) and the markdown report. The figures come from the functions of multilift_tools.figures,
+.compare, .modal_cli and .studies; what is added here is a caption footer, mission phase
+marks, the climb zoom of Fig. 4.8 and the gust spans of Fig. 4.15.
 """
 from __future__ import annotations
 
@@ -107,7 +107,7 @@ def delivered_thrust(run: Any, scenario: Scenario, i: int) -> np.ndarray:
 
 def swing_by_phase(run: Any, scenario: Scenario) -> list[tuple[str, float, float, float]]:
     """(phase, start, end, max swing [m]) with plotting.swing_metrics on each mission phase."""
-    from multilift_tools.plotting import swing_metrics
+    from multilift_tools.metrics import swing_metrics
     return [(name, a, b, swing_metrics(_window_run(run, a, b), scenario, b)['max'])
             for name, a, b in phases(scenario)]
 
@@ -173,7 +173,7 @@ def formation_norms(run: Any, i: int, t0: float = 0.0) -> np.ndarray:
 
 def run_metrics(run: Any, scenario: Scenario) -> dict:
     """The numbers of one formation run that the report quotes."""
-    from multilift_tools.plotting import swing_metrics
+    from multilift_tools.metrics import swing_metrics
     m: dict[str, Any] = {}
     g = np.abs(run.g())
     tail = run.formation_time >= run.formation_time[-1] - HOVER_TAIL
@@ -287,7 +287,7 @@ def _mark_phases(axes: Sequence[Any], scenario: Scenario) -> None:
 def _climb_inset(fig: Any, run: Any, scenario: Scenario, excess: float) -> None:
     """Fig. 4.8: a zoom on the climb, where the seed reads its 6.14 %: delivered thrust
     k_T sum(omega^2) [N] of every UAV, in room made above the curves."""
-    from multilift_tools.plotting import uav_color, uav_label
+    from multilift_tools.plot_style import uav_color, uav_label
     ax = fig.axes[0]
     low, high = ax.get_ylim()
     ax.set_ylim(low, high + 0.55 * (high - low))
@@ -325,15 +325,16 @@ def make_figures(runs: dict[str, Any], scenarios: dict[str, Scenario], figures: 
     """Every figure of the report: seed number -> PNG file name under `figures`;
     climb_excess [%]: the twin-lift leader's thrust excess over the first 2 s (Fig. 4.8);
     gusts: the V's gust encounters (Fig. 4.15; the twin-lift meets none)."""
-    from multilift_tools import plotting as pl
+    from multilift_tools import compare as cp, figures as pl
+    from multilift_tools.plot_style import WORLD, Context
 
     files: dict[str, str] = {'2.12': 'fig2_12_twin_lift_eigenvalues.png'}
     time_figures = (pl.fig_cable_constraints, pl.fig_attitude, pl.fig_formation_errors,
                     pl.fig_thrust)
-    swing = pl.Context(runs[SWING], scenarios[SWING])
+    swing = Context(runs[SWING], scenarios[SWING])
     fig = pl.fig_trajectories_3d(swing)
     fig.suptitle(f'{SWING}: UAV and payload paths, released at α = 15°, β = 25° '
-                 f'({pl.WORLD}); the UAV moves little')
+                 f'({WORLD}); the UAV moves little')
     files['4.1'] = save_with_caption(fig, figures / 'fig4_01_single_lift_trajectories.png',
                                      '4.1').name
     for number, source, name in (('4.2', 'baumgarte_constraint.png',
@@ -354,7 +355,7 @@ def make_figures(runs: dict[str, Any], scenarios: dict[str, Scenario], figures: 
                        ('4.13', pl.fig_top_view, 'top_view'),
                        ('4.14', pl.fig_trajectories_3d, 'trajectories'))}
     for case, specs in per_run.items():
-        ctx = pl.Context(runs[case], scenarios[case])
+        ctx = Context(runs[case], scenarios[case])
         for number, make, stem in specs:
             fig = make(ctx)
             if make in time_figures:
@@ -365,10 +366,10 @@ def make_figures(runs: dict[str, Any], scenarios: dict[str, Scenario], figures: 
             files[number] = save_with_caption(fig, figures / name, number).name
     pair = [runs[TWIN], runs[MULTI]]
     pair_scenarios = [scenarios[TWIN], scenarios[MULTI]]
-    compare = (('4.15', lambda: pl.fig_compare_payload(pair, LABELS), 'payload'),
-               ('4.16', lambda: pl.fig_compare_formation_error(pair, LABELS, pair_scenarios),
+    compare = (('4.15', lambda: cp.fig_compare_payload(pair, LABELS), 'payload'),
+               ('4.16', lambda: cp.fig_compare_formation_error(pair, LABELS, pair_scenarios),
                 'formation_error'),
-               ('4.17', lambda: pl.fig_compare_leader_rotors(pair, LABELS, pair_scenarios),
+               ('4.17', lambda: cp.fig_compare_leader_rotors(pair, LABELS, pair_scenarios),
                 'leader_rotor_speed'))
     for number, make, stem in compare:
         fig = make()
@@ -438,7 +439,7 @@ def formation_table(mt: dict, mm: dict, modal: dict, effect: list[float],
     add('swing_phases', 'Fig. 4.5: twin-lift payload swing, max per phase [m]',
         'release swing damped by drag, excited at turns and gusts',
         ', '.join(f'{n} {s:.2f}' for n, _, _, s in mt['swing_phases']),
-        'reproduce_report.swing_by_phase (plotting.swing_metrics)',
+        'reproduce_report.swing_by_phase (metrics.swing_metrics)',
         [s for *_, s in mt['swing_phases']])
     add('tilt', 'Fig. 4.6: twin-lift UAV tilt at t = 120 s (hover), measured (static balance) '
         '[deg]', 'non-zero attitude',
@@ -606,7 +607,7 @@ class ReportInputs:
     modal: dict                   # _modal_case results
     effect: list[float]           # gust_effect of the V
     files: dict[str, str]         # seed figure number -> PNG name
-    comparison: list[str]         # plotting.comparison_numbers lines
+    comparison: list[str]         # compare.comparison_numbers lines
     wall: dict[str, float]        # wall time per case [s]
     jobs: int
 
@@ -669,7 +670,7 @@ def build_report(x: ReportInputs) -> str:
         'tools (`modal`, `study baumgarte`); the seed\'s values are quoted from '
         '`../shared/seed/` (§2.8, Ch. 4). Every figure of the seed\'s Ch. 4 (Fig. 4.1-4.17) and '
         'Fig. 2.12 has a counterpart here, drawn by the figure functions of '
-        '`multilift_tools.plotting`, `.modal` and `.studies`.',
+        '`multilift_tools.figures`, `.compare`, `.modal_cli` and `.studies`.',
         '',
         '**Frames.** Our figures and numbers are in the world frame, **z up**, SI units. The '
         'seed works z down: (x, y, z)_world = (x, -y, -z)_seed, so the seed\'s +j is our -y '
@@ -1003,7 +1004,7 @@ def write_reproduction(out: Path, results: dict[str, dict], work: Path, jobs: in
                        started: float) -> Path:
     """Figures and reproduction.md in `out` from the cases' results; returns the report."""
     from multilift_tools.bagdata import load_run
-    from multilift_tools.plotting import comparison_numbers
+    from multilift_tools.compare import comparison_numbers
 
     figures = out / 'figures'
     scenarios = {name: load(name) for name in (SWING, TWIN, MULTI)}

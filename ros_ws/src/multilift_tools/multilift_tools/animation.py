@@ -19,8 +19,8 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from multilift_tools.bagdata import FORMATION_TOPIC, Run
 from multilift_tools.metrics import interp_rows
-from multilift_tools.plot_style import (PAYLOAD_COLOR, WORLD, Parser, equal_3d, load_bag,
-                                        parse_args, plt, uav_color, uav_label)
+from multilift_tools.plot_style import (PAYLOAD_COLOR, WORLD, Parser, equal_3d, parse_and_load,
+                                        plt, uav_color, uav_label)
 
 
 @dataclass(frozen=True)
@@ -202,13 +202,11 @@ def animate_main(argv: list[str]) -> int:
     parser.add_argument('--speed', type=_positive, default=5.0,
                         help='simulated seconds per second of animation (5)')
     parser.add_argument('--dpi', type=int, default=80, help='resolution (80: 560 x 448 px)')
-    args = parse_args(parser, argv)
-    if isinstance(args, int):
-        return args
     started = time.perf_counter()
-    run = load_bag(args.bag)
-    if run is None:
-        return 2
+    loaded = parse_and_load(parser, argv)
+    if isinstance(loaded, int):
+        return loaded
+    args, run = loaded
     out = Path(args.out) if args.out else run.path / 'animation.gif'
     try:
         frames = write_animation(run, out, args.fps, args.speed, args.dpi)

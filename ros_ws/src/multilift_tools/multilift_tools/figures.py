@@ -22,7 +22,7 @@ from multilift_tools.metrics import interp_rows
 from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, SATURATION_GREY, WORLD,
                                         Context, Parser, equal_3d, finish_time_axes,
                                         formation_row_labels, legend,
-                                        load_bag, parse_args, plot_context, plt, save_figure,
+                                        parse_and_load, plot_context, plt, save_figure,
                                         shade_flags, uav_color, uav_label, uav_width,
                                         value_span, vehicle_of)
 
@@ -385,13 +385,11 @@ def plot_main(argv: list[str]) -> int:
     parser.add_argument('--out', help='output directory (default: BAG/plots)')
     parser.add_argument('--scenario', help='scenario name or YAML for the vehicle parameters '
                         "(default: the one in the bag's summary.json)")
-    args = parse_args(parser, argv)
-    if isinstance(args, int):
-        return args
     started = time.perf_counter()
-    run = load_bag(args.bag)
-    if run is None:
-        return 2
+    loaded = parse_and_load(parser, argv)
+    if isinstance(loaded, int):
+        return loaded
+    args, run = loaded
     out = Path(args.out) if args.out else run.path / 'plots'
     written, skipped = make_plots(plot_context(run, args.scenario), out)
     for path in written:

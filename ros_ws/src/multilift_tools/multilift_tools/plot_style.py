@@ -165,3 +165,14 @@ def plot_context(run: Run, scenario: str | None) -> Context:
         print(f'note: {note}; rotor limits inferred from the saturation flags, no gusts or '
               'max thrust drawn', file=sys.stderr)
     return Context(run, found)
+
+
+def parse_and_load(parser: argparse.ArgumentParser, argv: list[str]
+                   ) -> tuple[argparse.Namespace, Run] | int:
+    """Parse `argv` (a positional `bag`) and load the bag: (arguments, run), or the exit code
+    (parse_args's, or 2 after load_bag's `error:` line)."""
+    args = parse_args(parser, argv)
+    if isinstance(args, int):
+        return args
+    run = load_bag(args.bag)
+    return 2 if run is None else (args, run)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 
 from multilift_tools.bagdata import PAYLOAD_ODOM, Run, rotor_limits
-from multilift_tools.metrics import comparison_rows, common_end, pendulum_period, until
+from multilift_tools.metrics import comparison_rows, common_end, until
 from multilift_tools.plot_style import (AXES_XYZ, SATURATION_GREY, WORLD, Parser,
                                         finish_time_axes, formation_row_labels, legend,
                                         load_bag, parse_args, plot_context, plt, save_figure,
@@ -127,7 +127,6 @@ def comparison_numbers(runs: Sequence[Run], labels: Sequence[str],
     """The table `compare` prints: payload swing, leader rotor speed, virtual-constraint error
     per follower, over the common time span; the last column is (B - A) / A."""
     t_end = common_end(runs)
-    periods = ' / '.join(f'{pendulum_period(r, s):.1f}' for r, s in zip(runs, scenarios))
     width = max(10, max(len(label) for label in labels) + 2)
     lines = [f'compared over t = 0 .. {t_end:.1f} s (the shorter run)',
              f'{"":34}{labels[0]:>{width}}{labels[1]:>{width}}{"B vs A":>10}']
@@ -135,8 +134,8 @@ def comparison_numbers(runs: Sequence[Run], labels: Sequence[str],
         cells = [f'{v:.3f}' if abs(v) < 100 else f'{v:.1f}' for v in (a, b)]
         cells = [c if c != 'nan' else '-' for c in cells]
         lines.append(f'{name:34}{cells[0]:>{width}}{cells[1]:>{width}}{_percent(a, b):>10}')
-    lines.append("swing: the payload's horizontal offset from the UAVs' centroid about its "
-                 f'moving mean over one pendulum period ({periods} s)')
+    lines.append("swing: the payload's horizontal distance from its static-equilibrium place "
+                 'under the UAVs (multilift_sim.statistics.payload_swing)')
     lines.append("|g_vc|: norm of a follower's virtual-constraint rows")
     return lines
 

@@ -1,7 +1,7 @@
 """Numbers measured on recorded runs, shared by the figures, `compare` and the reproduction
-report: interpolation onto another time base, time windows, the pendulum period, payload swing,
-virtual-constraint error norms, the comparison table's rows. No matplotlib. World frame, z up,
-SI units.
+report: interpolation onto another time base, time windows, cable lengths, payload swing
+(multilift_sim.statistics.payload_swing over a run), virtual-constraint error norms, the
+comparison table's rows. No matplotlib. World frame, z up, SI units.
 """
 from __future__ import annotations
 
@@ -32,37 +32,40 @@ def until(t: np.ndarray, t_end: float) -> np.ndarray:
     return t <= t_end + 1e-9
 
 
-def pendulum_period(run: Run, scenario: Scenario | None, gravity: float = 9.81) -> float:
-    """2 pi sqrt(h/g) [s], h the cable length of the scenario or else the mean height of the
-    UAVs' centroid above the payload [m]."""
+def cable_lengths(run: Run, scenario: Scenario | None) -> np.ndarray:
+    """l_i [m] per cable: the scenario's, or else the mean UAV-payload distance over the run
+    (a rigid cable keeps its length)."""
     if scenario is not None:
-        h = float(np.mean([u.cable_length for u in scenario.uavs]))
-        gravity = scenario.simulation.gravity
-    else:
-        centroid = run.uav_positions().mean(axis=0)
-        p = interp_rows(run.t, run.payload_time, run.payload_position())
-        h = float(np.mean(centroid[:, 2] - p[:, 2]))
-    return 2 * math.pi * math.sqrt(max(h, 1e-3) / gravity)
+        return np.array([u.cable_length for u in scenario.uavs], dtype=float)
+    p = interp_rows(run.t, run.payload_time, run.payload_position())
+    return np.linalg.norm(run.uav_positions() - p[None], axis=2).mean(axis=1)
+
+
+def swing_series(run: Run, scenario: Scenario | None) -> tuple[np.ndarray, np.ndarray]:
+    """Payload swing over the run: the UAVs' odometry times t (T,) [s] and
+    multilift_sim.statistics.payload_swing (T,) [m], the horizontal distance of the payload
+    from its static-equilibrium place under the UAVs at the same tick (NaN where the cables
+    cannot meet)."""
+    from multilift_sim.statistics import payload_swing
+
+    payload = interp_rows(run.t, run.payload_time, run.payload_position())
+    uavs = np.moveaxis(run.uav_positions(), 0, 1)                     # (T, n, 3)
+    return run.t, payload_swing(uavs, payload, cable_lengths(run, scenario))
+
+
+def peak_rms(values: np.ndarray) -> tuple[float, float]:
+    """(max, rms) of the finite `values`; NaN, NaN when there are none."""
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return math.nan, math.nan
+    return float(values.max()), float(np.sqrt(np.mean(values ** 2)))
 
 
 def swing_metrics(run: Run, scenario: Scenario | None, t_end: float) -> dict[str, float]:
-    """Payload swing: its horizontal offset d(t) from the UAVs' centroid [m] (world x, y),
-    minus the moving mean of d over one pendulum period; returns the max and RMS of |that|
-    [m], and the period [s] used. Over t <= t_end."""
-    keep = until(run.t, t_end)
-    t = run.t[keep]
-    p = interp_rows(t, run.payload_time, run.payload_position())
-    d = p[:, :2] - run.uav_positions()[:, keep, :2].mean(axis=0)
-    period = pendulum_period(run, scenario)
-    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    width = max(1, min(len(t), int(round(period / dt))))
-    kernel = np.ones(width) / width
-    smooth = np.stack([np.convolve(np.pad(d[:, k], (width // 2, width - 1 - width // 2),
-                                          mode='edge'), kernel, mode='valid')
-                       for k in range(2)], axis=1)
-    swing = np.linalg.norm(d - smooth, axis=1)
-    return {'max': float(swing.max()), 'rms': float(np.sqrt(np.mean(swing ** 2))),
-            'period': period}
+    """Payload swing (swing_series) over t <= t_end [s]: its max and rms [m]."""
+    t, swing = swing_series(run, scenario)
+    peak, rms = peak_rms(swing[until(t, t_end)])
+    return {'max': peak, 'rms': rms}
 
 
 def formation_norms(run: Run, i: int, t_end: float) -> np.ndarray:

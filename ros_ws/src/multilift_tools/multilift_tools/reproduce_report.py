@@ -22,7 +22,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from multilift_tools.metrics import interp_rows, swing_metrics
+from multilift_tools.metrics import interp_rows, peak_rms, swing_series
 from multilift_tools.reproduce import (BAUMGARTE_DURATION, BAUMGARTE_GAINS, CASES, MULTI,
                                          SWING, TWIN, release_amplitude)
 from multilift_sim.scenario import MissionSegment, Scenario, load
@@ -79,7 +79,7 @@ class Phase:
 
 @dataclass(frozen=True)
 class PhaseSwing:
-    """The largest payload swing [m] (metrics.swing_metrics) within one mission phase."""
+    """The largest payload swing [m] (metrics.swing_series) within one mission phase."""
 
     phase: Phase
     max_swing: float
@@ -318,16 +318,6 @@ class Report:
 # =============================================================================================
 # Measurements on the formation runs (seed §4.2-4.5)
 # =============================================================================================
-def _window_run(run: Any, t0: float, t1: float) -> Any:
-    """The run restricted to t0 <= t <= t1 [s] on every topic (a bagdata.Run)."""
-    from multilift_tools.bagdata import Run, Series
-    series = {}
-    for name, s in run.series.items():
-        keep = (s.t >= t0 - 1e-9) & (s.t <= t1 + 1e-9)
-        series[name] = Series(s.topic, s.t[keep], {k: v[keep] for k, v in s.fields.items()})
-    return Run(run.path, series, run.summary)
-
-
 def phase_name(segment: MissionSegment) -> str:
     """'climb', 'hover' or '+x cruise' ... of a mission segment (world axes)."""
     v = np.asarray(segment.velocity, dtype=float)
@@ -354,11 +344,15 @@ def delivered_thrust(run: Any, scenario: Scenario, i: int) -> np.ndarray:
                                                                      axis=1)
 
 
-def swing_by_phase(run: Any, scenario: Scenario) -> tuple[PhaseSwing, ...]:
-    """The largest swing (metrics.swing_metrics) in each mission phase."""
-    return tuple(PhaseSwing(p, swing_metrics(_window_run(run, p.start, p.end), scenario,
-                                             p.end)['max'])
-                 for p in phases(scenario))
+def swing_by_phase(t: np.ndarray, swing: np.ndarray, mission: Sequence[Phase]
+                   ) -> tuple[PhaseSwing, ...]:
+    """The largest payload swing [m] (metrics.swing_series: t [s], swing [m]) in each phase."""
+    return tuple(PhaseSwing(p, _peak_between(t, swing, p.start, p.end)) for p in mission)
+
+
+def _peak_between(t: np.ndarray, values: np.ndarray, t0: float, t1: float) -> float:
+    """The largest finite value of `values` at t0 <= t <= t1 [s] (1 ns tolerance)."""
+    return peak_rms(values[(t >= t0 - 1e-9) & (t <= t1 + 1e-9)])[0]
 
 
 def gust_encounters(run: Any, scenario: Scenario) -> tuple[GustEncounter, ...]:
@@ -432,7 +426,8 @@ def measure_run(run: Any, scenario: Scenario) -> FormationRunNumbers:
     """The numbers of one formation run that the report quotes."""
     g = np.abs(run.g())
     tail = run.formation_time >= run.formation_time[-1] - HOVER_TAIL
-    swing = swing_metrics(run, scenario, float(run.t[-1]))
+    t_swing, swing = swing_series(run, scenario)
+    swing_max, swing_rms = peak_rms(swing)
     mission = phases(scenario)
     climb = mission[0]
     t_rot = run.rotor_time(1)
@@ -457,9 +452,9 @@ def measure_run(run: Any, scenario: Scenario) -> FormationRunNumbers:
         name=scenario.name, duration=float(run.t[-1]), phases=tuple(mission),
         max_g=float(g.max()), max_g_hover=float(g[tail].max()), final_g=float(g[-1].max()),
         min_tension=float(run.tensions().min()),
-        swing_max=swing['max'], swing_rms=swing['rms'],
-        swing_phases=swing_by_phase(run, scenario),
-        swing_steady=swing_metrics(_window_run(run, *STEADY), scenario, STEADY[1])['max'],
+        swing_max=swing_max, swing_rms=swing_rms,
+        swing_phases=swing_by_phase(t_swing, swing, mission),
+        swing_steady=_peak_between(t_swing, swing, *STEADY),
         gusts=gust_encounters(run, scenario), distances=pair_distances(run, scenario),
         tilt=hover_tilt(run, scenario), followers=follower_errors(run, climb),
         leader_omega_cruise=float(omega[cruise].mean()), leader_omega_all=float(omega.mean()),

@@ -17,9 +17,10 @@ from multilift_sim.constraints import constraint_jacobian
 from multilift_sim.dynamics import FormationModel, StateLayout
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.modal import (coordinate_names, default_dependent_coordinates,
-                                 elimination_basis, modal_analysis, modal_main, mode_state,
+                                 elimination_basis, modal_analysis, mode_state,
                                  scenario_equilibrium, scenario_modal_analysis)
 from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
+from multilift_tools.modal_cli import modal_main
 
 SCENARIO_NAMES = sorted(p.stem for p in SCENARIOS.glob('*.yaml'))
 

@@ -27,7 +27,9 @@ from std_msgs.msg import String
 from multilift_tools import bagdata
 from multilift_sim.bag import BagWriter
 from multilift_tools.bagdata import RunDataError, euler_from_quaternions, load_run
-from multilift_tools.plotting import animate_main, compare_main, plot_main
+from multilift_tools.animation import animate_main
+from multilift_tools.compare import compare_main
+from multilift_tools.figures import plot_main
 
 DT = 0.05  # [s] sample step of the synthetic runs
 OMEGA_MAX = 2100.0  # [rad/s] rotor limit of the twin_lift / multi_lift scenarios
@@ -329,7 +331,7 @@ def test_bad_option_is_exit_code_2(bags, capsys):
 
 
 def test_missing_bag_from_the_command_line_has_no_traceback(tmp_path):
-    code = ('import sys; from multilift_tools.plotting import plot_main; '
+    code = ('import sys; from multilift_tools.figures import plot_main; '
             'sys.exit(plot_main(sys.argv[1:]))')
     done = subprocess.run([sys.executable, '-c', code, str(tmp_path / 'gone')],
                           capture_output=True, text=True, env=dict(os.environ), timeout=120)

@@ -41,13 +41,9 @@ the analysis is of the formation in still air.
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 import math
-import sys
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -57,7 +53,7 @@ from numpy.typing import ArrayLike
 from multilift_sim.constraints import cable_residuals, cable_tension, constraint_jacobian
 from multilift_sim.dynamics import FormationModel, FormationParams, StateLayout
 from multilift_sim.multirotor import euler_mass_matrix
-from multilift_sim.scenario import Scenario, ScenarioError, load
+from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import formation_start
 
 MODE_KINDS = ('pendulum', 'oscillatory', 'unstable', 'damped', 'rigid')
@@ -400,160 +396,3 @@ def mode_state(analysis: ModalAnalysis, mode: int, amplitude: float,
         jacobian = constraint_jacobian(layout.uav_positions(x), layout.payload_position(x))
         x[:size] -= np.linalg.pinv(jacobian) @ residual
     return x
-
-
-# ---------------------------------------------------------------------------------- report
-def _shape_text(analysis: ModalAnalysis, mode: int, count: int = 3) -> str:
-    names = coordinate_names(analysis.params.n_uavs)
-    shape = analysis.shapes[mode]
-    top = [k for k in np.argsort(-np.abs(shape))[:count] if abs(shape[k]) >= 0.01]
-    parts = []
-    for k in top:
-        value = shape[k]
-        text = (f'{value.real:+.2f}' if abs(value.imag) < 1e-3 * abs(value)
-                else f'{abs(value):.2f}<{math.degrees(np.angle(value)):.0f}deg')
-        parts.append(f'{names[k]} {text}')
-    return ', '.join(parts)
-
-
-def modal_report(analysis: ModalAnalysis, name: str) -> str:
-    """The eigenvalue table, pendulum periods and rigid-body count as text."""
-    eq = analysis.equilibrium
-    n = analysis.params.n_uavs
-    layout = StateLayout(n)
-    tilts = np.degrees(np.arccos(np.cos(layout.uav_euler(eq.state)[:, 0])
-                                 * np.cos(layout.uav_euler(eq.state)[:, 1])))
-    names = coordinate_names(n)
-    lines = [f'modal analysis of {name} (n = {n}): open loop, rotor speeds held at the static '
-             'equilibrium of Eq. 2.73',
-             '  cable tensions  ' + ', '.join(f'{t:.3f}' for t in eq.tensions) + ' N',
-             '  rotor speeds    ' + ', '.join(f'{np.mean(s):.1f}' for s in eq.rotor_speeds)
-             + ' rad/s (per UAV)',
-             '  UAV tilt        ' + ', '.join(f'{t:.2f}' for t in tilts) + ' deg',
-             f'  coordinates     {layout.n_coordinates}, of them {analysis.basis.shape[1]} '
-             'independent' + (' (dependent: ' + ', '.join(names[k] for k in analysis.dependent)
-                              + ')' if analysis.dependent else ' (null-space basis)'),
-             '',
-             f'  {"#":>2}  {"Re [1/s]":>10}  {"Im [1/s]":>12}  {"period [s]":>10}  '
-             f'{"kind":<11}  shape (largest components of q_f)']
-    row = 0
-    for k, value in enumerate(analysis.eigenvalues):
-        kind = analysis.kinds[k]
-        if kind == 'rigid' or value.imag < 0:
-            continue
-        row += 1          # a complex pair is one row (+/-), a real eigenvalue its own
-        imag = f'+/-{value.imag:.5f}' if value.imag > 0 else f'{0.0:.5f}'
-        period = f'{2 * math.pi / value.imag:.4f}' if value.imag > 0 else '-'
-        lines.append(f'  {row:>2}  {value.real:>+10.2e}  {imag:>12}  {period:>10}  '
-                     f'{kind:<11}  {_shape_text(analysis, k)}')
-    rigid = analysis.rigid_count
-    largest = max((abs(v) for v, c in zip(analysis.eigenvalues, analysis.kinds) if c == 'rigid'),
-                  default=0.0)
-    lines += ['',
-              f'  rigid-body modes: {rigid} eigenvalues with |lambda| < '
-              f'{analysis.zero_tolerance:g} 1/s (largest {largest:.1e}): translation of the '
-              'free formation and the UAV attitudes, which nothing holds in open loop',
-              '  pendulum periods: ' + (', '.join(f'{p:.4f}' for p in analysis.pendulum_periods)
-                                        or 'none') + ' s']
-    unstable = analysis.indices('unstable')
-    if unstable.size:
-        lines.append('  unstable: ' + ', '.join(f'{analysis.eigenvalues[k]:.4g}'
-                                                for k in unstable) + ' 1/s')
-    return '\n'.join(lines)
-
-
-def plot_eigenvalues(analysis: ModalAnalysis, path: Path, title: str) -> None:
-    """Eigenvalues in the complex plane (the analogue of seed Fig. 2.12) as a PNG."""
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(6.4, 4.8), layout='constrained')
-    axes = figure.add_subplot()
-    markers = {'pendulum': ('o', 'tab:blue'), 'oscillatory': ('s', 'tab:green'),
-               'unstable': ('^', 'tab:red'), 'damped': ('v', 'tab:purple'),
-               'rigid': ('x', 'tab:gray')}
-    for kind in MODE_KINDS:
-        k = analysis.indices(kind)
-        if k.size == 0:
-            continue
-        marker, colour = markers[kind]
-        values = analysis.eigenvalues[k]
-        label = f'{kind} ({k.size})' if kind != 'rigid' else f'rigid body ({k.size}, at 0)'
-        axes.plot(values.real, values.imag, marker, color=colour, linestyle='none',
-                  markersize=8, fillstyle='none' if kind == 'rigid' else 'full', label=label)
-    for count, k in enumerate(analysis.pendulum_modes):      # sides alternate: close pairs
-        value = analysis.eigenvalues[k]
-        right = count % 2 == 0
-        axes.annotate(f'{2 * math.pi / value.imag:.2f} s', (value.real, value.imag),
-                      textcoords='offset points', xytext=(8 if right else -8, -3),
-                      ha='left' if right else 'right', fontsize=8)
-    axes.axhline(0.0, color='black', linewidth=0.5)
-    axes.axvline(0.0, color='black', linewidth=0.5)
-    span = max(1e-3, float(np.max(np.abs(analysis.eigenvalues))))
-    if analysis.indices('unstable').size == 0 and analysis.indices('damped').size == 0:
-        axes.set_xlim(-0.5 * span, 0.5 * span)
-    axes.set_xlabel(r'real part Re($\lambda$) [1/s]')
-    axes.set_ylabel(r'imaginary part Im($\lambda$) [1/s]')
-    axes.set_title(title, fontsize=10)
-    axes.grid(True, alpha=0.3)
-    axes.legend(loc='best', fontsize=8)
-    figure.savefig(path, dpi=120)
-
-
-def modal_summary(analysis: ModalAnalysis, name: str) -> dict:
-    """JSON-ready eigenvalues [1/s], kinds, pendulum periods [s] and equilibrium."""
-    eq = analysis.equilibrium
-    return {'scenario': name,
-            'eigenvalues': [[float(v.real), float(v.imag)] for v in analysis.eigenvalues],
-            'kinds': list(analysis.kinds),
-            'pendulum_periods': [float(p) for p in analysis.pendulum_periods],
-            'rigid_count': analysis.rigid_count,
-            'dependent_coordinates': [coordinate_names(analysis.params.n_uavs)[k]
-                                      for k in analysis.dependent],
-            'equilibrium': {'state': eq.state.tolist(),
-                            'rotor_speeds': [s.tolist() for s in eq.rotor_speeds],
-                            'tensions': eq.tensions.tolist()}}
-
-
-class _UsageError(Exception):
-    pass
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:      # one line, exit code 2 (not argparse's usage)
-        raise _UsageError(message)
-
-
-def modal_main(argv: list[str] | None = None) -> int:
-    """`multilift modal SCENARIO [--out DIR]` (argv without the word 'modal').
-
-    Prints the eigenvalue table and the pendulum periods, writes DIR/<name>_eigenvalues.png
-    and DIR/<name>_modal.json (DIR default runs/modal). Exit 0, or 2 with one line on stderr
-    for a bad scenario or argument.
-    """
-    parser = _Parser(prog='multilift modal', description='modal analysis of a formation at '
-                     'its static equilibrium (seed Sec. 2.8)')
-    parser.add_argument('scenario', help='a name in scenarios/ or a YAML path')
-    parser.add_argument('--out', default='runs/modal', help='directory for the plot and JSON')
-    try:
-        args = parser.parse_args(argv)
-        scenario = load(args.scenario)
-        analysis = scenario_modal_analysis(scenario)
-    except (_UsageError, ScenarioError, ValueError) as exc:
-        print(f'error: {exc}', file=sys.stderr)
-        return 2
-    for warning in scenario.warnings:
-        print(f'warning: {warning}', file=sys.stderr)
-    print(modal_report(analysis, scenario.name))
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    png = out / f'{scenario.name}_eigenvalues.png'
-    plot_eigenvalues(analysis, png, f'{scenario.name}: eigenvalues of the linearised formation '
-                     '(open loop)')
-    summary = out / f'{scenario.name}_modal.json'
-    summary.write_text(json.dumps(modal_summary(analysis, scenario.name), indent=1))
-    print(f'  wrote {png} and {summary}')
-    return 0
-
-
-if __name__ == '__main__':
-    sys.exit(modal_main())

@@ -247,11 +247,11 @@ def cmd_topic(args: argparse.Namespace) -> int:
 
 # Subcommands whose parsing lives with their module: name -> (module, function, help)
 DELEGATED = {
-    'plot': ('multilift_tools.plotting', 'plot_main', 'PNG figures from a bag'),
-    'animate': ('multilift_tools.plotting', 'animate_main', 'GIF of the formation from a bag'),
-    'compare': ('multilift_tools.plotting', 'compare_main',
+    'plot': ('multilift_tools.figures', 'plot_main', 'PNG figures from a bag'),
+    'animate': ('multilift_tools.animation', 'animate_main', 'GIF of the formation from a bag'),
+    'compare': ('multilift_tools.compare', 'compare_main',
                 'seed Fig. 4.15-4.17 comparisons of two bags'),
-    'modal': ('multilift_sim.modal', 'modal_main',
+    'modal': ('multilift_tools.modal_cli', 'modal_main',
               'eigenvalues and pendulum periods at the static equilibrium (seed §2.8)'),
     'study': ('multilift_tools.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
     'bag': ('multilift_tools.bag_tools', 'bag_main',

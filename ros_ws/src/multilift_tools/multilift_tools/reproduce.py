@@ -3,10 +3,11 @@
 Runs the seed's cases headless (multilift_control.headless: the physics, control laws and bag of
 the ROS stack in one process) in parallel worker processes; multilift_tools.reproduce_report
 then draws a counterpart of every figure of the seed's §2.8 (Fig. 2.12) and Ch. 4 (Fig.
-4.1-4.17) with the figure functions of multilift_tools.plotting, .modal and .studies, measures
-every number and qualitative claim of those sections, and writes DIR/reproduction.md (default
-docs/) with the figures as PNG under DIR/figures/ (relative links). World frame, z up, SI units;
-the seed's frame is z down, (x, y, z)_world = (x, -y, -z)_seed (multilift_sim.frames).
+4.1-4.17) with the figure functions of multilift_tools.figures, .compare, .modal_cli and
+.studies, measures every number and qualitative claim of those sections, and writes
+DIR/reproduction.md (default docs/) with the figures as PNG under DIR/figures/ (relative
+links). World frame, z up, SI units; the seed's frame is z down, (x, y, z)_world = (x, -y,
+-z)_seed (multilift_sim.frames).
 
 This module also holds `single_lift_table`, the single-lift numbers (seed §2.8.1, §4.1) that
 tests/test_reproduction.py regenerates and compares with the committed report.
@@ -358,8 +359,8 @@ def _still_air(name: str, progress: _ProgressFile) -> dict:
 def _modal_case(figures: Path, progress: _ProgressFile) -> dict:
     """Modal analyses of the twin-lift (Fig. 2.12) and the V at their Eq. 2.73 equilibria."""
     from multilift_sim.dynamics import StateLayout
-    from multilift_sim.modal import (coordinate_names, plot_eigenvalues,
-                                     scenario_modal_analysis)
+    from multilift_sim.modal import coordinate_names, scenario_modal_analysis
+    from multilift_tools.modal_cli import plot_eigenvalues
 
     out = {}
     for k, name in enumerate((TWIN, MULTI)):

@@ -1,0 +1,400 @@
+"""`multilift plot BAG [--out DIR] [--scenario NAME|PATH]`: the figures of one recorded run.
+
+Everything is drawn in the world frame (z up, SI units) from the bag (`bagdata.load_run`);
+vehicle parameters the bag does not carry (rotor limits, k_T, gusts, formation geometry) come
+from the scenario named in the bag's summary.json, or `--scenario`. One figure per function;
+the Agg backend (plot_style), no display needed. Exit codes: 0 done, 2 bad input (one `error:`
+line).
+"""
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+
+from multilift_tools.bagdata import (FORMATION_TOPIC, PAYLOAD_GUST, PAYLOAD_ODOM,
+                                     REFERENCE_TOPIC, Run, RunDataError, rotor_limits)
+from multilift_tools.metrics import interp_rows
+from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, SATURATION_GREY, WORLD,
+                                        Context, Parser, equal_3d, finish_time_axes,
+                                        formation_row_labels, legend,
+                                        parse_and_load, plot_context, plt, save_figure,
+                                        shade_flags, uav_color, uav_label, uav_width,
+                                        value_span, vehicle_of)
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from multilift_sim.scenario import Scenario
+
+
+def fig_trajectories_3d(ctx: Context) -> Figure:
+    """3-D paths of the UAVs and the payload, with the cables at the start and the end."""
+    run = ctx.run
+    r, rp = run.uav_positions(), interp_rows(run.t, run.payload_time, run.payload_position())
+    fig = plt.figure(figsize=(10, 6.5))
+    ax = fig.add_axes((-0.02, 0.0, 0.8, 0.94), projection='3d')
+    for i in range(1, run.n_uavs + 1):
+        ax.plot(*r[i - 1].T, color=uav_color(i), label=uav_label(i), lw=1.4)
+    ax.plot(*rp.T, color=PAYLOAD_COLOR, lw=1.4, label='payload')
+    for k, (style, what) in enumerate(((':', 'start'), ('--', 'end'))):
+        idx = 0 if k == 0 else -1
+        for i in range(run.n_uavs):
+            ax.plot(*np.stack([r[i, idx], rp[idx]]).T, color='0.45', ls=style, lw=1.0,
+                    label=f'cables at {what} (t = {run.t[idx]:.0f} s)' if i == 0 else None)
+        ax.scatter(*r[:, idx].T, color=[uav_color(i) for i in range(1, run.n_uavs + 1)],
+                   marker='o' if k == 0 else 's', s=30, depthshade=False)
+        ax.scatter(*rp[idx], color=PAYLOAD_COLOR, marker='o' if k == 0 else 's', s=30,
+                   depthshade=False)
+    equal_3d(ax, np.concatenate([r.reshape(-1, 3), rp]))
+    ax.set_xlabel('x [m]')
+    ax.set_ylabel('y [m]')
+    ax.set_zlabel('z [m]')
+    ax.plot([], [], 'o', color='0.3', label='start')
+    ax.plot([], [], 's', color='0.3', label='end')
+    fig.suptitle(f'{run.label}: trajectories ({WORLD})')
+    fig.legend(loc='center right', fontsize='small')
+    return fig
+
+
+def _gust_regions(ax: Axes, scenario: Scenario | None) -> None:
+    if scenario is None:
+        return
+    for k, gust in enumerate(scenario.gusts, start=1):
+        cx, cy = gust.center
+        ax.add_patch(plt.Circle((cx, cy), gust.gradient_distance, color='tab:cyan',
+                                alpha=0.25, lw=0,
+                                label='gust regions (radius H)' if k == 1 else None))
+        dx, dy = gust.direction[0], gust.direction[1]
+        ax.annotate('', xy=(cx + dx * gust.gradient_distance, cy + dy * gust.gradient_distance),
+                    xytext=(cx, cy), arrowprops={'arrowstyle': '->', 'color': 'tab:blue'})
+        ax.text(cx, cy, f' gust {k}\n {gust.reference_speed:g} m/s', fontsize='x-small',
+                color='tab:blue', va='top')
+
+
+def _snapshot_times(ax: Axes, t: np.ndarray, payload: np.ndarray, idxs: np.ndarray,
+                    near: float = 0.6) -> None:
+    """'t = ... s' next to the payload at the snapshot samples; snapshots whose payloads lie
+    within `near` [m] of each other share one label."""
+    groups: list[list[int]] = []
+    for idx in idxs:
+        for group in groups:
+            if np.linalg.norm(payload[group[0], :2] - payload[idx, :2]) < near:
+                group.append(idx)
+                break
+        else:
+            groups.append([idx])
+    for group in groups:
+        text = ', '.join(f'{t[k]:.0f}' for k in group)
+        ax.annotate(f't = {text} s', payload[group[0], :2], textcoords='offset points',
+                    xytext=(4, -10), fontsize='x-small', color='0.3')
+
+
+def fig_top_view(ctx: Context) -> Figure:
+    """x-y paths seen from above, formation snapshots (UAVs and cables) and gust regions."""
+    run = ctx.run
+    r, rp = run.uav_positions(), interp_rows(run.t, run.payload_time, run.payload_position())
+    fig, ax = plt.subplots(figsize=(8, 7), layout='constrained')
+    _gust_regions(ax, ctx.scenario)
+    if run.has(REFERENCE_TOPIC):
+        ax.plot(*run.reference_position()[:, :2].T, color='0.5', ls='--', lw=1.0,
+                label='leader reference')
+    for i in range(1, run.n_uavs + 1):
+        ax.plot(*r[i - 1, :, :2].T, color=uav_color(i), lw=1.4, label=uav_label(i))
+    ax.plot(*rp[:, :2].T, color=PAYLOAD_COLOR, lw=1.4, label='payload')
+    for k, idx in enumerate(np.linspace(0, len(run.t) - 1, 5).astype(int)):
+        for i in range(run.n_uavs):
+            ax.plot(*np.stack([r[i, idx, :2], rp[idx, :2]]).T, color='0.55', lw=0.8,
+                    label='cables (projected), snapshots' if k == i == 0 else None)
+        if run.n_uavs > 1:
+            ring = np.vstack([r[:, idx, :2], r[:1, idx, :2]])
+            ax.plot(*ring.T, color='0.55', lw=0.8, ls=':')
+        ax.scatter(*r[:, idx, :2].T, color=[uav_color(i) for i in range(1, run.n_uavs + 1)],
+                   s=18, zorder=3)
+        ax.scatter(*rp[idx, :2], color=PAYLOAD_COLOR, marker='s', s=14, zorder=3)
+    _snapshot_times(ax, run.t, rp, np.linspace(0, len(run.t) - 1, 5).astype(int))
+    ax.set_aspect('equal', adjustable='datalim')
+    ax.set_xlabel('x [m]')
+    ax.set_ylabel('y [m]')
+    ax.set_title(f'{run.label}: top view ({WORLD}, seen from above)')
+    ax.grid(True, alpha=0.35)
+    legend(ax, loc='best')
+    return fig
+
+
+def fig_cable_constraints(ctx: Context) -> Figure:
+    """Cable constraint residuals g_i [m^2] and their rates g_i_dot [m^2/s] (seed Fig. 4.2/4.4)."""
+    run = ctx.run
+    t, g, g_dot = run.formation_time, run.g(), run.g_dot()
+    fig, (ax_g, ax_d) = plt.subplots(2, 1, sharex=True, figsize=(9, 6), layout='constrained')
+    for k in range(g.shape[1]):
+        i = k + 1
+        ax_g.plot(t, g[:, k], color=uav_color(i), lw=uav_width(i, 1.0),
+                  label=f'$g_{i}$ (cable {i})')
+        ax_d.plot(t, g_dot[:, k], color=uav_color(i), lw=uav_width(i, 1.0),
+                  label=f'$\\dot g_{i}$')
+    tolerance = ''
+    if ctx.scenario is not None:
+        sim = ctx.scenario.simulation
+        tolerance = (f' (tolerance {sim.constraint_tolerance:g} m², '
+                     f'{sim.constraint_rate_tolerance:g} m²/s)')
+    ax_g.set_ylabel('$g_i = |r_p - r_i|^2 - l_i^2$ [m²]')
+    ax_d.set_ylabel('$\\dot g_i$ [m²/s]')
+    ax_g.set_title(f'{run.label}: cable constraints; max |g| = {np.abs(g).max():.2g} m², '
+                   f'max |ġ| = {np.abs(g_dot).max():.2g} m²/s{tolerance}', fontsize='medium')
+    for ax in (ax_g, ax_d):
+        ax.ticklabel_format(axis='y', style='sci', scilimits=(-2, 3))
+        legend(ax, loc='upper right', ncols=min(g.shape[1], 5))
+    finish_time_axes([ax_g, ax_d])
+    return fig
+
+
+def fig_formation_errors(ctx: Context) -> Figure:
+    """Each follower's virtual-constraint rows g_vc (seed Fig. 4.7 / 4.11), world frame."""
+    run = ctx.run
+    followers = run.followers
+    fig, axes = plt.subplots(len(followers), 1, sharex=True, squeeze=False,
+                             figsize=(9, 2.2 + 2.3 * len(followers)), layout='constrained')
+    for ax, i in zip(axes[:, 0], followers):
+        e = run.formation_errors(i)
+        labels, unit = formation_row_labels(ctx.scenario, i, e.shape[1])
+        for k in range(e.shape[1]):
+            ax.plot(run.formation_error_time(i), e[:, k], lw=1.1, label=labels[k])
+        norm = np.linalg.norm(e, axis=1)
+        ax.axhline(0.0, color='0.3', lw=0.6)
+        ax.set_ylabel(f'UAV {i}: $g_{{vc}}$ [{unit}]')
+        ax.set_title(f'follower UAV {i}: norm of its rows |g_vc|: mean {norm.mean():.3f}, '
+                     f'max {norm.max():.3f} ({unit})', fontsize='medium')
+        legend(ax, loc='best')
+    fig.suptitle(f'{run.label}: virtual-constraint errors ({WORLD}); x, y, z rows: actual '
+                 'minus desired leader-follower offset', fontsize='medium')
+    finish_time_axes(axes[:, 0])
+    return fig
+
+
+def fig_attitude(ctx: Context) -> Figure:
+    """Roll and pitch of each UAV [deg] (odometry, solid) and their set-points (dotted)."""
+    run = ctx.run
+    euler = np.degrees(run.uav_euler())
+    fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9, 6), layout='constrained')
+    for k, (ax, name) in enumerate(zip(axes, ('roll φ', 'pitch θ'))):
+        for i in range(1, run.n_uavs + 1):
+            ax.plot(run.t, euler[i - 1, :, k], color=uav_color(i), lw=uav_width(i),
+                    label=uav_label(i))
+            if run.has(f'/uav{i}/attitude_setpoint'):
+                ax.plot(run.setpoint_time(i), np.degrees(run.attitude_setpoint(i)[:, k]),
+                        color=uav_color(i), lw=0.8, ls=':', alpha=0.9)
+        ax.plot([], [], color='0.3', lw=0.8, ls=':', label='set-points (dotted)')
+        ax.set_ylabel(f'{name} [deg]')
+        legend(ax, loc='best', ncols=min(run.n_uavs + 1, 4))
+    axes[0].set_title(f'{run.label}: attitude (ZYX Euler angles of body FLU in {WORLD}); '
+                      'solid measured, dotted set-point', fontsize='medium')
+    finish_time_axes(axes)
+    return fig
+
+
+def fig_thrust(ctx: Context) -> Figure:
+    """Collective thrust per UAV [N]: set-point and, with k_T known, k_T sum(omega^2)."""
+    run = ctx.run
+    fig, ax = plt.subplots(figsize=(9, 4.8), layout='constrained')
+    max_thrust = []
+    for i in range(1, run.n_uavs + 1):
+        if run.has(f'/uav{i}/attitude_setpoint'):
+            ax.plot(run.setpoint_time(i), run.thrust(i), color=uav_color(i), lw=uav_width(i),
+                    label=f'{uav_label(i)} set-point')
+        vehicle = vehicle_of(ctx, i)
+        if vehicle is not None and run.has(f'/uav{i}/rotor_cmd'):
+            omega = run.rotor_speeds(i)
+            ax.plot(run.rotor_time(i), vehicle.thrust_coefficient * (omega ** 2).sum(axis=1),
+                    color=uav_color(i), lw=0.8, ls='--', alpha=0.8,
+                    label=f'{uav_label(i)} delivered $k_T \\sum\\omega^2$')
+            max_thrust.append(vehicle.thrust_coefficient * omega.shape[1]
+                              * vehicle.rotor_speed_max ** 2)
+    if max_thrust and np.allclose(max_thrust, max_thrust[0]):
+        ax.axhline(max_thrust[0], color='tab:red', lw=1.0, ls='-.',
+                   label=f'max thrust {max_thrust[0]:.2f} N (all rotors at ω_max)')
+    ax.set_ylabel('thrust along body z [N]')
+    ax.set_title(f'{run.label}: collective thrust per UAV', fontsize='medium')
+    legend(ax, loc='best', ncols=2)
+    finish_time_axes([ax])
+    return fig
+
+
+def _rotor_panel(ax: Axes, run: Run, i: int, limits: tuple[float, float] | None,
+                 limit_note: str) -> None:
+    t, omega, sat = run.rotor_time(i), run.rotor_speeds(i), run.saturated(i)
+    for k in range(omega.shape[1]):
+        ax.plot(t, omega[:, k], lw=0.9, color=f'C{k}', label=f'rotor {k + 1}')
+    lo, hi = value_span(omega)
+    if limits is not None:
+        w_min, w_max = limits
+        lo, hi = min(lo, w_max), max(hi, w_max)
+        margin = 0.08 * max(hi - lo, 1.0)
+        ax.axhspan(w_max, hi + margin, color=SATURATION_GREY, zorder=0,
+                   label=f'saturation ω ≥ ω_max = {w_max:g} rad/s{limit_note}')
+        if w_min > 0 and lo - margin < w_min:
+            ax.axhspan(lo - margin, w_min, color=SATURATION_GREY, zorder=0,
+                       label=f'saturation ω ≤ ω_min = {w_min:g} rad/s')
+        ax.set_ylim(lo - margin, hi + margin)
+    shade_flags(ax, t, sat.any(axis=1), 'a rotor clipped (saturated flag)')
+    ax.set_ylabel(f'UAV {i}: ω [rad/s]')
+    ax.set_title(f'{uav_label(i)}: saturated {np.mean(sat.any(axis=1)) * 100:.1f} % of the '
+                 f'time, mean ω = {omega.mean():.0f} rad/s', fontsize='small')
+    legend(ax, loc='lower left', ncols=3)
+
+
+def fig_rotor_speeds(ctx: Context) -> Figure:
+    """Rotor speeds per UAV [rad/s] after saturation, the saturation band shaded grey."""
+    run = ctx.run
+    uavs = [i for i in range(1, run.n_uavs + 1) if run.has(f'/uav{i}/rotor_cmd')]
+    fig, axes = plt.subplots(len(uavs), 1, sharex=True, squeeze=False,
+                             figsize=(9, 1.5 + 2.6 * len(uavs)), layout='constrained')
+    for ax, i in zip(axes[:, 0], uavs):
+        note = '' if ctx.scenario is not None else ' (inferred from the flags)'
+        _rotor_panel(ax, run, i, rotor_limits(run, ctx.scenario, i), note)
+    fig.suptitle(f'{run.label}: rotor speeds (commands after saturation)', fontsize='medium')
+    finish_time_axes(axes[:, 0])
+    return fig
+
+
+def fig_payload_position(ctx: Context) -> Figure:
+    """Payload x, y, z [m] over time (seed Fig. 4.15) and the gust speed met [m/s]."""
+    run = ctx.run
+    gust = run.has(PAYLOAD_GUST)
+    rows = 4 if gust else 3
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(9, 1.6 + 1.9 * rows),
+                             layout='constrained')
+    p = run.payload_position()
+    for k, ax in enumerate(axes[:3]):
+        ax.plot(run.payload_time, p[:, k], color=PAYLOAD_COLOR, lw=1.2)
+        ax.set_ylabel(f'${AXES_XYZ[k]}_p$ [m]')
+    if gust:
+        speed = run.gust_speed()
+        axes[3].plot(run.gust_time, speed, color='tab:cyan', lw=1.2)
+        axes[3].set_ylim(0.0, max(1.0, 1.1 * float(speed.max())))
+        axes[3].set_ylabel('gust |w| [m/s]')
+        axes[3].set_title('gust speed at the payload' + ('' if speed.any() else
+                                                         ': no gust met in this run'),
+                          fontsize='small')
+    axes[0].set_title(f'{run.label}: payload position ({WORLD})', fontsize='medium')
+    finish_time_axes(axes)
+    return fig
+
+
+def fig_tensions(ctx: Context) -> Figure:
+    """Cable tensions T_i [N]; negative values (compression of the rigid rod) shaded."""
+    run = ctx.run
+    t, tension = run.formation_time, run.tensions()
+    fig, ax = plt.subplots(figsize=(9, 4.8), layout='constrained')
+    for k in range(tension.shape[1]):
+        ax.plot(t, tension[:, k], color=uav_color(k + 1), lw=uav_width(k + 1, 1.0),
+                label=f'$T_{k + 1}$ (UAV {k + 1} - payload)')
+    ax.axhline(0.0, color='0.3', lw=0.7)
+    lo = tension.min()
+    if lo < 0:
+        ax.axhspan(min(lo * 1.1, -0.05), 0.0, color='tab:red', alpha=0.08,
+                   label='T < 0: compression (rigid-rod model; a real cable goes slack)')
+    ax.set_ylabel('cable tension [N]')
+    ax.set_title(f'{run.label}: cable tensions, {lo:.2f} .. {tension.max():.2f} N',
+                 fontsize='medium')
+    legend(ax, loc='best')
+    finish_time_axes([ax])
+    return fig
+
+
+def fig_leader_tracking(ctx: Context) -> Figure:
+    """Leader position minus its mission reference, per world axis and its norm [m]."""
+    run = ctx.run
+    ref = interp_rows(run.t, run.reference_time, run.reference_position())
+    err = run.uav_positions()[0] - ref
+    fig, ax = plt.subplots(figsize=(9, 4.5), layout='constrained')
+    for k in range(3):
+        ax.plot(run.t, err[:, k], lw=1.0, label=f'{AXES_XYZ[k]}')
+    norm = np.linalg.norm(err, axis=1)
+    ax.plot(run.t, norm, color='black', lw=1.2, label='|r_1 - r_ref|')
+    ax.set_ylabel('leader tracking error $r_1 - r_{ref}$ [m]')
+    ax.set_title(f'{run.label}: leader tracking ({WORLD}); max {norm.max():.3f} m, '
+                 f'rms {np.sqrt(np.mean(norm ** 2)):.3f} m', fontsize='medium')
+    legend(ax, loc='best', ncols=4)
+    finish_time_axes([ax])
+    return fig
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """A figure of `plot`: file stem, function, and `lacks(run)`: what the bag lacks for it
+    (empty: it can be drawn)."""
+
+    name: str
+    make: Callable[[Context], Figure]
+    lacks: Callable[[Run], list[str]]
+
+
+def _topics(*topics: str) -> Callable[[Run], list[str]]:
+    """A `lacks` function: the topics of `topics` the bag has no messages on."""
+    return lambda run: [topic for topic in topics if not run.has(topic)]
+
+
+def _lacks_followers(run: Run) -> list[str]:
+    return [] if run.followers else ['follower (no /uav{i}/formation_error topic)']
+
+
+FIGURES: tuple[FigureSpec, ...] = (
+    FigureSpec('trajectories_3d', fig_trajectories_3d, _topics(PAYLOAD_ODOM)),
+    FigureSpec('top_view', fig_top_view, _topics(PAYLOAD_ODOM)),
+    FigureSpec('cable_constraints', fig_cable_constraints, _topics(FORMATION_TOPIC)),
+    FigureSpec('cable_tensions', fig_tensions, _topics(FORMATION_TOPIC)),
+    FigureSpec('formation_errors', fig_formation_errors, _lacks_followers),
+    FigureSpec('attitude', fig_attitude, _topics()),
+    FigureSpec('thrust', fig_thrust, _topics('/uav1/attitude_setpoint')),
+    FigureSpec('rotor_speeds', fig_rotor_speeds, _topics('/uav1/rotor_cmd')),
+    FigureSpec('payload_position', fig_payload_position, _topics(PAYLOAD_ODOM)),
+    FigureSpec('leader_tracking', fig_leader_tracking, _topics(REFERENCE_TOPIC)),
+)
+
+
+def make_plots(ctx: Context, out: Path) -> tuple[list[Path], list[str]]:
+    """Every figure of FIGURES the bag has data for, as `out/<name>.png`; (written, skipped)."""
+    out.mkdir(parents=True, exist_ok=True)
+    written, skipped = [], []
+    for spec in FIGURES:
+        missing = spec.lacks(ctx.run)
+        if missing:
+            skipped.append(f'{spec.name}: bag has no {", ".join(missing)}')
+            continue
+        try:
+            fig = spec.make(ctx)
+        except RunDataError as exc:  # a topic a figure needs only in part
+            plt.close('all')
+            skipped.append(f'{spec.name}: {exc}')
+            continue
+        written.append(save_figure(fig, out / f'{spec.name}.png'))
+    return written, skipped
+
+
+def plot_main(argv: list[str]) -> int:
+    """`multilift plot BAG [--out DIR] [--scenario S]`: PNG figures of one run; prints each file
+    written. Returns the exit code (0 done, 2 bad input)."""
+    parser = Parser(prog='multilift plot', description='PNG figures of a recorded run')
+    parser.add_argument('bag', help='a bag directory written by `multilift run --bag`')
+    parser.add_argument('--out', help='output directory (default: BAG/plots)')
+    parser.add_argument('--scenario', help='scenario name or YAML for the vehicle parameters '
+                        "(default: the one in the bag's summary.json)")
+    started = time.perf_counter()
+    loaded = parse_and_load(parser, argv)
+    if isinstance(loaded, int):
+        return loaded
+    args, run = loaded
+    out = Path(args.out) if args.out else run.path / 'plots'
+    written, skipped = make_plots(plot_context(run, args.scenario), out)
+    for path in written:
+        print(path)
+    for note in skipped:
+        print(f'skipped {note}', file=sys.stderr)
+    print(f'{len(written)} figures in {time.perf_counter() - started:.1f} s', file=sys.stderr)
+    return 0

@@ -9,7 +9,6 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 import rclpy
@@ -21,7 +20,7 @@ from std_msgs.msg import Byte, ByteMultiArray, Int64
 
 from multilift_sim.ros.introspection import message_to_ordered, message_to_yaml
 
-ROOT = Path(__file__).resolve().parents[1]
+from conftest import ROOT
 DOMAIN = 75 + os.getpid() % 25
 ENV = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
 LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,

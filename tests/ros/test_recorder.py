@@ -30,7 +30,7 @@ from std_msgs.msg import Int64, String
 from multilift_sim.bag import recover
 from multilift_sim.recording import LogTime, is_recordable, parse_topic_spec
 
-ROOT = Path(__file__).resolve().parents[1]
+from conftest import ROOT
 DOMAIN = 50 + os.getpid() % 25
 LATCHED = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)

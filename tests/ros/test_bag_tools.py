@@ -35,7 +35,7 @@ from multilift_sim.bagyaml import OfferedQos, qos_yaml
 from multilift_tools.topic_tools import RateWindow, format_hz
 from multilift_sim.ros.common import run_topics
 
-ROOT = Path(__file__).resolve().parents[1]
+from conftest import ROOT
 MULTILIFT = ROOT / 'scripts' / 'multilift'
 DOMAIN = 2 + os.getpid() % 8
 ENV = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',

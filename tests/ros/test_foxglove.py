@@ -18,7 +18,6 @@ import subprocess
 import sys
 import threading
 import time
-from pathlib import Path
 
 import pytest
 import rclpy
@@ -31,7 +30,7 @@ from websockets.sync.client import connect
 from multilift_sim import msgdefs
 from multilift_tools.foxglove_bridge import SUBPROTOCOL, is_bridged, stamp_ns
 
-ROOT = Path(__file__).resolve().parents[1]
+from conftest import ROOT
 DOMAIN = 10 + os.getpid() % 8
 ENV = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
            PYTHONUNBUFFERED='1')

@@ -2,8 +2,9 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from multilift_sim.kinematics import (euler_rate_matrix, euler_rate_matrix_dot,
-                                      euler_rate_matrix_inverse, rotation_matrix)
+from multilift_sim.kinematics import (euler_from_quaternion, euler_rate_matrix,
+                                      euler_rate_matrix_dot, euler_rate_matrix_inverse,
+                                      quaternion_from_euler, rotation_matrix)
 
 RNG = np.random.default_rng(7)
 ETA = RNG.uniform([-1.5, -1.4, -3.1], [1.5, 1.4, 3.1], size=(12, 3))
@@ -43,3 +44,22 @@ def test_w_inverse_and_w_dot():
     numeric = (euler_rate_matrix(ETA + h * ETA_DOT)
                - euler_rate_matrix(ETA - h * ETA_DOT)) / (2 * h)
     assert np.allclose(euler_rate_matrix_dot(ETA, ETA_DOT), numeric, atol=1e-8)
+
+
+def test_quaternion_from_euler_is_scipys_zyx_quaternion():
+    q = quaternion_from_euler(ETA)
+    expected = Rotation.from_euler('ZYX', ETA[:, ::-1]).as_quat()  # (x, y, z, w)
+    assert q.shape == (12, 4)
+    signs = np.sign(np.sum(q * expected, axis=1))[:, None]  # q and -q are one rotation
+    assert np.allclose(q, signs * expected, atol=1e-14)
+    assert np.allclose(quaternion_from_euler(ETA[3]), q[3], atol=0)  # one attitude, shape (3,)
+
+
+def test_euler_from_quaternion_inverts_quaternion_from_euler():
+    angles = RNG.uniform([-3.0, -1.5, -3.0], [3.0, 1.5, 3.0], size=(200, 3))
+    np.testing.assert_allclose(euler_from_quaternion(quaternion_from_euler(angles)), angles,
+                               atol=1e-9)
+    # a stack of any shape, scipy's quaternions as input
+    stack = Rotation.from_euler('ZYX', angles[:6, ::-1]).as_quat().reshape(2, 3, 4)
+    np.testing.assert_allclose(euler_from_quaternion(stack), angles[:6].reshape(2, 3, 3),
+                               atol=1e-9)

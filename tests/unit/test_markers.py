@@ -3,7 +3,6 @@ snapshot, the leader's mission path and the scenario's gusts; its cost."""
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import pytest
@@ -132,18 +131,15 @@ def test_gust_zones_are_cylinders_of_radius_h(twin):
         assert bottom < snapshot.payload_position[2] < top  # the payload's heights
 
 
-def test_round_trip_and_cost(twin):
+def test_round_trip_and_five_uavs(twin):
     scenario, snapshot = twin
     array = formation_markers(snapshot, [4.0, 5.0], scenario, 0)
     copy = deserialize_message(serialize_message(array), MarkerArray)
     assert [(m.ns, m.id, m.type) for m in copy.markers] == [
         (m.ns, m.id, m.type) for m in array.markers]
+    # five UAVs: a body, a heading and a cable each (the cost per call is a benchmark's business)
     v5 = scenario_io.load('v5')
-    snap = FormationSimulator(v5).snapshot()
-    start = time.perf_counter()
-    for k in range(200):
-        formation_markers(snap, [5.0] * 5, v5, k)
-    per_call = (time.perf_counter() - start) / 200
-    assert per_call < 1e-3, f'{per_call * 1e3:.2f} ms per call'  # measured: 0.04 ms
+    five = formation_markers(FormationSimulator(v5).snapshot(), [5.0] * 5, v5, 0)
+    assert len(five.markers) == len(array.markers) + 3 * 3
     with pytest.raises(ValueError, match='2 UAVs'):
         formation_markers(snapshot, [4.0], scenario, 0)

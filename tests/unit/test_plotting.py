@@ -26,7 +26,7 @@ from std_msgs.msg import String
 
 from multilift_tools import bagdata
 from multilift_sim.bag import BagWriter
-from multilift_tools.bagdata import RunDataError, euler_from_quaternions, load_run
+from multilift_tools.bagdata import RunDataError, load_run
 from multilift_tools.animation import animate_main
 from multilift_tools.compare import compare_main
 from multilift_tools.figures import plot_main
@@ -234,13 +234,6 @@ def test_load_run_returns_what_was_written(bags):
     np.testing.assert_allclose(run.reference_position(), truth.reference, atol=1e-12)
     assert run.duration == pytest.approx(truth.t[-1])
     assert not run.has('/chatter')
-
-
-def test_euler_from_quaternions_inverts_the_zyx_quaternion():
-    rng = np.random.default_rng(7)
-    angles = rng.uniform([-3.0, -1.5, -3.0], [3.0, 1.5, 3.0], size=(200, 3))
-    q = np.array([_quaternion(*a) for a in angles])
-    np.testing.assert_allclose(euler_from_quaternions(q), angles, atol=1e-9)
 
 
 def test_missing_topic_is_a_clear_error(bags):

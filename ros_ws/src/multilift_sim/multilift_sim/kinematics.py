@@ -93,3 +93,35 @@ def euler_rate_matrix_dot(eta: ArrayLike, eta_dot: ArrayLike) -> np.ndarray:
     w_dot[..., 2, 1] = -c_phi * phi_dot
     w_dot[..., 2, 2] = -s_phi * c_theta * phi_dot - c_phi * s_theta * theta_dot
     return w_dot
+
+
+def quaternion_from_euler(eta: ArrayLike) -> np.ndarray:
+    """Unit quaternion (x, y, z, w) of ``R = Rz(psi) Ry(theta) Rx(phi)`` (body -> world).
+
+    eta: Euler angles (roll, pitch, yaw) [rad], shape (..., 3). Returns shape (..., 4), scalar
+    part last as geometry_msgs/Quaternion orders it.
+    """
+    half = 0.5 * _angles(eta)
+    s, c = np.sin(half), np.cos(half)
+    sr, sp, sy = s[..., 0], s[..., 1], s[..., 2]
+    cr, cp, cy = c[..., 0], c[..., 1], c[..., 2]
+    q = np.empty(half.shape[:-1] + (4,))
+    q[..., 0] = sr * cp * cy - cr * sp * sy
+    q[..., 1] = cr * sp * cy + sr * cp * sy
+    q[..., 2] = cr * cp * sy - sr * sp * cy
+    q[..., 3] = cr * cp * cy + sr * sp * sy
+    return q
+
+
+def euler_from_quaternion(q: ArrayLike) -> np.ndarray:
+    """ZYX Euler angles (roll, pitch, yaw) [rad], shape (..., 3), of unit quaternions
+    (x, y, z, w), shape (..., 4): the inverse of `quaternion_from_euler` for |pitch| < pi/2."""
+    quat = np.asarray(q, dtype=float)
+    if quat.shape[-1:] != (4,):
+        raise ValueError(f'quaternions must have shape (..., 4), got shape {quat.shape}')
+    x, y, z, w = quat[..., 0], quat[..., 1], quat[..., 2], quat[..., 3]
+    eta = np.empty(quat.shape[:-1] + (3,))
+    eta[..., 0] = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    eta[..., 1] = np.arcsin(np.clip(2 * (w * y - z * x), -1.0, 1.0))
+    eta[..., 2] = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return eta

@@ -36,11 +36,11 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from multilift_sim.ros.common import WORLD_FRAME, quaternion_from_euler, stamp_from_ns
+from multilift_sim.kinematics import quaternion_from_euler
+from multilift_sim.ros.common import WORLD_FRAME, stamp_from_ns
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import Snapshot
 
-TOPIC = '/visualization/markers'
 PAYLOAD_DIAMETER = 0.3  # [m] drawn size of the payload (the model's payload is a point mass)
 BODY_DIAMETER_ARMS = 2.6  # UAV disc diameter in arm lengths
 BODY_HEIGHT = 0.06  # [m] UAV disc thickness
@@ -184,7 +184,7 @@ class FormationMarkers:
             position = body.pose.position
             position.x, position.y, position.z = (float(c) for c in uav.position)
             o = body.pose.orientation
-            o.x, o.y, o.z, o.w = quaternion_from_euler(*(float(a) for a in uav.euler))
+            o.x, o.y, o.z, o.w = (float(c) for c in quaternion_from_euler(uav.euler))
             r, g, b = tension_color(float(tension), self.reference_tension)
             c = cable.color
             c.r, c.g, c.b = r, g, b

@@ -33,7 +33,7 @@ from multilift_tools.bag_tools import (CLOCK_TOPIC, PlayEvent, format_file_size,
                                      playback_qos_policies, read_summary, wall_offset)
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
 from multilift_tools.topic_tools import RateWindow, format_hz
-from multilift_sim.ros.common import run_topics
+from multilift_sim.topics import run_topics
 
 from conftest import ROOT
 MULTILIFT = ROOT / 'scripts' / 'multilift'

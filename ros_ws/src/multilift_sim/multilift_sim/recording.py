@@ -21,9 +21,10 @@ import time
 from typing import Callable
 
 from multilift_sim.msgdefs import MessageDefinitionError, split_type_name
+from multilift_sim.topics import CLOCK
 
 EXCLUDED_TOPICS = frozenset({'/rosout', '/parameter_events'})
-CLOCK_TOPIC = '/clock'
+CLOCK_TOPIC = CLOCK  # what the recorder's time source follows
 TIME_SOURCES = ('auto', 'sim', 'wall')
 
 

@@ -17,7 +17,8 @@ from matplotlib import animation, cm, colors
 from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-from multilift_tools.bagdata import FORMATION_TOPIC, Run
+from multilift_sim.topics import FORMATION_STATE
+from multilift_tools.bagdata import Run
 from multilift_tools.metrics import interp_rows
 from multilift_tools.plot_style import (PAYLOAD_COLOR, WORLD, Parser, equal_3d, parse_and_load,
                                         plt, uav_color, uav_label)
@@ -40,7 +41,7 @@ def animation_data(run: Run, fps: float, speed: float) -> AnimationData:
     t = run.t
     uavs = run.uav_positions()
     payload = interp_rows(t, run.payload_time, run.payload_position())
-    tensions = (interp_rows(t, run.formation_time, run.tensions()) if run.has(FORMATION_TOPIC)
+    tensions = (interp_rows(t, run.formation_time, run.tensions()) if run.has(FORMATION_STATE)
                 else np.zeros((len(t), run.n_uavs)))
     times = np.arange(t[0], t[-1] + 1e-9, speed / fps)
     frames = np.unique(np.clip(np.searchsorted(t, times), 0, len(t) - 1))

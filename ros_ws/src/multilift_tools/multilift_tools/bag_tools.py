@@ -59,8 +59,8 @@ from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 
 from multilift_sim.bag import TORN_RECORD_ERRORS, BagError, recover
+from multilift_sim.topics import CLOCK as CLOCK_TOPIC
 
-CLOCK_TOPIC = '/clock'
 PLAY_DEPTH = 100  # keep_last depth of the player's publishers (our nodes' PUBLISHER_QOS depth)
 ACK_WAIT = 3.0  # [s] longest wait for reliable subscribers to acknowledge the last messages
 WAIT_FOR_SUBSCRIBERS_MAX = 30.0  # [s] longest --wait-for-subscribers wait

@@ -12,29 +12,22 @@ a name/path given) for what the bag does not carry: rotor limits, k_T, gusts, fo
 from __future__ import annotations
 
 import json
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
+from multilift_sim.kinematics import euler_from_quaternion
+from multilift_sim.topics import (ATTITUDE_SETPOINT, ATTITUDE_SETPOINT_TYPE, FORMATION_ERROR,
+                                  FORMATION_ERROR_TYPE, FORMATION_STATE, FORMATION_STATE_TYPE,
+                                  ODOM, ODOMETRY_TYPE, PAYLOAD_GUST, PAYLOAD_ODOM,
+                                  REFERENCE_TOPIC, ROTOR_CMD, ROTOR_COMMAND_TYPE,
+                                  TRACKING_REFERENCE_TYPE, VECTOR3_STAMPED_TYPE, topic_type,
+                                  uav_topic)
+
 if TYPE_CHECKING:
     from multilift_sim.scenario import Scenario
-
-ODOMETRY = 'nav_msgs/msg/Odometry'
-FORMATION_STATE = 'multilift_msgs/msg/FormationState'
-ROTOR_COMMAND = 'multilift_msgs/msg/RotorCommand'
-ATTITUDE_SETPOINT = 'multilift_msgs/msg/AttitudeSetpoint'
-TRACKING_REFERENCE = 'multilift_msgs/msg/TrackingReference'
-FORMATION_ERROR = 'multilift_msgs/msg/VirtualConstraintError'
-VECTOR3_STAMPED = 'geometry_msgs/msg/Vector3Stamped'
-
-PAYLOAD_ODOM = '/payload/odom'
-PAYLOAD_GUST = '/payload/gust'
-FORMATION_TOPIC = '/formation/state'
-REFERENCE_TOPIC = '/uav1/reference'
-_UAV_TOPIC = re.compile(r'^/uav([1-9][0-9]*)/(odom|rotor_cmd|attitude_setpoint|formation_error)$')
 
 
 class RunDataError(ValueError):
@@ -81,22 +74,17 @@ def _vector3_stamped(msg: Any) -> dict[str, Any]:
 
 
 _EXTRACT: dict[str, Callable[[Any], dict[str, Any]]] = {
-    ODOMETRY: _odometry, FORMATION_STATE: _formation_state, ROTOR_COMMAND: _rotor_command,
-    ATTITUDE_SETPOINT: _attitude_setpoint, TRACKING_REFERENCE: _reference,
-    FORMATION_ERROR: _formation_error, VECTOR3_STAMPED: _vector3_stamped,
+    ODOMETRY_TYPE: _odometry, FORMATION_STATE_TYPE: _formation_state,
+    ROTOR_COMMAND_TYPE: _rotor_command, ATTITUDE_SETPOINT_TYPE: _attitude_setpoint,
+    TRACKING_REFERENCE_TYPE: _reference, FORMATION_ERROR_TYPE: _formation_error,
+    VECTOR3_STAMPED_TYPE: _vector3_stamped,
 }
-_EXPECTED_TYPE = {'odom': ODOMETRY, 'rotor_cmd': ROTOR_COMMAND,
-                  'attitude_setpoint': ATTITUDE_SETPOINT, 'formation_error': FORMATION_ERROR}
 
 
 def _wanted_type(topic: str) -> str | None:
     """The message type a multilift topic has, or None for a topic this module ignores."""
-    fixed = {PAYLOAD_ODOM: ODOMETRY, PAYLOAD_GUST: VECTOR3_STAMPED,
-             FORMATION_TOPIC: FORMATION_STATE, REFERENCE_TOPIC: TRACKING_REFERENCE}
-    if topic in fixed:
-        return fixed[topic]
-    match = _UAV_TOPIC.match(topic)
-    return _EXPECTED_TYPE[match.group(2)] if match else None
+    wanted = topic_type(topic)
+    return wanted if wanted in _EXTRACT else None
 
 
 @dataclass(frozen=True)
@@ -130,16 +118,6 @@ def _series(topic: str, stamps: list[float], rows: list[dict[str, Any]]) -> Seri
     return Series(topic, t, fields)
 
 
-def euler_from_quaternions(q: np.ndarray) -> np.ndarray:
-    """ZYX Euler angles (roll, pitch, yaw) [rad], shape (..., 3), of unit quaternions
-    (x, y, z, w), shape (..., 4), with R = Rz(yaw) Ry(pitch) Rx(roll) body -> world."""
-    x, y, z, w = np.moveaxis(np.asarray(q, dtype=float), -1, 0)
-    roll = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = np.arcsin(np.clip(2 * (w * y - z * x), -1.0, 1.0))
-    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return np.stack([roll, pitch, yaw], axis=-1)
-
-
 @dataclass(frozen=True)
 class Run:
     """One recorded run. Times [s] are simulated (header stamps); positions world [m], z up.
@@ -168,14 +146,14 @@ class Run:
     def n_uavs(self) -> int:
         """Number of UAVs: /uav1/odom, /uav2/odom, ... without a gap."""
         n = 0
-        while self.has(f'/uav{n + 1}/odom'):
+        while self.has(uav_topic(n + 1, ODOM)):
             n += 1
         return n
 
     @property
     def followers(self) -> list[int]:
         """Indices i >= 2 of the UAVs with a /uav{i}/formation_error topic."""
-        return [i for i in range(2, self.n_uavs + 1) if self.has(f'/uav{i}/formation_error')]
+        return [i for i in range(2, self.n_uavs + 1) if self.has(uav_topic(i, FORMATION_ERROR))]
 
     @property
     def scenario_name(self) -> str | None:
@@ -192,13 +170,13 @@ class Run:
     @property
     def t(self) -> np.ndarray:
         """(T,) stamps [s] of /uav1/odom; the time base of `uav_positions` and `uav_euler`."""
-        return self.topic('/uav1/odom').t
+        return self.topic(uav_topic(1, ODOM)).t
 
     def _uav_field(self, name: str) -> np.ndarray:
         base = self.t
         out = []
         for i in range(1, self.n_uavs + 1):
-            s = self.topic(f'/uav{i}/odom')
+            s = self.topic(uav_topic(i, ODOM))
             values = s[name]
             if len(s.t) != len(base) or not np.array_equal(s.t, base):
                 values = np.stack([np.interp(base, s.t, values[:, k])
@@ -212,7 +190,7 @@ class Run:
 
     def uav_euler(self) -> np.ndarray:
         """(n, T, 3) ZYX Euler angles (roll, pitch, yaw) [rad] from the odometry quaternions."""
-        return euler_from_quaternions(self._uav_field('orientation'))
+        return euler_from_quaternion(self._uav_field('orientation'))
 
     def uav_body_velocities(self) -> np.ndarray:
         """(n, T, 3) UAV linear velocities in each UAV's body frame (FLU) [m/s]."""
@@ -236,44 +214,44 @@ class Run:
     @property
     def formation_time(self) -> np.ndarray:
         """(T,) stamps [s] of /formation/state."""
-        return self.topic(FORMATION_TOPIC).t
+        return self.topic(FORMATION_STATE).t
 
     def tensions(self) -> np.ndarray:
         """(T, n) cable tensions [N]; positive = taut, negative = compression of the rod."""
-        return self.topic(FORMATION_TOPIC)['tension']
+        return self.topic(FORMATION_STATE)['tension']
 
     def g(self) -> np.ndarray:
         """(T, n) cable constraints g_i = |r_p - r_i|^2 - l_i^2 [m^2]."""
-        return self.topic(FORMATION_TOPIC)['g']
+        return self.topic(FORMATION_STATE)['g']
 
     def g_dot(self) -> np.ndarray:
         """(T, n) their rates g_i_dot [m^2/s]."""
-        return self.topic(FORMATION_TOPIC)['g_dot']
+        return self.topic(FORMATION_STATE)['g_dot']
 
     # -- rotors and set-points (per UAV i = 1..n) ------------------------------------------
     def rotor_time(self, i: int) -> np.ndarray:
         """(T,) stamps [s] of /uav{i}/rotor_cmd (the state time each command answers)."""
-        return self.topic(f'/uav{i}/rotor_cmd').t
+        return self.topic(uav_topic(i, ROTOR_CMD)).t
 
     def rotor_speeds(self, i: int) -> np.ndarray:
         """(T, n_r) commanded rotor speeds of UAV i after saturation [rad/s]."""
-        return self.topic(f'/uav{i}/rotor_cmd')['omega'].astype(float)
+        return self.topic(uav_topic(i, ROTOR_CMD))['omega'].astype(float)
 
     def saturated(self, i: int) -> np.ndarray:
         """(T, n_r) bool: where UAV i's request was clipped to [omega_min, omega_max]."""
-        return self.topic(f'/uav{i}/rotor_cmd')['saturated'].astype(bool)
+        return self.topic(uav_topic(i, ROTOR_CMD))['saturated'].astype(bool)
 
     def setpoint_time(self, i: int) -> np.ndarray:
         """(T,) stamps [s] of /uav{i}/attitude_setpoint."""
-        return self.topic(f'/uav{i}/attitude_setpoint').t
+        return self.topic(uav_topic(i, ATTITUDE_SETPOINT)).t
 
     def attitude_setpoint(self, i: int) -> np.ndarray:
         """(T, 3) roll, pitch, yaw [rad] the outer loop of UAV i asks for."""
-        return self.topic(f'/uav{i}/attitude_setpoint')['euler']
+        return self.topic(uav_topic(i, ATTITUDE_SETPOINT))['euler']
 
     def thrust(self, i: int) -> np.ndarray:
         """(T,) collective thrust [N] the outer loop of UAV i asks for (body z)."""
-        return self.topic(f'/uav{i}/attitude_setpoint')['thrust']
+        return self.topic(uav_topic(i, ATTITUDE_SETPOINT))['thrust']
 
     def thrusts(self) -> np.ndarray:
         """(n, T) thrust set-points [N] of every UAV, on UAV 1's set-point stamps."""
@@ -284,15 +262,15 @@ class Run:
     # -- formation control -----------------------------------------------------------------
     def formation_error_time(self, i: int) -> np.ndarray:
         """(T,) stamps [s] of /uav{i}/formation_error."""
-        return self.topic(f'/uav{i}/formation_error').t
+        return self.topic(uav_topic(i, FORMATION_ERROR)).t
 
     def formation_errors(self, i: int) -> np.ndarray:
         """(T, m_i) follower i's virtual-constraint rows g_vc [m; m^2 for distance rows]."""
-        return self.topic(f'/uav{i}/formation_error')['error'].astype(float)
+        return self.topic(uav_topic(i, FORMATION_ERROR))['error'].astype(float)
 
     def formation_error_rates(self, i: int) -> np.ndarray:
         """(T, m_i) their rates [m/s; m^2/s for distance rows]."""
-        return self.topic(f'/uav{i}/formation_error')['error_rate'].astype(float)
+        return self.topic(uav_topic(i, FORMATION_ERROR))['error_rate'].astype(float)
 
     # -- environment and reference ---------------------------------------------------------
     @property
@@ -382,7 +360,7 @@ def load_run(bag_dir: str | Path) -> Run:
         raise RunDataError(f'cannot read bag {path}: {type(exc).__name__}: {exc}') from None
     series = {topic: _series(topic, stamps[topic], rows[topic]) for topic in stamps}
     run = Run(path, series, _summary(path))
-    if not run.has('/uav1/odom'):
+    if not run.has(uav_topic(1, ODOM)):
         raise RunDataError(f'bag {path} has no /uav1/odom messages: not a multilift run')
     return run
 

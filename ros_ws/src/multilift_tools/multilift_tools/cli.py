@@ -22,7 +22,7 @@ from pathlib import Path
 
 from multilift_sim import scenario as scenario_io
 from multilift_tools.launcher import Child, Supervisor, find_executable
-from multilift_sim.ros.common import run_topics
+from multilift_sim.topics import run_topics
 
 
 def _ros_args(params: dict) -> list[str]:
@@ -204,8 +204,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def _run_headless(scenario, bag: Path | None) -> int:
     """The same scenario, physics and control laws in this process, no ROS graph."""
+    # no rclpy and no message types here unless a bag is written (tests/unit/test_architecture.py)
     from multilift_control.headless import run_headless
-    from multilift_tools.headless_bag import record_headless
     from multilift_sim.simulation import SimulationStopped
     progress = Progress(None, sys.stdout.isatty())
     start = time.monotonic()
@@ -220,8 +220,11 @@ def _run_headless(scenario, bag: Path | None) -> int:
     if bag is not None:
         _fresh_bag_dir(bag)
     try:
-        run = run_headless(scenario, on_tick) if bag is None else \
-            record_headless(scenario, bag, on_tick)
+        if bag is None:
+            run = run_headless(scenario, on_tick)
+        else:
+            from multilift_tools.headless_bag import record_headless
+            run = record_headless(scenario, bag, on_tick)
     except SimulationStopped as exc:
         progress.close()
         print(f'error: {exc}', file=sys.stderr)

@@ -12,7 +12,8 @@ from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
-from multilift_tools.bagdata import PAYLOAD_ODOM, Run, rotor_limits
+from multilift_sim.topics import PAYLOAD_ODOM, ROTOR_CMD, uav_topic
+from multilift_tools.bagdata import Run, rotor_limits
 from multilift_tools.metrics import comparison_rows, common_end, until
 from multilift_tools.plot_style import (AXES_XYZ, SATURATION_GREY, WORLD, Parser,
                                         finish_time_axes, formation_row_labels, legend,
@@ -141,7 +142,7 @@ def comparison_numbers(runs: Sequence[Run], labels: Sequence[str],
 
 
 def _compare_needs(run: Run) -> list[str]:
-    need = [PAYLOAD_ODOM, '/uav1/rotor_cmd']
+    need = [PAYLOAD_ODOM, uav_topic(1, ROTOR_CMD)]
     return [t for t in need if not run.has(t)]
 
 

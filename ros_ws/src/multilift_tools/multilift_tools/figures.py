@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from multilift_tools.bagdata import (FORMATION_TOPIC, PAYLOAD_GUST, PAYLOAD_ODOM,
-                                     REFERENCE_TOPIC, Run, RunDataError, rotor_limits)
+from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_STATE, PAYLOAD_GUST,
+                                  PAYLOAD_ODOM, REFERENCE_TOPIC, ROTOR_CMD, uav_topic)
+from multilift_tools.bagdata import Run, RunDataError, rotor_limits
 from multilift_tools.metrics import interp_rows
 from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, SATURATION_GREY, WORLD,
                                         Context, Parser, equal_3d, finish_time_axes,
@@ -186,7 +187,7 @@ def fig_attitude(ctx: Context) -> Figure:
         for i in range(1, run.n_uavs + 1):
             ax.plot(run.t, euler[i - 1, :, k], color=uav_color(i), lw=uav_width(i),
                     label=uav_label(i))
-            if run.has(f'/uav{i}/attitude_setpoint'):
+            if run.has(uav_topic(i, ATTITUDE_SETPOINT)):
                 ax.plot(run.setpoint_time(i), np.degrees(run.attitude_setpoint(i)[:, k]),
                         color=uav_color(i), lw=0.8, ls=':', alpha=0.9)
         ax.plot([], [], color='0.3', lw=0.8, ls=':', label='set-points (dotted)')
@@ -204,11 +205,11 @@ def fig_thrust(ctx: Context) -> Figure:
     fig, ax = plt.subplots(figsize=(9, 4.8), layout='constrained')
     max_thrust = []
     for i in range(1, run.n_uavs + 1):
-        if run.has(f'/uav{i}/attitude_setpoint'):
+        if run.has(uav_topic(i, ATTITUDE_SETPOINT)):
             ax.plot(run.setpoint_time(i), run.thrust(i), color=uav_color(i), lw=uav_width(i),
                     label=f'{uav_label(i)} set-point')
         vehicle = vehicle_of(ctx, i)
-        if vehicle is not None and run.has(f'/uav{i}/rotor_cmd'):
+        if vehicle is not None and run.has(uav_topic(i, ROTOR_CMD)):
             omega = run.rotor_speeds(i)
             ax.plot(run.rotor_time(i), vehicle.thrust_coefficient * (omega ** 2).sum(axis=1),
                     color=uav_color(i), lw=0.8, ls='--', alpha=0.8,
@@ -251,7 +252,7 @@ def _rotor_panel(ax: Axes, run: Run, i: int, limits: tuple[float, float] | None,
 def fig_rotor_speeds(ctx: Context) -> Figure:
     """Rotor speeds per UAV [rad/s] after saturation, the saturation band shaded grey."""
     run = ctx.run
-    uavs = [i for i in range(1, run.n_uavs + 1) if run.has(f'/uav{i}/rotor_cmd')]
+    uavs = [i for i in range(1, run.n_uavs + 1) if run.has(uav_topic(i, ROTOR_CMD))]
     fig, axes = plt.subplots(len(uavs), 1, sharex=True, squeeze=False,
                              figsize=(9, 1.5 + 2.6 * len(uavs)), layout='constrained')
     for ax, i in zip(axes[:, 0], uavs):
@@ -347,12 +348,12 @@ def _lacks_followers(run: Run) -> list[str]:
 FIGURES: tuple[FigureSpec, ...] = (
     FigureSpec('trajectories_3d', fig_trajectories_3d, _topics(PAYLOAD_ODOM)),
     FigureSpec('top_view', fig_top_view, _topics(PAYLOAD_ODOM)),
-    FigureSpec('cable_constraints', fig_cable_constraints, _topics(FORMATION_TOPIC)),
-    FigureSpec('cable_tensions', fig_tensions, _topics(FORMATION_TOPIC)),
+    FigureSpec('cable_constraints', fig_cable_constraints, _topics(FORMATION_STATE)),
+    FigureSpec('cable_tensions', fig_tensions, _topics(FORMATION_STATE)),
     FigureSpec('formation_errors', fig_formation_errors, _lacks_followers),
     FigureSpec('attitude', fig_attitude, _topics()),
-    FigureSpec('thrust', fig_thrust, _topics('/uav1/attitude_setpoint')),
-    FigureSpec('rotor_speeds', fig_rotor_speeds, _topics('/uav1/rotor_cmd')),
+    FigureSpec('thrust', fig_thrust, _topics(uav_topic(1, ATTITUDE_SETPOINT))),
+    FigureSpec('rotor_speeds', fig_rotor_speeds, _topics(uav_topic(1, ROTOR_CMD))),
     FigureSpec('payload_position', fig_payload_position, _topics(PAYLOAD_ODOM)),
     FigureSpec('leader_tracking', fig_leader_tracking, _topics(REFERENCE_TOPIC)),
 )

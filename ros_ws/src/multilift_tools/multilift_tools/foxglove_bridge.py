@@ -32,6 +32,8 @@ import threading
 import time
 from typing import Any
 
+from multilift_sim.topics import CLOCK
+
 DEFAULT_PORT = 8765
 DEFAULT_HOST = '127.0.0.1'
 POLL_PERIOD = 0.5  # [s] graph poll for new and vanished topics
@@ -83,7 +85,7 @@ class FoxgloveBridge:
         self.forwarded = 0
         self._last_broadcast = 0.0
         self.node.create_subscription(
-            Clock, '/clock', self._on_clock,
+            Clock, CLOCK, self._on_clock,
             QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT,
                        durability=DurabilityPolicy.VOLATILE))
         self.node.create_timer(POLL_PERIOD, self.poll)
@@ -98,7 +100,7 @@ class FoxgloveBridge:
     def poll(self) -> None:
         """Add channels for new topics, drop those without publishers, pick the time base."""
         graph = dict(self.node.get_topic_names_and_types())
-        sim_time = self.node.count_publishers('/clock') > 0
+        sim_time = self.node.count_publishers(CLOCK) > 0
         if sim_time != self.sim_time:
             self.sim_time = sim_time
             if not sim_time:

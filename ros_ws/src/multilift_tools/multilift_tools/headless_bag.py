@@ -14,7 +14,8 @@ from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
 from multilift_sim.ros import messages
-from multilift_sim.ros.common import MARKER_DECIMATION, run_topics, uav_topic
+from multilift_sim.ros.common import MARKER_DECIMATION
+from multilift_sim.topics import run_topics, uav_topic
 from multilift_sim.ros.markers import formation_markers
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot

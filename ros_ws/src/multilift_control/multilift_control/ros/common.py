@@ -7,8 +7,7 @@ from multilift_msgs.msg import FormationSnapshot
 from multilift_control.cascade import UavState
 from multilift_sim.ros import messages
 from multilift_sim.ros.common import ns_from_stamp
-
-SNAPSHOT_TOPIC = '/formation/snapshot'
+from multilift_sim.topics import FORMATION_SNAPSHOT as SNAPSHOT_TOPIC  # noqa: F401 (nodes)
 
 
 def snapshot_input(msg: FormationSnapshot) -> tuple[int, list[UavState], list[np.ndarray]]:

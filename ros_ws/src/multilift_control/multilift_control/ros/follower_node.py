@@ -21,8 +21,8 @@ from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros import messages
 from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      controller_peers_missing, run_node, serve_controller,
-                                      uav_topic)
+                                      controller_peers_missing, run_node, serve_controller)
+from multilift_sim.topics import uav_topic
 
 
 class FollowerNode(Node):

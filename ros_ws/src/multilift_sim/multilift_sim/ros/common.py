@@ -1,10 +1,10 @@
-"""What every multilift node shares: QoS, time stamps, message <-> model conversions, the
-topic names, and a shutdown-safe `run_node`. This is ROS adapter code; the physics never sees it.
+"""What every multilift node shares: QoS, time stamps, message <-> model conversions and a
+shutdown-safe `run_node` (topic names: multilift_sim.topics). This is ROS adapter code; the
+physics never sees it.
 """
 from __future__ import annotations
 
 import json
-import math
 import os
 import signal
 import sys
@@ -22,6 +22,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
+from multilift_sim.kinematics import (euler_from_quaternion, quaternion_from_euler,
+                                      rotation_matrix)
+
 WORLD_FRAME = 'world'
 
 # Publishers keep their last messages for late joiners and our subscribers ask for them: a
@@ -38,11 +41,6 @@ class StartupError(RuntimeError):
     """The graph did not come together in time; the message says what is missing."""
 
 
-def uav_topic(index: int, leaf: str) -> str:
-    """`/uav{index}/{leaf}`, index from 1 (1 is the leader)."""
-    return f'/uav{index}/{leaf}'
-
-
 def uav_frame(index: int) -> str:
     return f'uav{index}/base_link'
 
@@ -53,24 +51,6 @@ def stamp_from_ns(t_ns: int) -> Time:
 
 def ns_from_stamp(stamp: Time) -> int:
     return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
-
-
-def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> tuple[float, float, float,
-                                                                          float]:
-    """(x, y, z, w) of R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
-
-
-def euler_from_quaternion(x: float, y: float, z: float, w: float) -> np.ndarray:
-    """ZYX Euler angles (roll, pitch, yaw) [rad] of a unit quaternion."""
-    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
-    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return np.array([roll, pitch, yaw])
 
 
 def fill_odometry(msg: Odometry, t_ns: int, child_frame: str, position: np.ndarray,
@@ -87,7 +67,7 @@ def fill_odometry(msg: Odometry, t_ns: int, child_frame: str, position: np.ndarr
         q.x, q.y, q.z, q.w = 0.0, 0.0, 0.0, 1.0
         linear = velocity_world
     else:
-        q.x, q.y, q.z, q.w = quaternion_from_euler(*(float(a) for a in euler))
+        q.x, q.y, q.z, q.w = (float(c) for c in quaternion_from_euler(euler))
         linear = rotation.T @ velocity_world  # world -> body
     v = msg.twist.twist.linear
     v.x, v.y, v.z = (float(c) for c in linear)
@@ -101,10 +81,9 @@ def odometry_arrays(msg: Odometry) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
     """(position, velocity, euler, body_rates) of an Odometry: world position and velocity,
     ZYX Euler angles, body (FLU) angular velocity; the twist's linear part is rotated from the
     body frame to world."""
-    from multilift_sim.kinematics import rotation_matrix
     p = msg.pose.pose.position
     q = msg.pose.pose.orientation
-    euler = euler_from_quaternion(q.x, q.y, q.z, q.w)
+    euler = euler_from_quaternion((q.x, q.y, q.z, q.w))
     v = msg.twist.twist.linear
     w = msg.twist.twist.angular
     velocity = rotation_matrix(euler) @ np.array([v.x, v.y, v.z])
@@ -259,21 +238,3 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
                 pass
         rclpy.try_shutdown()
     return code
-
-
-def run_topics(n_uavs: int) -> list[tuple[str, str]]:
-    """Every topic a run of n UAVs publishes, with its type: what the recorder records."""
-    topics = [('/clock', 'rosgraph_msgs/msg/Clock'), ('/payload/odom', 'nav_msgs/msg/Odometry'),
-              ('/formation/state', 'multilift_msgs/msg/FormationState'),
-              ('/formation/snapshot', 'multilift_msgs/msg/FormationSnapshot'),
-              ('/payload/gust', 'geometry_msgs/msg/Vector3Stamped'),
-              ('/visualization/markers', 'visualization_msgs/msg/MarkerArray'),
-              (uav_topic(1, 'reference'), 'multilift_msgs/msg/TrackingReference')]
-    for i in range(1, n_uavs + 1):
-        topics += [(uav_topic(i, 'odom'), 'nav_msgs/msg/Odometry'),
-                   (uav_topic(i, 'rotor_cmd'), 'multilift_msgs/msg/RotorCommand'),
-                   (uav_topic(i, 'attitude_setpoint'), 'multilift_msgs/msg/AttitudeSetpoint')]
-        if i > 1:
-            topics.append((uav_topic(i, 'formation_error'),
-                           'multilift_msgs/msg/VirtualConstraintError'))
-    return topics

@@ -27,7 +27,8 @@ from multilift_sim.ros.markers import formation_markers
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (MARKER_DECIMATION, PUBLISHER_QOS, STARTUP_TIMEOUT,
                                       SUBSCRIBER_QOS, Fatal, ns_from_stamp, recorder_missing,
-                                      run_node, uav_topic, wait_until, write_summary)
+                                      run_node, wait_until, write_summary)
+from multilift_sim.topics import uav_topic
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 

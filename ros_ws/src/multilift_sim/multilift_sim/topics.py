@@ -1,0 +1,79 @@
+"""The topics of a multilift run and their message types: the one table (no rclpy).
+
+The simulator, the controllers, the recorder, the headless bag writer, the bag reader and the
+tools all name topics from here. UAV indices count from 1 (1 = the leader). Types are written
+`pkg/msg/Type`, as rosbag2 and `ros2 topic` write them. Frames and units: README.md.
+"""
+from __future__ import annotations
+
+import re
+
+# message types
+CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
+ODOMETRY_TYPE = 'nav_msgs/msg/Odometry'
+VECTOR3_STAMPED_TYPE = 'geometry_msgs/msg/Vector3Stamped'
+MARKER_ARRAY_TYPE = 'visualization_msgs/msg/MarkerArray'
+FORMATION_STATE_TYPE = 'multilift_msgs/msg/FormationState'
+FORMATION_SNAPSHOT_TYPE = 'multilift_msgs/msg/FormationSnapshot'
+ROTOR_COMMAND_TYPE = 'multilift_msgs/msg/RotorCommand'
+ATTITUDE_SETPOINT_TYPE = 'multilift_msgs/msg/AttitudeSetpoint'
+TRACKING_REFERENCE_TYPE = 'multilift_msgs/msg/TrackingReference'
+FORMATION_ERROR_TYPE = 'multilift_msgs/msg/VirtualConstraintError'
+
+# topics of the whole run
+CLOCK = '/clock'                        # simulated time, the simulator only
+PAYLOAD_ODOM = '/payload/odom'          # payload position and velocity
+PAYLOAD_GUST = '/payload/gust'          # gust velocity at the payload [m/s], world
+FORMATION_STATE = '/formation/state'    # per cable: tension, g_i, g_i_dot
+FORMATION_SNAPSHOT = '/formation/snapshot'  # what the controllers read, one message a tick
+MARKERS = '/visualization/markers'      # the formation drawn for RViz / Foxglove
+
+# leaves of the per-UAV topics /uav{i}/{leaf}
+ODOM = 'odom'                           # UAV i's state (every UAV)
+ROTOR_CMD = 'rotor_cmd'                 # UAV i's rotor speeds (every UAV)
+ATTITUDE_SETPOINT = 'attitude_setpoint'  # UAV i's outer-loop output (every UAV)
+REFERENCE = 'reference'                 # the mission reference (the leader only)
+FORMATION_ERROR = 'formation_error'     # follower i's rows of g_vc (followers only)
+
+UAV_TYPES = {ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
+             ATTITUDE_SETPOINT: ATTITUDE_SETPOINT_TYPE, REFERENCE: TRACKING_REFERENCE_TYPE,
+             FORMATION_ERROR: FORMATION_ERROR_TYPE}
+RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
+             FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
+             PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
+             MARKERS: MARKER_ARRAY_TYPE}
+
+_UAV_TOPIC = re.compile(r'^/uav([1-9][0-9]*)/(' + '|'.join(UAV_TYPES) + r')$')
+
+
+def uav_topic(index: int, leaf: str) -> str:
+    """`/uav{index}/{leaf}`, index from 1 (1 is the leader)."""
+    return f'/uav{index}/{leaf}'
+
+
+REFERENCE_TOPIC = uav_topic(1, REFERENCE)
+
+
+def parse_uav_topic(topic: str) -> tuple[int, str] | None:
+    """(index, leaf) of a per-UAV topic such as `/uav2/odom`, or None for any other name."""
+    match = _UAV_TOPIC.match(topic)
+    return (int(match.group(1)), match.group(2)) if match else None
+
+
+def topic_type(topic: str) -> str | None:
+    """The type a multilift topic has (`pkg/msg/Type`), or None for a name not of a run."""
+    if topic in RUN_TYPES:
+        return RUN_TYPES[topic]
+    parsed = parse_uav_topic(topic)
+    return UAV_TYPES[parsed[1]] if parsed else None
+
+
+def run_topics(n_uavs: int) -> list[tuple[str, str]]:
+    """Every topic a run of n UAVs publishes, with its type: what the recorder records."""
+    topics = list(RUN_TYPES.items()) + [(REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE)]
+    for i in range(1, n_uavs + 1):
+        topics += [(uav_topic(i, leaf), UAV_TYPES[leaf])
+                   for leaf in (ODOM, ROTOR_CMD, ATTITUDE_SETPOINT)]
+        if i > 1:
+            topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
+    return topics

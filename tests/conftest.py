@@ -11,7 +11,12 @@ from __future__ import annotations
 
 import itertools
 import os
+import re
+import select
+import subprocess
+import time
 from pathlib import Path
+from typing import Callable, TypeVar
 
 import pytest
 
@@ -20,6 +25,7 @@ ROOT = TESTS.parent
 SCENARIOS = ROOT / 'scenarios'
 LAYERS = {'unit': 'no ROS graph, no node processes (tests/unit/)',
           'ros': 'starts nodes or talks to a ROS graph (tests/ros/)'}
+T = TypeVar('T')
 _domains = itertools.count(int(os.environ.get('ROS_DOMAIN_ID', '77')) % 50 + 20)
 
 
@@ -43,3 +49,49 @@ def ros_env(monkeypatch) -> dict:
     monkeypatch.setenv('ROS_DOMAIN_ID', domain)
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     return dict(os.environ)
+
+
+# -- waiting for conditions (tests never wait a fixed time) ----------------------------------------
+def wait_for(condition: Callable[[], T], timeout: float, what: str, poll: float = 0.1) -> T:
+    """Poll `condition()` until it returns something truthy and return that; after `timeout`
+    wall seconds (generous: the machine may be loaded) fail naming `what`."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f'{what}: not within {timeout:g} s')
+        time.sleep(poll)
+
+
+def run_work_dir(process: subprocess.Popen, timeout: float = 60.0) -> Path:
+    """The log directory `scripts/multilift run` (started with stdout=PIPE, text=True) names
+    in its first line ("... logs in DIR"); the run's progress file is DIR/progress."""
+    ready, _, _ = select.select([process.stdout], [], [], timeout)
+    assert ready, f'`multilift run` printed nothing within {timeout:g} s'
+    line = process.stdout.readline()
+    match = re.search(r'logs in (\S+)', line)
+    assert match, f'unexpected first line of `multilift run`: {line!r} (exit {process.poll()})'
+    return Path(match.group(1))
+
+
+def simulated_time(work: Path) -> float:
+    """Simulated time [s] the simulator of a `multilift run` reached (its progress file), 0.0
+    before the first tick."""
+    try:
+        return float((work / 'progress').read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        return 0.0
+
+
+def wait_until_simulated(process: subprocess.Popen, t: float, timeout: float = 120.0) -> float:
+    """Wait until a `multilift run` (stdout=PIPE, text=True) simulated `t` seconds; fail if it
+    exits first. Returns the simulated time reached."""
+    work = run_work_dir(process)
+
+    def reached() -> float:
+        assert process.poll() is None, f'the run exited ({process.returncode}) before t = {t} s'
+        now = simulated_time(work)
+        return now if now >= t else 0.0
+    return wait_for(reached, timeout, f'the run reaching t = {t} s simulated')

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from conftest import ROOT, SCENARIOS
+from conftest import ROOT, SCENARIOS, wait_for, wait_until_simulated
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 
@@ -125,14 +125,11 @@ def private_scenario(tmp_path):
     return path
 
 
-def _wait_for_processes(marker: str, count: int, timeout: float = 30.0) -> list[int]:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
+def _wait_for_processes(marker: str, count: int, timeout: float = 60.0) -> list[int]:
+    def enough() -> list[int]:
         pids = _children_of(marker)
-        if len(pids) >= count:
-            return pids
-        time.sleep(0.2)
-    raise AssertionError(f'only {_children_of(marker)} running')
+        return pids if len(pids) >= count else []
+    return wait_for(enough, timeout, f'{count} processes matching {marker!r} running')
 
 
 def test_ctrl_c_leaves_closed_readable_bag_and_no_processes(tmp_path, ros_env,
@@ -140,7 +137,7 @@ def test_ctrl_c_leaves_closed_readable_bag_and_no_processes(tmp_path, ros_env,
     bag = tmp_path / 'bag'
     proc = _run([str(private_scenario), '--bag', str(bag)], ros_env)
     _wait_for_processes(private_scenario.name, 3)
-    time.sleep(4.0)
+    wait_until_simulated(proc, 1.0)  # 100 ticks and more in the bag
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
@@ -160,7 +157,7 @@ def test_a_dead_controller_stops_the_run_and_is_named(tmp_path, ros_env, scenari
     bag = tmp_path / 'bag'
     proc = _run([str(private), '--bag', str(bag)], ros_env)
     pids = _wait_for_processes(f'{victim}.*{private.name}', 1)
-    time.sleep(3.0)
+    wait_until_simulated(proc, 0.5)  # the run is under way
     os.kill(pids[0], signal.SIGKILL)
     killed = time.monotonic()
     _, err = proc.communicate(timeout=60)
@@ -176,7 +173,7 @@ def test_a_silent_controller_hits_the_lockstep_timeout(tmp_path, ros_env, privat
     private_scenario.write_text(text)
     proc = _run([str(private_scenario)], ros_env)
     pids = _wait_for_processes(f'leader_node.*{private_scenario.name}', 1)
-    time.sleep(3.0)
+    wait_until_simulated(proc, 0.5)  # the leader has answered: the lockstep is running
     os.kill(pids[0], signal.SIGSTOP)
     try:
         _, err = proc.communicate(timeout=60)

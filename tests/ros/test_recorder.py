@@ -146,6 +146,20 @@ def _on_disk(bag_dir: Path, topic: str) -> list:
     return values
 
 
+def _log_times(bag_dir: Path, topic: str) -> list[int]:
+    """Log times [ns] of `topic` in the (maybe unfinished) MCAP, in file order."""
+    times = []
+    try:
+        with open(next(bag_dir.glob('*.mcap')), 'rb') as stream:
+            for _, channel, message in NonSeekingReader(stream).iter_messages(
+                    log_time_order=False):
+                if channel.topic == topic:
+                    times.append(message.log_time)
+    except (McapError, StopIteration):
+        pass  # no file yet, or it ends without summary and footer: the recorder is running
+    return times
+
+
 def _read(bag_dir: Path) -> dict[str, list]:
     """topic -> [(log_time, message)] of a bag, via rosbags."""
     result: dict[str, list] = {}
@@ -167,15 +181,28 @@ def test_sigint_records_exactly_what_was_published(ros, publish, start_recorder,
     test_pub = publish(Int64, '/rec_test/int')
     rotor_pub = publish(RotorCommand, '/rec_test/rotor_command')
     extra_pub = publish(String, '/rec_test/extra')  # found by `all`
+    probe_pub = publish(String, '/rec_test/probe')  # found by `all` too
     clock_pub = publish(Clock, '/clock', QoSProfile(depth=10))
-    assert spin_until(lambda: test_pub.get_subscription_count() >= 1
-                      and rotor_pub.get_subscription_count() >= 1
-                      and extra_pub.get_subscription_count() >= 1
-                      and clock_pub.get_subscription_count() >= 1), 'recorder never matched'
+    assert spin_until(lambda: all(pub.get_subscription_count() >= 1 for pub in (
+        test_pub, rotor_pub, extra_pub, probe_pub, clock_pub))), 'recorder never matched'
     clock = Clock()
     clock.clock.sec = 5  # simulated time of this whole run [s]
     clock_pub.publish(clock)
-    spin_for(0.5)
+    # The recorder uses the clock once a probe published after it is logged at t = 5 s:
+    # probes one at a time until one is (the /clock and probe readers are independent).
+    probes = 0
+
+    def clock_in_effect() -> bool:
+        nonlocal probes
+        times = _log_times(bag_dir, '/rec_test/probe')
+        if len(times) < probes:
+            return False  # the last probe is not on disk yet
+        if times and times[-1] == 5_000_000_000:
+            return True
+        probe_pub.publish(String(data=f'probe {probes}'))
+        probes += 1
+        return False
+    assert spin_until(clock_in_effect), 'the recorder never logged at the /clock time'
     for i in range(n):
         test_pub.publish(Int64(data=1000 + i))
         rotor_pub.publish(_rotor(i))

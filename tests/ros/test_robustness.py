@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from rosbags.highlevel import AnyReader
 
-from conftest import ROOT, SCENARIOS
+from conftest import ROOT, SCENARIOS, wait_for, wait_until_simulated
 from multilift_control.headless import run_headless
 from multilift_tools.sweep import sweep_main
 from multilift_sim import scenario as scenario_io
@@ -475,11 +475,9 @@ def test_sigterm_leaves_no_process_and_a_closed_bag(tmp_path):
     proc = subprocess.Popen([MULTILIFT, 'run', str(scenario), '--bag', str(bag)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=_ros_env(15))
-    deadline = time.monotonic() + 60
-    while len(_pids_with(scenario.name)) < 4 and time.monotonic() < deadline:
-        time.sleep(0.2)   # the command (cli), sim, leader, follower name the scenario file
-    assert len(_pids_with(scenario.name)) == 4
-    time.sleep(4.0)
+    # the command (cli), sim, leader, follower name the scenario file
+    wait_for(lambda: len(_pids_with(scenario.name)) == 4, 60, 'the run\'s 4 processes')
+    wait_until_simulated(proc, 1.0)  # 100 ticks and more in the bag
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
@@ -567,14 +565,28 @@ def test_sweep_sigterm_stops_the_workers_and_writes_what_finished(tmp_path):
                              '--set', 'payload.mass=0.5,0.6,0.7,0.8,0.9,1.0', '--jobs', '2',
                              '--out', str(out), '--no-progress'],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 60
-    workers: list[int] = []
-    while len(workers) < 2 and time.monotonic() < deadline:
-        time.sleep(0.5)
+
+    def children() -> list[int]:
         found = subprocess.run(['pgrep', '-P', str(proc.pid)], capture_output=True, text=True)
-        workers = [int(p) for p in found.stdout.split()]
-    assert len(workers) >= 2
-    time.sleep(3.0)   # the 120 s missions are still running
+        return [int(p) for p in found.stdout.split()]
+
+    def cpu_seconds(pid: int) -> float:
+        try:
+            fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
+        except OSError:
+            return 0.0
+        return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')  # utime + stime
+
+    def two_workers() -> list[int]:
+        pids = children()
+        return pids if len(pids) >= 2 else []
+
+    workers = wait_for(two_workers, 60, 'two sweep workers')
+    # the workers are flying their 120 s missions (imports take well under a CPU second each);
+    # the multiprocessing resource tracker is a child too, hence "the two busiest"
+    wait_for(lambda: sum(sorted(cpu_seconds(p) for p in children())[-2:]) > 3.0, 120,
+             'the workers computing')
+    assert proc.poll() is None, 'the sweep ended before SIGTERM'
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err

@@ -9,9 +9,9 @@ with ``M_eta = W^T J W`` (Eq. 2.24), tau the body torque (FLU) and ``W^T`` the i
 Eq. 2.30. The velocity term c_eta (``C_eta eta_dot`` of Eq. 2.27-2.28) is derived here as
 ``W^T (J W_dot eta_dot + omega x J omega)``, i.e. the Euler equation ``J omega_dot + omega x J
 omega = tau`` pulled back to Euler coordinates; this equals ``M_eta_dot eta_dot - 1/2
-d/deta (eta_dot^T M_eta eta_dot)`` (tests/test_multirotor.py checks it by finite differences).
+d/deta (eta_dot^T M_eta eta_dot)`` (tests/unit/test_multirotor.py checks it by finite differences).
 Departure from the print: the element list of C_eta printed after Eq. 2.27 does not satisfy
-that identity (tests/test_multirotor.py shows the mismatch), so it is not used.
+that identity (tests/unit/test_multirotor.py shows the mismatch), so it is not used.
 
 Functions take one vehicle (inertia (3,), eta (3,)) or a stack (inertia (n, 3), eta (n, 3)).
 """

@@ -8,7 +8,7 @@ dynamics.py: inertial frame z down, FRD body, gravity ``+g e_z``, thrust ``-u_T 
 
 with the payload at ``r_p = r + l (c_a s_b, -s_a, c_a c_b)`` (Eq. 2.33) and the equation of
 motion ``M q_ddot + C q_dot + f_g = B_u u`` (Eq. 2.34). The printed M_r, C_r, M_p, C_p and f_g
-(Eq. 2.36-2.39) agree with a derivation from the Lagrangian (tests/test_reduced_model.py checks
+(Eq. 2.36-2.39) agree with a derivation from the Lagrangian (tests/unit/test_reduced_model.py checks
 them by finite differences); the one slip is the block 0_{3x3} in C of Eq. 2.35, which must be
 0_{3x2}. The attitude blocks M_eta and C_eta eta_dot come from multirotor.py (the printed C_eta
 is wrong, see there). Integrated with scipy's solve_ivp; frames.py maps results to the world.

@@ -10,7 +10,7 @@ links). World frame, z up, SI units; the seed's frame is z down, (x, y, z)_world
 -z)_seed (multilift_sim.frames).
 
 This module also holds `single_lift_table`, the single-lift numbers (seed §2.8.1, §4.1) that
-tests/test_reproduction.py regenerates and compares with the committed report.
+tests/unit/test_reproduction.py regenerates and compares with the committed report.
 
 Cases (one worker process each, longest first): the twin-lift and the "V" of three flying the
 §4.2 mission (bags), the V again in still air (how far the gusts move its payload), the

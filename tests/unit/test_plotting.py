@@ -26,6 +26,9 @@ from std_msgs.msg import String
 
 from multilift_tools import bagdata
 from multilift_sim.bag import BagWriter
+from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_ERROR, FORMATION_STATE, ODOM,
+                                  PAYLOAD_GUST, PAYLOAD_ODOM, REFERENCE_TOPIC, ROTOR_CMD,
+                                  topic_type, uav_topic)
 from multilift_tools.bagdata import RunDataError, load_run
 from multilift_tools.animation import animate_main
 from multilift_tools.compare import compare_main
@@ -124,48 +127,39 @@ def _messages(truth: Truth, k: int) -> list[tuple[str, object]]:
     out: list[tuple[str, object]] = []
     for i in range(n):
         q = _quaternion(*truth.euler[i, k])
-        out.append((f'/uav{i + 1}/odom', _odometry(t, truth.uavs[i, k], q, (0.5, 0, 0),
+        out.append((uav_topic(i + 1, ODOM), _odometry(t, truth.uavs[i, k], q, (0.5, 0, 0),
                                                    f'uav{i + 1}/base_link')))
         rotor = RotorCommand(angular_velocity=[float(w) for w in truth.omega[i, k]],
                              saturated=[bool(s) for s in truth.saturated[i, k]])
         _stamp(rotor, t)
-        out.append((f'/uav{i + 1}/rotor_cmd', rotor))
+        out.append((uav_topic(i + 1, ROTOR_CMD), rotor))
         roll, pitch, yaw = truth.euler[i, k]
         setpoint = AttitudeSetpoint(roll=float(roll), pitch=float(pitch), yaw=float(yaw),
                                     thrust=float(truth.thrust[i, k]))
         _stamp(setpoint, t)
-        out.append((f'/uav{i + 1}/attitude_setpoint', setpoint))
+        out.append((uav_topic(i + 1, ATTITUDE_SETPOINT), setpoint))
         if i > 0:
             error = VirtualConstraintError(error=[float(e) for e in truth.errors[i - 1, k]],
                                            error_rate=[0.0, 0.0, 0.0])
             _stamp(error, t)
-            out.append((f'/uav{i + 1}/formation_error', error))
-    out.append(('/payload/odom', _odometry(t, truth.payload[k], (0.0, 0.0, 0.0, 1.0),
+            out.append((uav_topic(i + 1, FORMATION_ERROR), error))
+    out.append((PAYLOAD_ODOM, _odometry(t, truth.payload[k], (0.0, 0.0, 0.0, 1.0),
                                            truth.payload_velocity[k], 'payload')))
     state = FormationState(cable_tension=[float(v) for v in truth.tension[k]],
                            constraint_position=[float(v) for v in truth.g[k]],
                            constraint_velocity=[float(v) for v in truth.g_dot[k]])
     _stamp(state, t)
-    out.append(('/formation/state', state))
+    out.append((FORMATION_STATE, state))
     gust = Vector3Stamped()
     _stamp(gust, t)
     gust.vector.x, gust.vector.y, gust.vector.z = (float(v) for v in truth.gust[k])
-    out.append(('/payload/gust', gust))
+    out.append((PAYLOAD_GUST, gust))
     reference = TrackingReference()
     _stamp(reference, t)
     reference.position.x, reference.position.y, reference.position.z = (
         float(v) for v in truth.reference[k])
-    out.append(('/uav1/reference', reference))
+    out.append((REFERENCE_TOPIC, reference))
     return out
-
-
-TYPES = {'odom': 'nav_msgs/msg/Odometry', 'rotor_cmd': 'multilift_msgs/msg/RotorCommand',
-         'attitude_setpoint': 'multilift_msgs/msg/AttitudeSetpoint',
-         'formation_error': 'multilift_msgs/msg/VirtualConstraintError',
-         '/payload/odom': 'nav_msgs/msg/Odometry',
-         '/formation/state': 'multilift_msgs/msg/FormationState',
-         '/payload/gust': 'geometry_msgs/msg/Vector3Stamped',
-         '/uav1/reference': 'multilift_msgs/msg/TrackingReference'}
 
 
 def make_bag(directory: Path, n: int, duration: float = 13.0, swing: float = 0.5,
@@ -176,13 +170,13 @@ def make_bag(directory: Path, n: int, duration: float = 13.0, swing: float = 0.5
     samples = [_messages(truth, k) for k in range(len(truth.t))]
     with BagWriter(directory) as bag:
         for topic, _ in samples[0]:
-            bag.add_topic(topic, TYPES.get(topic) or TYPES[topic.rsplit('/', 1)[1]])
+            bag.add_topic(topic, topic_type(topic))
         bag.add_topic('/chatter', 'std_msgs/msg/String')  # a foreign topic: ignored
         bag.write('/chatter', serialize_message(String(data='hello')), 0)
         for k, messages in enumerate(samples):
             for topic, msg in messages:
-                j = len(samples) - 1 - k if topic == '/uav1/odom' else k
-                if topic == '/uav1/odom':
+                j = len(samples) - 1 - k if topic == uav_topic(1, ODOM) else k
+                if topic == uav_topic(1, ODOM):
                     msg = samples[j][0][1]
                 bag.write(topic, serialize_message(msg), int(round(truth.t[j] * 1e9)) + 1)
     if scenario is not None:

@@ -34,8 +34,8 @@ A worker (or a whole worker host) that dies mid-run: Dask runs its task again on
 worker; each result is read once and released, so no row is lost or doubled. A run that kills
 its worker three times is an `error` row (KilledWorker). Progress on stderr: runs done,
 failed (stopped or error), ETA. Exit codes: 0 the campaign finished (failed runs are rows),
-1 the cluster cannot be reached, 2 bad input, 130 interrupted (Ctrl-C or SIGTERM: the finished
-rows are written).
+1 the cluster cannot be reached or went away mid-campaign (the finished rows are written),
+2 bad input, 130 interrupted (Ctrl-C or SIGTERM: the finished rows are written).
 """
 from __future__ import annotations
 
@@ -45,6 +45,7 @@ import math
 import os
 import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -54,6 +55,10 @@ from multilift_tools import campaign as cp
 
 def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
+
+
+class ClusterLost(RuntimeError):
+    """The campaign's futures were cancelled under it (the scheduler went away)."""
 
 
 class Progress:
@@ -67,6 +72,13 @@ class Progress:
         if enabled and sys.stderr.isatty():
             from tqdm import tqdm
             self.bar = tqdm(total=total, unit='run', file=sys.stderr, dynamic_ncols=True)
+
+    def note(self, text: str) -> None:
+        """A line on stderr (above the bar on a terminal)."""
+        if self.bar is not None:
+            self.bar.write(text, file=sys.stderr)
+        else:
+            print(text, file=sys.stderr, flush=True)
 
     def update(self, status: str) -> None:
         self.done += 1
@@ -89,8 +101,12 @@ def run_campaign(client, campaign: cp.Campaign, duration: float | None, bags: Pa
                  progress: Progress, rows: dict[int, dict]) -> None:
     """Submit every run to `client` and put each row in `rows` (index -> row) as its run
     finishes (a KeyboardInterrupt leaves the finished ones there)."""
+    from concurrent.futures import CancelledError
+
     from distributed import as_completed
 
+    # a lost scheduler is one line at the end (ClusterLost), not the client's reconnect traces
+    logging.getLogger('distributed.client').setLevel(logging.CRITICAL)
     specs = {}
     futures = []
     tag = f'{os.getpid()}-{time.time_ns()}'
@@ -102,12 +118,15 @@ def run_campaign(client, campaign: cp.Campaign, duration: float | None, bags: Pa
         specs[future.key] = run
         futures.append(future)
     pending = as_completed(futures)
-    print(f'[sweep] {len(futures)} run(s) submitted', file=sys.stderr, flush=True)
+    progress.note(f'[sweep] {len(futures)} run(s) submitted')
+    progress.start = time.monotonic()   # the ETA counts from here, not the cluster's start
     del futures  # as_completed holds the only reference: a read result is released below
     for future in pending:
         run = specs.pop(future.key)
         try:
             result = future.result()
+        except CancelledError as exc:   # not the run's fault: no row, stop the campaign
+            raise ClusterLost(f'run {run.index} was cancelled: {exc}') from None
         except Exception as exc:  # noqa: BLE001 - KilledWorker, a result that cannot unpickle
             result = {'status': 'error', 'message': cp.error_message(exc),
                       **dict.fromkeys(cp.STATISTICS), 'wall_time': None,
@@ -125,9 +144,17 @@ def open_client(scheduler: str | None, workers: int):
 
     if scheduler is not None:
         return Client(scheduler, timeout='10s'), None
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           host='127.0.0.1', dashboard_address=None,
-                           silence_logs=logging.ERROR)
+    # the worker processes start with SIGINT ignored (a disposition they inherit): Ctrl-C on
+    # a terminal reaches the whole process group, and this process stops them itself
+    main = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               host='127.0.0.1', dashboard_address=None,
+                               silence_logs=logging.ERROR)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, old)
     return Client(cluster), cluster
 
 
@@ -210,6 +237,7 @@ def sweep_main(argv: list[str] | None = None) -> int:
           flush=True)
     progress = Progress(total, not args.no_progress)
     interrupted = False
+    lost = ''
     rows: dict[int, dict] = {}
     old_term = signal.signal(signal.SIGTERM, _interrupt)  # unattended: SIGTERM as Ctrl-C
     client = cluster = None
@@ -223,6 +251,8 @@ def sweep_main(argv: list[str] | None = None) -> int:
         run_campaign(client, campaign, args.duration, bags, progress, rows)
     except KeyboardInterrupt:
         interrupted = True
+    except ClusterLost as exc:
+        lost = f'error: the Dask cluster went away mid-campaign ({exc})'.replace('\n', ' ')
     finally:
         progress.close()
         if client is not None:
@@ -242,6 +272,9 @@ def sweep_main(argv: list[str] | None = None) -> int:
     where = f' to {args.out}' if args.out else ''
     print(f'{len(table)} of {total} run(s) written{where}; {failed} failed (stopped or error)'
           + (' (interrupted)' if interrupted else ''), file=sys.stderr)
+    if lost:
+        print(lost, file=sys.stderr)
+        return 1
     return 130 if interrupted else 0
 
 

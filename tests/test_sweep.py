@@ -25,6 +25,7 @@ import yaml
 from conftest import ROOT, SCENARIOS
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
+from multilift_sim.statistics import summary_row
 from multilift_tools import campaign as cp
 from multilift_tools.plot_sweep import plot_sweep_main
 from multilift_tools.sweep import sweep_main
@@ -144,10 +145,11 @@ def test_rows_in_product_order_equal_an_in_process_run(tmp_path):
     data['payload']['mass'] = 0.8
     data['formation']['alpha_vc'] = 2.1
     scenario = scenario_io.loads(yaml.safe_dump(data), 'here.yaml')
-    sim = run_headless(replace(scenario, simulation=replace(scenario.simulation,
+    run = run_headless(replace(scenario, simulation=replace(scenario.simulation,
                                                             duration=2.0)))
-    assert rows[3]['max_abs_g'] == sim.stats.max_abs_constraint
-    assert rows[3]['max_rotor_speed'] == max(sim.stats.max_rotor_speed)
+    assert rows[3]['max_abs_g'] == run.simulator.stats.max_abs_constraint
+    assert rows[3]['max_rotor_speed'] == max(run.simulator.stats.max_rotor_speed)
+    assert {k: rows[3][k] for k in cp.STATISTICS} == summary_row(run.summary())
 
 
 def test_a_stopped_run_is_a_stopped_row_with_bags(tmp_path):

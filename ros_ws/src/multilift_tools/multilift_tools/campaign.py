@@ -35,11 +35,10 @@ import numpy as np
 import yaml
 
 from multilift_sim import scenario as scenario_io
+from multilift_sim.statistics import summary_row
 
-# run statistics, in table order (`run_statistics_row`): units in the module docstring of sweep
-STATISTICS = ('simulated_time', 'max_abs_g', 'max_abs_g_dot', 'max_rotor_speed',
-              'saturated_time', 'min_tension', 'max_tension', 'tracking_error_max',
-              'tracking_error_rms', 'formation_error_max', 'formation_error_mean')
+# run statistics, in table order (`run_statistics_row`; units in the docstring of sweep)
+STATISTICS = tuple(summary_row({}))
 STATUSES = ('ok', 'stopped', 'error')
 DISTRIBUTIONS = ('uniform', 'normal', 'choice')
 _STEP = re.compile(r'([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$')
@@ -354,67 +353,37 @@ def load_base(name_or_path: str) -> tuple[str, dict]:
 def run_statistics_row(scenario, bag: Path | None = None) -> tuple[dict[str, Any], str]:
     """Fly `scenario` headless (recording to `bag` when given): (its statistics, keyed as
     STATISTICS, None where a figure does not apply; why it stopped, '' when it reached t_max).
-    Other exceptions propagate. The one place a row's statistics come from."""
-    from multilift_control.formation import FormationGeometry, VirtualConstraints
+    Other exceptions propagate. The one place a row's statistics come from: the run's summary
+    through `multilift_sim.statistics.summary_row`, what `run` reports."""
     from multilift_control.headless import run_headless
-    from multilift_control.mission import MissionPath
     from multilift_sim.simulation import SimulationStopped
 
-    n = scenario.n_uavs
-    path = MissionPath(scenario.mission) if scenario.control.mode == 'cascade' else None
-    constraints = None
-    follower_rows = []
-    if n > 1 and scenario.formation is not None:
-        constraints = VirtualConstraints(FormationGeometry.from_config(scenario.formation, n))
-        follower_rows = [constraints.rows_of(i) for i in range(1, n)]
-    acc = {'sim': None, 'track_max': 0.0, 'track_sq': 0.0, 'samples': 0, 'form_max': 0.0,
-           'form_sum': 0.0, 'form_samples': 0}
-
-    def on_tick(sim, *_) -> None:
-        acc['sim'] = sim
-        state = sim.state
-        if path is not None:
-            error = float(np.linalg.norm(path(sim.t).position - state[:3]))
-            acc['track_max'] = max(acc['track_max'], error)
-            acc['track_sq'] += error * error
-            acc['samples'] += 1
-        if constraints is not None:
-            r = state[:6 * n].reshape(n, 6)[:, :3]
-            residual = constraints.residual(r)
-            acc['form_max'] = max(acc['form_max'], float(np.max(np.abs(residual))))
-            acc['form_sum'] += sum(float(np.linalg.norm(residual[rows]))
-                                   for rows in follower_rows)
-            acc['form_samples'] += len(follower_rows)
-
-    stopped = ''
+    if bag is None:
+        run = run_headless(scenario, raise_on_stop=False)
+        return _statistics(run.summary()), run.error or ''
+    from multilift_tools.headless_bag import record_headless
+    seen: list = []
     try:
-        if bag is None:
-            run_headless(scenario, on_tick=on_tick)
-        else:
-            from multilift_tools.headless_bag import record_headless
-            record_headless(scenario, bag, on_tick)
+        run = record_headless(scenario, bag, seen.append)
     except SimulationStopped as exc:
-        stopped = str(exc)
-    row: dict[str, Any] = dict.fromkeys(STATISTICS)
-    sim = acc['sim']
-    if sim is not None:
-        stats = sim.stats
-        row.update(simulated_time=float(sim.t), max_abs_g=float(stats.max_abs_constraint),
-                   max_abs_g_dot=float(stats.max_abs_constraint_rate),
-                   max_rotor_speed=float(max(stats.max_rotor_speed)),
-                   saturated_time=float(sum(stats.saturated_time)),
-                   min_tension=_finite(stats.min_tension), max_tension=_finite(stats.max_tension))
-    if acc['samples']:
-        row.update(tracking_error_max=acc['track_max'],
-                   tracking_error_rms=math.sqrt(acc['track_sq'] / acc['samples']))
-    if acc['form_samples']:
-        row.update(formation_error_max=acc['form_max'],
-                   formation_error_mean=acc['form_sum'] / acc['form_samples'])
-    return row, stopped
+        # record_headless raises with no run to summarise: the simulator's own figures
+        # (the controllers' tracking and formation errors are then empty)
+        sim = dict(seen[-1].stats.as_dict()) if seen else {}
+        return _statistics({'sim': sim}), str(exc)
+    return _statistics(run.summary()), run.error or ''
 
 
-def _finite(value: float) -> float | None:
-    return float(value) if math.isfinite(value) else None
+def _statistics(summary: dict) -> dict[str, Any]:
+    return {k: _plain(v) for k, v in summary_row(summary).items()}
+
+
+def _plain(value: Any) -> Any:
+    """numpy scalars as Python numbers (the table's types), non-finite as None."""
+    if isinstance(value, (np.floating, float)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
 
 
 def run_one(source: str, base: dict, edits: list, duration: float | None = None,

@@ -21,9 +21,12 @@ process, the laws and tick order of the ROS stack).
 The table (FILE: Parquet when it ends in .parquet, CSV otherwise; CSV on stdout without
 --out) has one row per run in input order: run (index), the parameters, seed, status (`ok`;
 `stopped`: the simulation stopped itself, e.g. a cable left its tolerance; `error`: an
-exception), message (why, one line), then the statistics: simulated_time [s], max_abs_g [m^2],
+exception), message (why, one line), then the statistics (`multilift_sim.statistics
+.summary_row`, what `run` reports): simulated_time [s], max_abs_g [m^2],
 max_abs_g_dot [m^2/s], max_rotor_speed [rad/s] (over every UAV), saturated_time [s] (summed
-over the UAVs), min_tension/max_tension [N], tracking_error_max/tracking_error_rms [m] (leader
+over the UAVs), min_tension/max_tension [N], payload_swing_max/payload_swing_rms [m] (the
+payload's distance from its equilibrium place under the UAVs), max_gust_speed [m/s] (met by
+the payload), tracking_error_max/tracking_error_rms [m] (leader
 against the mission reference, every tick; empty without a mission path), formation_error_max
 (largest |g_vc| of any follower row, m or m^2), formation_error_mean (mean over ticks and
 followers of the norm of its rows; empty for n = 1); a stopped run's figures cover the time

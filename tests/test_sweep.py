@@ -122,6 +122,17 @@ def test_run_one_turns_a_rejected_value_into_an_error_row():
     assert ok['simulated_time'] == pytest.approx(0.05)
 
 
+def test_run_one_reports_a_simulation_that_stopped_itself():
+    base = _base('single_lift_swing')
+    edits = [('simulation.baumgarte_alpha', ('simulation', 'baumgarte_alpha'), 0.0),
+             ('simulation.baumgarte_beta', ('simulation', 'baumgarte_beta'), 0.0),
+             ('simulation.constraint_tolerance', ('simulation', 'constraint_tolerance'), 1e-12)]
+    row = cp.run_one('single_lift_swing', base, edits, 1.0)
+    assert row['status'] == 'stopped'
+    assert row['message'].startswith('cable 1: constraint residual |g|')
+    assert 0 < row['simulated_time'] < 1.0 and row['max_abs_g'] > 1e-12
+
+
 # --------------------------------------------------------------------------- local cluster
 def test_rows_in_product_order_equal_an_in_process_run(tmp_path):
     out = tmp_path / 'sweep.csv'

@@ -1,14 +1,11 @@
 """Robustness for unattended runs: the scenario loader under random valid and invalid values
 (hypothesis), determinism headless and through ROS, isolation of runs on different ROS domains,
-a non-finite rotor command, rotor saturation, SIGTERM, and `multilift sweep`.
+a non-finite rotor command, rotor saturation, SIGTERM (`multilift sweep`: test_sweep.py).
 
 The ROS tests use ROS_DOMAIN_ID 12..17 (conftest.ros_env hands out 20..99) with discovery
 limited to this machine."""
 from __future__ import annotations
 
-import copy
-import csv
-import io
 import math
 import os
 import signal
@@ -25,7 +22,6 @@ from rosbags.highlevel import AnyReader
 
 from conftest import ROOT, SCENARIOS, wait_for, wait_until_simulated
 from multilift_control.headless import run_headless
-from multilift_tools.sweep import sweep_main
 from multilift_sim import scenario as scenario_io
 from multilift_sim.allocation import FRAME_TYPES
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
@@ -490,120 +486,3 @@ def test_sigterm_leaves_no_process_and_a_closed_bag(tmp_path):
     data = _raw_messages(bag)
     assert len(data['/uav1/odom']) > 50
     assert abs(len(data['/uav1/odom']) - len(data['/uav2/rotor_cmd'])) <= 1
-
-
-# --------------------------------------------------------------------------- sweep
-def test_sweep_writes_one_row_per_variant_in_product_order(tmp_path, capsys):
-    out = tmp_path / 'sweep.csv'
-    code = sweep_main(['twin_lift', '--set', 'payload.mass=0.4,0.8', '--set',
-                       'formation.alpha_vc=1.0,2.1', '--duration', '2', '--jobs', '2',
-                       '--out', str(out), '--no-progress'])
-    assert code == 0
-    rows = list(csv.DictReader(io.StringIO(out.read_text())))
-    assert [(r['payload.mass'], r['formation.alpha_vc']) for r in rows] == \
-        [('0.4', '1.0'), ('0.4', '2.1'), ('0.8', '1.0'), ('0.8', '2.1')]
-    for row in rows:
-        assert row['error'] == '' and float(row['simulated_time']) == pytest.approx(2.0)
-        assert 0 < float(row['max_rotor_speed']) <= 2100
-        assert float(row['max_abs_g']) < 0.02
-        assert float(row['tracking_error_rms']) <= float(row['tracking_error_max'])
-        assert float(row['formation_error_max']) >= 0
-    # a row computed in a worker process equals the same variant run here
-    data = _base('twin_lift')
-    data['payload']['mass'] = 0.8
-    data['formation']['alpha_vc'] = 2.1
-    sim = run_headless(_short(_load(data), 2.0)).simulator
-    assert float(rows[3]['max_abs_g']) == sim.stats.max_abs_constraint
-    assert float(rows[3]['max_rotor_speed']) == max(sim.stats.max_rotor_speed)
-
-
-def test_sweep_reports_a_stopped_run_in_its_row(tmp_path):
-    out = tmp_path / 'sweep.csv'
-    code = sweep_main(['single_lift_swing', '--set', 'simulation.baumgarte_alpha=0.0,20.0',
-                       '--set', 'simulation.baumgarte_beta=0.0', '--set',
-                       'simulation.constraint_tolerance=1e-12', '--duration', '2', '--jobs',
-                       '1', '--out', str(out), '--no-progress'])
-    assert code == 0
-    rows = list(csv.DictReader(io.StringIO(out.read_text())))
-    assert len(rows) == 2
-    assert rows[0]['error'].startswith('cable 1: constraint residual |g|')
-    assert float(rows[0]['simulated_time']) < 2.0
-
-
-@pytest.mark.parametrize('args,message', [
-    (['--set', 'payload.mas=0.4'], 'payload.mas: unknown key'),
-    (['--set', 'payload.mass=0.4,-1'], 'payload.mass: -1.0 must be > 0'),
-    (['--set', 'vehicle.frame_type=quad_x,tri'], "vehicle.frame_type: 'tri' must be one of"),
-    (['--set', 'uavs[7].cable_length=3'], 'uavs[7].cable_length: index 7 is out of range'),
-    (['--set', 'payload.mass'], 'expected KEY=V1,V2'),
-    (['--set', 'payload.mass=0.4', '--set', 'payload.mass=0.5'], 'given twice'),
-    (['--set', 'payload..mass=1'], 'is not a key'),
-    (['--set', 'payload.mass=1', '--jobs', '0'], '--jobs: 0 must be >= 1'),
-])
-def test_sweep_bad_input_is_one_line_and_exit_2(args, message, capsys):
-    assert sweep_main(['twin_lift', *args]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count('\n') == 0 and err.startswith('error: ') and message in err, err
-
-
-def test_sweep_makes_the_uav_list_for_per_uav_keys(tmp_path):
-    out = tmp_path / 'sweep.csv'
-    assert sweep_main(['multi_lift', '--set', 'uavs[2].cable_length=10.26,10.5',
-                       '--duration', '0.5', '--jobs', '1', '--out', str(out),
-                       '--no-progress']) == 0
-    rows = list(csv.DictReader(io.StringIO(out.read_text())))
-    assert [r['uavs[2].cable_length'] for r in rows] == ['10.26', '10.5']
-    assert all(r['error'] == '' for r in rows)
-    assert copy.deepcopy(_base('multi_lift')).get('uavs') is None  # the file is untouched
-
-
-def test_sweep_sigterm_stops_the_workers_and_writes_what_finished(tmp_path):
-    out = tmp_path / 'sweep.csv'
-    code = ('import sys; from multilift_tools.sweep import sweep_main; '
-            'sys.exit(sweep_main(sys.argv[1:]))')
-    proc = subprocess.Popen([str(ROOT / '.venv' / 'bin' / 'python'), '-c', code, 'multi_lift',
-                             '--set', 'payload.mass=0.5,0.6,0.7,0.8,0.9,1.0', '--jobs', '2',
-                             '--out', str(out), '--no-progress'],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-
-    def children() -> list[int]:
-        found = subprocess.run(['pgrep', '-P', str(proc.pid)], capture_output=True, text=True)
-        return [int(p) for p in found.stdout.split()]
-
-    def cpu_seconds(pid: int) -> float:
-        try:
-            fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-        except OSError:
-            return 0.0
-        return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')  # utime + stime
-
-    def two_workers() -> list[int]:
-        pids = children()
-        return pids if len(pids) >= 2 else []
-
-    workers = wait_for(two_workers, 60, 'two sweep workers')
-    # the workers are flying their 120 s missions (imports take well under a CPU second each);
-    # the multiprocessing resource tracker is a child too, hence "the two busiest"
-    wait_for(lambda: sum(sorted(cpu_seconds(p) for p in children())[-2:]) > 3.0, 120,
-             'the workers computing')
-    assert proc.poll() is None, 'the sweep ended before SIGTERM'
-    proc.send_signal(signal.SIGTERM)
-    _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, err
-    assert '(interrupted)' in err
-
-    # the children include multiprocessing's resource tracker, which exits by itself a moment
-    # after its parent (when its pipe closes): give each child up to 5 s to be gone
-    def running(pid: int) -> bool:
-        try:
-            return Path(f'/proc/{pid}/stat').read_text().split()[2] != 'Z'
-        except FileNotFoundError:
-            return False
-
-    for pid in workers:
-        gone = time.monotonic() + 5.0
-        while time.monotonic() < gone and running(pid):
-            time.sleep(0.1)
-        assert not running(pid), pid
-    rows = list(csv.DictReader(io.StringIO(out.read_text())))
-    assert len(rows) < 6   # the header and whatever finished

@@ -262,7 +262,10 @@ DELEGATED = {
     'foxglove': ('multilift_tools.foxglove_bridge', 'foxglove_main',
                  'serve the live graph to Foxglove over WebSocket (ws://localhost:8765)'),
     'sweep': ('multilift_tools.sweep', 'sweep_main',
-              'headless variants of a scenario in parallel, one CSV row each'),
+              'a campaign of headless runs (grid and sampled) on a Dask cluster, a table row '
+              'each'),
+    'plot-sweep': ('multilift_tools.plot_sweep', 'plot_sweep_main',
+                   'figures and the worst runs of a sweep table'),
     'reproduce': ('multilift_tools.reproduce', 'reproduce_main',
                   "the seed's §2.8 and Ch. 4 results, figures and docs/reproduction.md"),
 }

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_sim.dynamics import StateLayout, initial_state_single_lift
+from multilift_sim.dynamics import Integration, StateLayout, initial_state_single_lift
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
@@ -83,6 +83,10 @@ class FormationSimulator:
         self.steps_per_tick = sim.physics_steps_per_tick
         self.dt = 1.0 / sim.physics_rate
         self.stats = RunStatistics(self.n)
+        # the last integration (its cable_tension is the tension at the tick it started from)
+        # and (g, g_dot) at the current state, for whoever reports them (the headless bag)
+        self.last_step: Integration | None = None
+        self.residuals: tuple[np.ndarray, np.ndarray] | None = None
         # how far each cable reaches for the swing's equilibrium place: l_i widened by the
         # constraint tolerance, so cables held within it always meet [m]
         self._reach = [math.sqrt(u.cable_length ** 2 + sim.constraint_tolerance)
@@ -153,6 +157,7 @@ class FormationSimulator:
         self.stats.add_commands(peaks, saturated, self.period_ns * 1e-9)
         step = self.model.integrate(self.state, speeds, self.dt, self.steps_per_tick)
         self.state = step.state
+        self.last_step = step
         self.stats.add_tensions(step.cable_tension)
         self.tick += 1
         self.stats.simulated_time = self.t
@@ -195,6 +200,7 @@ class FormationSimulator:
             raise SimulationStopped(f'the formation state became non-finite at t = {t:.3f} s')
         g, g_dot = residuals if residuals is not None else \
             self.model.constraint_residuals(self.state)
+        self.residuals = (g, g_dot)
         abs_g, abs_g_dot = np.abs(g), np.abs(g_dot)
         worst, worst_rate = int(np.argmax(abs_g)), int(np.argmax(abs_g_dot))
         peak, peak_rate = float(abs_g[worst]), float(abs_g_dot[worst_rate])

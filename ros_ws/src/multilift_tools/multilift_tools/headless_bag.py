@@ -1,24 +1,132 @@
-"""A headless run recorded to the same bag a ROS run gives: the same topics, the same messages
-(built by multilift_sim.ros.messages), stamped with simulated time. No ROS graph is involved; rclpy
-is used only to serialise the messages to CDR.
+"""A headless run recorded to the same bag a ROS run gives: the same topics, the same messages,
+stamped with simulated time. No ROS graph and no rclpy: the CDR is packed straight from the
+tick's numbers (multilift_sim.cdr, from the values multilift_sim.msgvalues and .scene compute
+for the nodes' messages too), padding zeroed, so two runs of a scenario write byte-identical
+bags.
+
+The tick's work is done once: `/formation/state` and the markers of tick t need the cable
+tension at t under the answers to t, which is what integrating from t computes
+(`Integration.cable_tension`), and g, g_dot at t, which the previous integration (or the
+simulator's start check) computed. So they are written when the next tick arrives (they are
+the last records of tick t, so the order of the bag is unchanged); the last tick, and a tick
+whose integration stopped the run, solve once more.
 """
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Callable
 
-from rclpy.serialization import serialize_message
-
 from multilift_control.headless import HeadlessRun, run_headless
 from multilift_control.runtime import ControllerAnswer
+from multilift_sim import cdr
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
-from multilift_sim.ros import messages
+from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, formation_snapshot, odometry,
+                                     quaternion, uav_frame, vec3)
 from multilift_sim.ros.common import MARKER_DECIMATION
-from multilift_sim.topics import run_topics, uav_topic
-from multilift_sim.ros.markers import formation_markers
 from multilift_sim.scenario import Scenario
+from multilift_sim.scene import FormationScene
 from multilift_sim.simulation import FormationSimulator, Snapshot
+from multilift_sim.topics import run_topics, uav_topic
+
+TF_TOPIC = '/tf'
+
+
+class HeadlessBag:
+    """Packs one run's messages into a BagWriter, tick by tick (see the module docstring)."""
+
+    def __init__(self, scenario: Scenario, writer: BagWriter) -> None:
+        self.scenario = scenario
+        n = scenario.n_uavs
+        self._writer = writer
+        self._topics = dict(run_topics(n))
+        qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
+        for topic, kind in self._topics.items():
+            writer.add_topic(topic, kind, qos)
+        self._write = writer.write
+        self._clock = cdr.Clock()
+        self._gust = cdr.Vector3Stamped()
+        self._payload_odom = cdr.Odometry(PAYLOAD_FRAME)
+        self._state = cdr.formation_state(n)
+        self._snapshot = cdr.FormationSnapshot([u.vehicle.n_rotors for u in scenario.uavs])
+        self._applied = None  # the rotor speeds held up to this tick (None at t = 0)
+        self._scene = FormationScene(scenario)
+        self._markers = cdr.MarkerArray(self._scene.specs)
+        self._reference = cdr.TrackingReference()
+        self._uavs = [(uav_topic(i, 'odom'), cdr.Odometry(uav_frame(i)),
+                       uav_topic(i, 'rotor_cmd'),
+                       cdr.RotorCommand(scenario.uavs[i - 1].vehicle.n_rotors, uav_frame(i)),
+                       uav_topic(i, 'attitude_setpoint'), cdr.AttitudeSetpoint(uav_frame(i)),
+                       uav_topic(i, 'reference'), uav_topic(i, 'formation_error'))
+                      for i in range(1, n + 1)]
+        self._errors: dict[int, cdr.FloatSequences] = {}
+        self._tf = (cdr.TFMessage([uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME])
+                    if TF_TOPIC in self._topics else None)
+        self._pending: tuple[int, Snapshot, list] | None = None  # tick t awaiting its tension
+
+    def tick(self, sim: FormationSimulator, snap: Snapshot,
+             answers: list[ControllerAnswer]) -> None:
+        """Write the state at tick t and every controller's answer to it."""
+        self.finish_pending(sim)
+        t_ns, write = snap.t_ns, self._write
+        write('/clock', self._clock.pack(t_ns), t_ns)
+        write('/formation/snapshot', self._snapshot.pack(
+            t_ns, *formation_snapshot(snap, self._applied)), t_ns)
+        self._applied = [a.output.rotor_speeds for a in answers]
+        for uav, (odom_topic, odom, *_rest) in zip(snap.uavs, self._uavs):
+            write(odom_topic, odom.pack(t_ns, *odometry(uav.position, uav.velocity, uav.euler,
+                                                        uav.rotation, uav.body_rates)), t_ns)
+        write('/payload/odom', self._payload_odom.pack(
+            t_ns, *odometry(snap.payload_position, snap.payload_velocity, None, None, None)),
+            t_ns)
+        if self._tf is not None:
+            write(TF_TOPIC, self._tf.pack(
+                t_ns, [vec3(u.position) for u in snap.uavs] + [vec3(snap.payload_position)],
+                [quaternion(u.euler) for u in snap.uavs] + [IDENTITY]),
+                t_ns)
+        gust = sim.model.gust_velocity_at_payload(sim.t, sim.state)
+        write('/payload/gust', self._gust.pack(t_ns, *gust), t_ns)
+        for answer in answers:
+            (_, _, cmd_topic, cmd, sp_topic, setpoint, ref_topic,
+             error_topic) = self._uavs[answer.index]
+            out = answer.output
+            write(cmd_topic, cmd.pack(t_ns, out.rotor_speeds.tolist(),
+                                      [bool(s) for s in out.saturated]), t_ns)
+            roll, pitch, yaw = out.attitude_setpoint
+            write(sp_topic, setpoint.pack(t_ns, roll, pitch, yaw, out.thrust), t_ns)
+            ref = answer.reference
+            if ref is not None:
+                write(ref_topic, self._reference.pack(t_ns, *ref.position, *ref.velocity,
+                                                      *ref.acceleration), t_ns)
+            if answer.formation_error is not None:
+                errors = answer.formation_error
+                packer = self._errors.get(len(errors))
+                if packer is None:
+                    packer = self._errors[len(errors)] = cdr.virtual_constraint_error(
+                        len(errors))
+                write(error_topic, packer.pack(t_ns, answer.formation_error.tolist(),
+                                               answer.formation_error_rate.tolist()), t_ns)
+        self._pending = (sim.tick, snap, [a.output.rotor_speeds for a in answers],
+                         sim.residuals)
+
+    def finish_pending(self, sim: FormationSimulator) -> None:
+        """Write `/formation/state` (and the markers) of the tick before: from the integration
+        that left it when the simulator has moved on, else solved here (the last tick)."""
+        if self._pending is None:
+            return
+        tick, snap, speeds, (g, g_dot) = self._pending
+        self._pending = None
+        if sim.tick == tick + 1 and sim.last_step is not None:
+            tension = sim.last_step.cable_tension
+        else:  # the run ended at this tick (or its integration stopped the run)
+            tension, g, g_dot = sim.cable_state(speeds)
+        t_ns = snap.t_ns
+        self._write('/formation/state', self._state.pack(t_ns, tension.tolist(), g.tolist(),
+                                                         g_dot.tolist()), t_ns)
+        if tick % MARKER_DECIMATION == 0:
+            self._scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
+                               snap.payload_position, tension)
+            self._write('/visualization/markers', self._markers.pack(t_ns), t_ns)
 
 
 def record_headless(scenario: Scenario, bag_dir: Path,
@@ -27,49 +135,21 @@ def record_headless(scenario: Scenario, bag_dir: Path,
     """Fly `scenario` without ROS and write every topic of a ROS run to `bag_dir`: the
     simulator's state and every controller's answer as the nodes publish them."""
     writer = BagWriter(bag_dir)
-    qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
-    for topic, kind in run_topics(scenario.n_uavs):
-        writer.add_topic(topic, kind, qos)
-
-    rotor_counts = [u.vehicle.n_rotors for u in scenario.uavs]
-    applied: list = [None]  # the rotor speeds held up to this tick (None at t = 0)
-
-    def write(topic: str, msg, t_ns: int) -> None:
-        writer.write(topic, serialize_message(msg), t_ns)
+    bag = HeadlessBag(scenario, writer)
+    simulator: list[FormationSimulator] = []
 
     def tick(sim: FormationSimulator, snap: Snapshot, answers: list[ControllerAnswer]) -> None:
-        t_ns = snap.t_ns
-        write('/clock', messages.clock(t_ns), t_ns)
-        write('/formation/snapshot',
-              messages.formation_snapshot(snap, applied[0], rotor_counts), t_ns)
-        applied[0] = [a.output.rotor_speeds for a in answers]
-        for i, uav in enumerate(snap.uavs):
-            write(uav_topic(i + 1, 'odom'), messages.uav_odometry(t_ns, i + 1, uav), t_ns)
-        write('/payload/odom', messages.payload_odometry(t_ns, snap.payload_position,
-                                                         snap.payload_velocity), t_ns)
-        gust = sim.model.gust_velocity_at_payload(sim.t, sim.state)
-        write('/payload/gust', messages.gust(t_ns, gust), t_ns)
-        for answer in answers:
-            i, out = answer.index + 1, answer.output
-            write(uav_topic(i, 'rotor_cmd'), messages.rotor_command(t_ns, i, out), t_ns)
-            write(uav_topic(i, 'attitude_setpoint'), messages.attitude_setpoint(t_ns, i, out),
-                  t_ns)
-            if answer.reference is not None:
-                write(uav_topic(i, 'reference'),
-                      messages.tracking_reference(t_ns, answer.reference), t_ns)
-            if answer.formation_error is not None:
-                write(uav_topic(i, 'formation_error'),
-                      messages.formation_error(t_ns, answer.formation_error,
-                                               answer.formation_error_rate), t_ns)
-        tension, g, g_dot = sim.cable_state([a.output.rotor_speeds for a in answers])
-        write('/formation/state', messages.formation_state(t_ns, tension, g, g_dot), t_ns)
-        if sim.tick % MARKER_DECIMATION == 0:
-            write('/visualization/markers',
-                  formation_markers(snap, tension, scenario, t_ns), t_ns)
+        if not simulator:
+            simulator.append(sim)
+        bag.tick(sim, snap, answers)
         if on_tick is not None:
             on_tick(sim)
 
     try:
         return run_headless(scenario, tick)
     finally:
-        writer.close()
+        try:
+            if simulator:
+                bag.finish_pending(simulator[0])
+        finally:
+            writer.close()

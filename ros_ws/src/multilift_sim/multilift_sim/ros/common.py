@@ -22,10 +22,11 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
-from multilift_sim.kinematics import (euler_from_quaternion, quaternion_from_euler,
+from multilift_sim.kinematics import (euler_from_quaternion, quaternion_from_euler,  # noqa: F401
                                       rotation_matrix)
 
-WORLD_FRAME = 'world'
+from multilift_sim import msgvalues
+from multilift_sim.msgvalues import WORLD_FRAME, uav_frame  # noqa: F401
 
 # Publishers keep their last messages for late joiners and our subscribers ask for them: a
 # controller or recorder whose subscription matched a moment after t = 0 was published still
@@ -41,12 +42,9 @@ class StartupError(RuntimeError):
     """The graph did not come together in time; the message says what is missing."""
 
 
-def uav_frame(index: int) -> str:
-    return f'uav{index}/base_link'
-
-
 def stamp_from_ns(t_ns: int) -> Time:
-    return Time(sec=int(t_ns // 1_000_000_000), nanosec=int(t_ns % 1_000_000_000))
+    sec, nanosec = msgvalues.stamp(t_ns)
+    return Time(sec=sec, nanosec=nanosec)
 
 
 def ns_from_stamp(stamp: Time) -> int:
@@ -56,24 +54,19 @@ def ns_from_stamp(stamp: Time) -> int:
 def fill_odometry(msg: Odometry, t_ns: int, child_frame: str, position: np.ndarray,
                   velocity_world: np.ndarray, euler: np.ndarray | None,
                   rotation: np.ndarray | None, body_rates: np.ndarray | None) -> Odometry:
-    """Odometry in `world`; twist in the child frame as nav_msgs/Odometry specifies."""
+    """Odometry in `world`; twist in the child frame as nav_msgs/Odometry specifies (the
+    values of msgvalues.odometry, which the headless bag packs too)."""
     msg.header.stamp = stamp_from_ns(t_ns)
     msg.header.frame_id = WORLD_FRAME
     msg.child_frame_id = child_frame
-    p = msg.pose.pose.position
-    p.x, p.y, p.z = (float(v) for v in position)
-    q = msg.pose.pose.orientation
-    if euler is None:
-        q.x, q.y, q.z, q.w = 0.0, 0.0, 0.0, 1.0
-        linear = velocity_world
-    else:
-        q.x, q.y, q.z, q.w = (float(c) for c in quaternion_from_euler(euler))
-        linear = rotation.T @ velocity_world  # world -> body
-    v = msg.twist.twist.linear
-    v.x, v.y, v.z = (float(c) for c in linear)
-    w = msg.twist.twist.angular
-    rates = np.zeros(3) if body_rates is None else body_rates
-    w.x, w.y, w.z = (float(c) for c in rates)
+    position, orientation, linear, angular = msgvalues.odometry(
+        position, velocity_world, euler, rotation, body_rates)
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+    v, w = msg.twist.twist.linear, msg.twist.twist.angular
+    p.x, p.y, p.z = position
+    q.x, q.y, q.z, q.w = orientation
+    v.x, v.y, v.z = linear
+    w.x, w.y, w.z = angular
     return msg
 
 

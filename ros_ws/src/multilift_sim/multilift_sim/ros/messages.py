@@ -13,6 +13,7 @@ from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, FormationSt
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
+from multilift_sim import msgvalues
 from multilift_sim.ros.common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
 
 
@@ -54,17 +55,13 @@ def formation_state(t_ns: int, tension: np.ndarray, g: np.ndarray,
 def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | None,
                        rotor_counts: Sequence[int]) -> FormationSnapshot:
     """From a simulation.Snapshot and the rotor speeds applied up to it (None at t = 0)."""
-    uavs = snapshot.uavs
-    msg = FormationSnapshot(
-        position=np.concatenate([u.position for u in uavs]),
-        velocity=np.concatenate([u.velocity for u in uavs]),
-        euler=np.concatenate([u.euler for u in uavs]),
-        body_rates=np.concatenate([u.body_rates for u in uavs]),
-        payload_position=np.asarray(snapshot.payload_position, dtype=float),
-        payload_velocity=np.asarray(snapshot.payload_velocity, dtype=float),
-        rotor_count=[int(c) for c in rotor_counts],
-        previous_rotor_speeds=(np.concatenate(previous_rotor_speeds).astype(float)
-                               if previous_rotor_speeds is not None else []))
+    (position, velocity, euler, body_rates, payload_position, payload_velocity,
+     previous) = msgvalues.formation_snapshot(snapshot, previous_rotor_speeds)
+    msg = FormationSnapshot(position=position, velocity=velocity, euler=euler,
+                            body_rates=body_rates, payload_position=payload_position,
+                            payload_velocity=payload_velocity,
+                            rotor_count=[int(c) for c in rotor_counts],
+                            previous_rotor_speeds=previous if previous.size else [])
     msg.header.stamp = stamp_from_ns(snapshot.t_ns)
     msg.header.frame_id = WORLD_FRAME
     return msg

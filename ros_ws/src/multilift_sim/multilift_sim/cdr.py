@@ -1,0 +1,321 @@
+"""CDR (XCDR1, little endian) of the messages a run records, packed without rclpy.
+
+Each packer compiles one `struct.Struct` for its message layout once (the frame names and the
+sequence lengths of a run are fixed), then packs a message in one call from plain numbers: the
+values come from multilift_sim.msgvalues and multilift_sim.scene, the same functions the rclpy
+builders of multilift_sim.ros.messages use. The bytes are rclpy's `serialize_message` output
+with the padding zeroed (rclpy leaves it uninitialised):
+
+- a 4-byte encapsulation header `00 01 00 00` (CDR, little endian), then the message;
+- every primitive aligned to its own size, counted from the end of that header;
+- a string is a uint32 length including the NUL, its bytes, the NUL;
+- a sequence is a uint32 count, then its elements (aligned from the first element);
+- no padding after the last field.
+"""
+from __future__ import annotations
+
+import struct
+from typing import Sequence
+
+from multilift_sim.msgvalues import WORLD_FRAME, stamp
+from multilift_sim.scene import MarkerSpec
+
+ENCAPSULATION = b'\x00\x01\x00\x00'
+_ZERO_VECTOR = (0.0, 0.0, 0.0)
+
+
+class Layout:
+    """Builds a struct format for a CDR message field by field, tracking alignment; `pad`
+    lists the (offset, length) of every padding run in the packed bytes (header included)."""
+
+    def __init__(self) -> None:
+        self._fmt = ['<4s']
+        self._offset = 0  # from the end of the encapsulation header
+        self.pad: list[tuple[int, int]] = []
+
+    def _align(self, size: int) -> None:
+        gap = -self._offset % size
+        if gap:
+            self._fmt.append(f'{gap}x')
+            self.pad.append((4 + self._offset, gap))
+            self._offset += gap
+
+    def primitive(self, code: str, count: int = 1) -> None:
+        """`count` values of struct code `code` (i, I, d, f, ?, B): count args."""
+        size = struct.calcsize(code)
+        if count:
+            self._align(size)
+            self._fmt.append(f'{count}{code}')
+            self._offset += size * count
+
+    def zeros(self, code: str, count: int = 1) -> None:
+        """`count` values of `code` that are always zero: no args."""
+        size = struct.calcsize(code)
+        if count:
+            self._align(size)
+            self._fmt.append(f'{size * count}x')
+            self._offset += size * count
+
+    def string(self, text: str) -> bytes:
+        """A string field whose value is `text` (fixed for the layout): args (length, bytes);
+        returns the bytes to pass."""
+        data = text.encode('utf-8')
+        self.primitive('I')
+        self._fmt.append(f'{len(data) + 1}s')  # struct pads with the NUL
+        self._offset += len(data) + 1
+        return data
+
+    def header(self, frame: str) -> bytes:
+        """std_msgs/Header: args (sec, nanosec, length, frame bytes)."""
+        self.primitive('i')
+        self.primitive('I')
+        return self.string(frame)
+
+    def compile(self) -> struct.Struct:
+        return struct.Struct(''.join(self._fmt))
+
+
+def _header_layout(frame: str) -> tuple[Layout, tuple]:
+    layout = Layout()
+    data = layout.header(frame)
+    return layout, (len(data) + 1, data)
+
+
+class Clock:
+    """rosgraph_msgs/Clock."""
+
+    def __init__(self) -> None:
+        layout = Layout()
+        layout.primitive('i')
+        layout.primitive('I')
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, t_ns: int) -> bytes:
+        return self._struct.pack(ENCAPSULATION, *stamp(t_ns))
+
+
+class Odometry:
+    """nav_msgs/Odometry with zero covariances, frame `frame`, child `child`."""
+
+    def __init__(self, child: str, frame: str = WORLD_FRAME) -> None:
+        layout, self._frame = _header_layout(frame)
+        child_data = layout.string(child)
+        self._frame += (len(child_data) + 1, child_data)
+        layout.primitive('d', 7)    # pose: position, orientation
+        layout.zeros('d', 36)       # pose covariance
+        layout.primitive('d', 6)    # twist: linear, angular
+        layout.zeros('d', 36)       # twist covariance
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, t_ns: int, position: Sequence[float], orientation: Sequence[float],
+             linear: Sequence[float], angular: Sequence[float]) -> bytes:
+        """From msgvalues.odometry's four tuples."""
+        return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, *position,
+                                 *orientation, *linear, *angular)
+
+
+class _Stamped:
+    """A header then `floats` float64 fields (Vector3Stamped, AttitudeSetpoint,
+    TrackingReference)."""
+
+    def __init__(self, floats: int, frame: str) -> None:
+        layout, self._frame = _header_layout(frame)
+        layout.primitive('d', floats)
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, t_ns: int, *values: float) -> bytes:
+        return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, *values)
+
+
+class Vector3Stamped(_Stamped):
+    """geometry_msgs/Vector3Stamped: pack(t_ns, x, y, z)."""
+
+    def __init__(self, frame: str = WORLD_FRAME) -> None:
+        super().__init__(3, frame)
+
+
+class AttitudeSetpoint(_Stamped):
+    """multilift_msgs/AttitudeSetpoint: pack(t_ns, roll, pitch, yaw, thrust)."""
+
+    def __init__(self, frame: str) -> None:
+        super().__init__(4, frame)
+
+
+class TrackingReference(_Stamped):
+    """multilift_msgs/TrackingReference: pack(t_ns, position (3), velocity (3),
+    acceleration (3))."""
+
+    def __init__(self, frame: str = WORLD_FRAME) -> None:
+        super().__init__(9, frame)
+
+
+class FloatSequences:
+    """A header then float64[] fields of fixed lengths `lengths` (FormationState: tension, g,
+    g_dot; VirtualConstraintError: error, error_rate): pack(t_ns, *sequences)."""
+
+    def __init__(self, lengths: Sequence[int], frame: str = WORLD_FRAME) -> None:
+        layout, self._frame = _header_layout(frame)
+        for length in lengths:
+            layout.primitive('I')
+            layout.primitive('d', length)
+        self._lengths = tuple(lengths)
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, t_ns: int, *sequences: Sequence[float]) -> bytes:
+        args = [ENCAPSULATION, *stamp(t_ns), *self._frame]
+        for length, values in zip(self._lengths, sequences, strict=True):
+            if len(values) != length:
+                raise ValueError(f'a sequence of {len(values)} values for a layout of {length}')
+            args.append(length)
+            args.extend(values)
+        return self._struct.pack(*args)
+
+
+def formation_state(n: int) -> FloatSequences:
+    """multilift_msgs/FormationState of n cables."""
+    return FloatSequences((n, n, n))
+
+
+def virtual_constraint_error(m: int) -> FloatSequences:
+    """multilift_msgs/VirtualConstraintError of m constraints."""
+    return FloatSequences((m, m))
+
+
+class FormationSnapshot:
+    """multilift_msgs/FormationSnapshot of UAVs with `rotor_counts` rotors:
+    pack(t_ns, *msgvalues.formation_snapshot(...)), the previous rotor speeds empty at t = 0
+    or one per rotor."""
+
+    def __init__(self, rotor_counts: Sequence[int], frame: str = WORLD_FRAME) -> None:
+        n = len(rotor_counts)
+        self._counts = tuple(int(c) for c in rotor_counts)
+        self._rows = 3 * n
+        self._structs = {}
+        for previous in (0, sum(self._counts)):
+            layout, self._frame = _header_layout(frame)
+            for _ in range(4):                 # position, velocity, euler, body_rates
+                layout.primitive('I')
+                layout.primitive('d', 3 * n)
+            layout.primitive('d', 6)           # payload position, velocity (float64[3] each)
+            layout.primitive('I')
+            layout.primitive('I', n)           # rotor_count
+            layout.primitive('I')
+            layout.primitive('d', previous)    # previous_rotor_speeds
+            self._structs[previous] = (layout, layout.compile())
+
+    def layout(self, previous: int) -> Layout:
+        return self._structs[previous][0]
+
+    def pack(self, t_ns: int, position: Sequence[float], velocity: Sequence[float],
+             euler: Sequence[float], body_rates: Sequence[float],
+             payload_position: Sequence[float], payload_velocity: Sequence[float],
+             previous: Sequence[float]) -> bytes:
+        rows = self._rows
+        for values in (position, velocity, euler, body_rates):
+            if len(values) != rows:
+                raise ValueError(f'{len(values)} values for {rows} (3 per UAV)')
+        entry = self._structs.get(len(previous))
+        if entry is None:
+            raise ValueError(f'{len(previous)} previous rotor speeds for rotor counts '
+                             f'{self._counts}')
+        return entry[1].pack(ENCAPSULATION, *stamp(t_ns), *self._frame, rows, *position,
+                             rows, *velocity, rows, *euler, rows, *body_rates,
+                             *payload_position, *payload_velocity, len(self._counts),
+                             *self._counts, len(previous), *previous)
+
+
+class RotorCommand:
+    """multilift_msgs/RotorCommand of `n_rotors` rotors: pack(t_ns, speeds, saturated)."""
+
+    def __init__(self, n_rotors: int, frame: str) -> None:
+        layout, self._frame = _header_layout(frame)
+        layout.primitive('I')
+        layout.primitive('d', n_rotors)
+        layout.primitive('I')
+        layout.primitive('?', n_rotors)
+        self._n = n_rotors
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, t_ns: int, speeds: Sequence[float], saturated: Sequence[bool]) -> bytes:
+        return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, self._n, *speeds,
+                                 self._n, *saturated)
+
+
+class TFMessage:
+    """tf2_msgs/TFMessage of one TransformStamped per child frame, all from `frame`:
+    pack(t_ns, translations, rotations), one (x, y, z) and one (x, y, z, w) per child."""
+
+    def __init__(self, children: Sequence[str], frame: str = WORLD_FRAME) -> None:
+        layout = Layout()
+        layout.primitive('I')
+        self._names = []
+        for child in children:
+            frame_data = layout.header(frame)
+            child_data = layout.string(child)
+            layout.primitive('d', 7)
+            self._names.append((len(frame_data) + 1, frame_data, len(child_data) + 1,
+                                child_data))
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, t_ns: int, translations: Sequence[Sequence[float]],
+             rotations: Sequence[Sequence[float]]) -> bytes:
+        sec, nanosec = stamp(t_ns)
+        args = [ENCAPSULATION, len(self._names)]
+        for (flen, fdata, clen, cdata), translation, rotation in zip(
+                self._names, translations, rotations, strict=True):
+            args += (sec, nanosec, flen, fdata, clen, cdata, *translation, *rotation)
+        return self._struct.pack(*args)
+
+
+class MarkerArray:
+    """visualization_msgs/MarkerArray of `specs` (scene.MarkerSpec; their names, types and
+    point counts fix the layout, their other values are read at every `pack`), frame `frame`."""
+
+    def __init__(self, specs: Sequence[MarkerSpec], frame: str = WORLD_FRAME) -> None:
+        layout = Layout()
+        layout.primitive('I')
+        self._specs = list(specs)
+        self._constant = []  # per marker: (frame length, frame, ns length, ns, id, type, action)
+        for spec in self._specs:
+            frame_data = layout.header(frame)
+            ns_data = layout.string(spec.ns)
+            layout.primitive('i', 3)           # id, type, action
+            layout.primitive('d', 10)          # pose (7), scale (3)
+            layout.primitive('f', 4)           # color
+            layout.zeros('i', 2)               # lifetime
+            layout.zeros('?')                  # frame_locked
+            layout.primitive('I')              # points
+            layout.primitive('d', 3 * len(spec.points))
+            layout.zeros('I')                  # colors: empty
+            layout.string('')                  # texture_resource
+            layout.zeros('i', 2)               # texture.header.stamp
+            layout.string('')                  # texture.header.frame_id
+            layout.string('')                  # texture.format
+            layout.zeros('I')                  # texture.data: empty
+            layout.zeros('I')                  # uv_coordinates: empty
+            layout.string('')                  # text
+            layout.string('')                  # mesh_resource
+            layout.string('')                  # mesh_file.filename
+            layout.zeros('I')                  # mesh_file.data: empty
+            layout.zeros('?')                  # mesh_use_embedded_materials
+            self._constant.append((len(frame_data) + 1, frame_data, len(ns_data) + 1, ns_data))
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, t_ns: int) -> bytes:
+        """The array of the specs' current values, every marker stamped t_ns."""
+        sec, nanosec = stamp(t_ns)
+        args = [ENCAPSULATION, len(self._specs)]
+        empty = (1, b'')
+        for spec, (flen, fdata, nlen, ndata) in zip(self._specs, self._constant):
+            args += (sec, nanosec, flen, fdata, nlen, ndata, spec.id, spec.type, spec.action,
+                     *spec.position, *spec.orientation, *spec.scale, *spec.color,
+                     len(spec.points))
+            for point in spec.points:
+                args += point
+            args += empty  # texture_resource
+            args += empty  # texture.header.frame_id
+            args += empty  # texture.format
+            args += empty  # text
+            args += empty  # mesh_resource
+            args += empty  # mesh_file.filename
+        return self._struct.pack(*args)

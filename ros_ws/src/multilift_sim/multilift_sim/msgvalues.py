@@ -1,0 +1,73 @@
+"""The numbers our messages carry, computed once from model values (no rclpy, no message types).
+
+multilift_sim.ros.messages fills rclpy messages from these functions and multilift_sim.cdr packs
+CDR straight from them, so a node's message and a headless bag's record hold the same values.
+World frame, SI units.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from multilift_sim.kinematics import quaternion_from_euler
+
+WORLD_FRAME = 'world'
+PAYLOAD_FRAME = 'payload'
+
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+IDENTITY: Quat = (0.0, 0.0, 0.0, 1.0)
+
+
+def uav_frame(index: int) -> str:
+    """`uav{index}/base_link`, index from 1 (1 is the leader)."""
+    return f'uav{index}/base_link'
+
+
+def stamp(t_ns: int) -> tuple[int, int]:
+    """(sec, nanosec) of builtin_interfaces/Time for a time [ns]."""
+    return int(t_ns // 1_000_000_000), int(t_ns % 1_000_000_000)
+
+
+def quaternion(euler: Sequence[float]) -> Quat:
+    """(x, y, z, w) of ZYX Euler angles (kinematics.quaternion_from_euler) as floats."""
+    q = quaternion_from_euler(euler).tolist()
+    return q[0], q[1], q[2], q[3]
+
+
+def vec3(values: Sequence[float]) -> Vec3:
+    return float(values[0]), float(values[1]), float(values[2])
+
+
+def odometry(position: Sequence[float], velocity_world: Sequence[float],
+             euler: Sequence[float] | None, rotation: np.ndarray | None,
+             body_rates: Sequence[float] | None) -> tuple[Vec3, Quat, Vec3, Vec3]:
+    """(position, orientation, linear twist, angular twist) of a nav_msgs/Odometry in `world`:
+    the twist is in the child frame as nav_msgs/Odometry specifies (world velocity rotated by
+    R^T); without an attitude (`euler` None) the orientation is the identity and the twist the
+    world velocity."""
+    if euler is None:
+        orientation, linear = IDENTITY, vec3(velocity_world)
+    else:
+        orientation = quaternion(euler)
+        linear = vec3(rotation.T @ velocity_world)  # world -> body
+    angular = (0.0, 0.0, 0.0) if body_rates is None else vec3(body_rates)
+    return vec3(position), orientation, linear, angular
+
+
+def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | None
+                       ) -> tuple[np.ndarray, ...]:
+    """The arrays of a multilift_msgs/FormationSnapshot from a simulation.Snapshot and the
+    rotor speeds applied up to it (None at t = 0): (position, velocity, euler, body_rates)
+    3 per UAV, payload position and velocity, previous rotor speeds UAV by UAV (empty at
+    t = 0)."""
+    uavs = snapshot.uavs
+    previous = (np.concatenate(previous_rotor_speeds).astype(float)
+                if previous_rotor_speeds is not None else np.empty(0))
+    return (np.concatenate([u.position for u in uavs]),
+            np.concatenate([u.velocity for u in uavs]),
+            np.concatenate([u.euler for u in uavs]),
+            np.concatenate([u.body_rates for u in uavs]),
+            np.asarray(snapshot.payload_position, dtype=float),
+            np.asarray(snapshot.payload_velocity, dtype=float), previous)

@@ -1,0 +1,173 @@
+"""What `/visualization/markers` draws, as plain numbers (no rclpy, no message types).
+
+`FormationScene(scenario)` holds one `MarkerSpec` per marker of the scenario's MarkerArray, in
+the array's order; `update(...)` writes one tick's poses, cable points and colours into them.
+multilift_sim.ros.markers fills rclpy Marker messages from these specs and multilift_sim.cdr
+packs CDR from them, so the node's array and the headless bag's hold the same values. The
+markers (world frame, z up, metres):
+
+- ns `uav`, id i (1 = leader), CYLINDER: the UAV body, a disc BODY_DIAMETER_ARMS arm lengths
+  across and BODY_HEIGHT thick, at the UAV's pose;
+- ns `uav_heading`, id i, ARROW: the body x axis (front), 2 arm lengths long;
+- ns `cable`, id i, LINE_STRIP: UAV i's centre of mass to the payload, coloured by tension;
+- ns `payload`, id 0, SPHERE: the payload, PAYLOAD_DIAMETER across;
+- ns `mission_path`, id 0, LINE_STRIP: the leader's reference path through the corners of
+  `scenario.mission` (start, then the end of each segment);
+- ns `gust_zone`, id k (from 0), CYLINDER: where gust k blows, radius H (its gradient distance)
+  about its centre, spanning the heights the payload can reach (height does not matter to a
+  gust, seed Eq. 2.55), translucent.
+
+Cable colour: tension T [N] against the static share of the payload weight per cable,
+T_ref = m_p g / n: blue at T <= 0+ (slack), green at T_ref, red at 2 T_ref and above; a negative
+tension (the rigid rod in compression, which the model reports) is magenta.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+from multilift_sim.msgvalues import quaternion
+from multilift_sim.scenario import Scenario
+
+PAYLOAD_DIAMETER = 0.3  # [m] drawn size of the payload (the model's payload is a point mass)
+BODY_DIAMETER_ARMS = 2.6  # UAV disc diameter in arm lengths
+BODY_HEIGHT = 0.06  # [m] UAV disc thickness
+CABLE_WIDTH = 0.03  # [m] line width of a cable
+PATH_WIDTH = 0.05  # [m] line width of the mission path
+GUST_ALPHA = 0.15  # opacity of a gust zone
+GUST_MARGIN = 1.0  # [m] a gust zone reaches this far above and below the payload's heights
+
+# visualization_msgs/Marker types and action used here
+ARROW, SPHERE, CYLINDER, LINE_STRIP = 0, 2, 3, 4
+ADD = 0
+
+_LEADER = (0.95, 0.55, 0.05)  # orange
+_FOLLOWER = (0.15, 0.45, 0.95)  # blue
+_PAYLOAD = (0.35, 0.35, 0.35)
+_PATH = (0.1, 0.7, 0.2)
+_GUST = (0.55, 0.8, 1.0)
+_COMPRESSION = (0.9, 0.1, 0.9)
+
+
+def tension_color(tension: float, reference: float) -> tuple[float, float, float]:
+    """RGB of a cable under `tension` [N] on the blue-green-red scale of T / `reference` [N].
+
+    0 (or slack) is blue, `reference` green, 2 `reference` or more red; negative (compression)
+    is magenta. `reference` must be positive.
+    """
+    if not math.isfinite(tension):
+        return _COMPRESSION
+    if tension < 0.0:
+        return _COMPRESSION
+    s = min(tension / (2.0 * reference), 1.0)
+    if s <= 0.5:  # blue -> green
+        u = s / 0.5
+        return (0.0, u, 1.0 - u)
+    u = (s - 0.5) / 0.5  # green -> red
+    return (u, 1.0 - u, 0.0)
+
+
+def mission_corners(scenario: Scenario) -> list[tuple[float, float, float]]:
+    """The leader reference's corners, world [m]: the start, then the end of every segment."""
+    corners = [tuple(float(c) for c in scenario.mission.start)]
+    previous_end = 0.0
+    for segment in scenario.mission.segments:
+        duration = segment.end_time - previous_end
+        previous_end = segment.end_time
+        last = corners[-1]
+        corners.append(tuple(last[k] + segment.velocity[k] * duration for k in range(3)))
+    return corners
+
+
+@dataclass
+class MarkerSpec:
+    """The values of one visualization_msgs/Marker (every field not here is zero or empty)."""
+    ns: str
+    id: int
+    type: int
+    position: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    orientation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])
+    scale: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    color: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])  # RGBA
+    points: list[tuple[float, float, float]] = field(default_factory=list)
+    action: int = ADD
+
+
+def _rgba(rgb: Sequence[float], alpha: float = 1.0) -> list[float]:
+    return [float(rgb[0]), float(rgb[1]), float(rgb[2]), float(alpha)]
+
+
+def _static_specs(scenario: Scenario) -> list[MarkerSpec]:
+    corners = mission_corners(scenario)
+    specs = [MarkerSpec('mission_path', 0, LINE_STRIP, scale=(PATH_WIDTH, 0.0, 0.0),
+                        color=_rgba(_PATH, 0.8),
+                        points=[tuple(float(c) for c in corner) for corner in corners])]
+    heights = [c[2] for c in corners] + [u.position[2] for u in scenario.uavs]
+    longest = max(u.cable_length for u in scenario.uavs)
+    bottom = min(heights) - longest - GUST_MARGIN
+    top = max(heights) + GUST_MARGIN
+    for k, gust in enumerate(scenario.gusts):
+        diameter = float(2.0 * gust.gradient_distance)
+        specs.append(MarkerSpec(
+            'gust_zone', k, CYLINDER,
+            position=[float(gust.center[0]), float(gust.center[1]), float(0.5 * (bottom + top))],
+            scale=(diameter, diameter, float(top - bottom)), color=_rgba(_GUST, GUST_ALPHA)))
+    return specs
+
+
+class FormationScene:
+    """The marker specs of one scenario, in MarkerArray order: per UAV body, heading, cable;
+    then the payload, the mission path and the gust zones. `update` rewrites the moving parts."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.scenario = scenario
+        weight = scenario.payload.mass * scenario.simulation.gravity  # [N]
+        self.reference_tension = weight / scenario.n_uavs  # [N]
+        self.bodies, self.headings, self.cables = [], [], []
+        for i, uav in enumerate(scenario.uavs):
+            arm = float(uav.vehicle.arm_length)  # [m]
+            rgb = _LEADER if i == 0 else _FOLLOWER
+            self.bodies.append(MarkerSpec('uav', i + 1, CYLINDER,
+                                          scale=(BODY_DIAMETER_ARMS * arm,
+                                                 BODY_DIAMETER_ARMS * arm, BODY_HEIGHT),
+                                          color=_rgba(rgb)))
+            self.headings.append(MarkerSpec('uav_heading', i + 1, ARROW,
+                                            scale=(2.0 * arm, 0.25 * arm, 0.25 * arm),
+                                            color=_rgba(rgb)))
+            self.cables.append(MarkerSpec(
+                'cable', i + 1, LINE_STRIP, scale=(CABLE_WIDTH, 0.0, 0.0),
+                color=_rgba(tension_color(0.0, self.reference_tension)),
+                points=[(0.0, 0.0, 0.0), (0.0, 0.0, 0.0)]))
+        self.payload = MarkerSpec('payload', 0, SPHERE, scale=(PAYLOAD_DIAMETER,) * 3,
+                                  color=_rgba(_PAYLOAD))
+        self.specs = ([m for trio in zip(self.bodies, self.headings, self.cables)
+                       for m in trio] + [self.payload] + _static_specs(scenario))
+
+    @property
+    def n_uavs(self) -> int:
+        return len(self.bodies)
+
+    def update(self, uav_positions: Sequence[Sequence[float]],
+               uav_euler: Sequence[Sequence[float]], payload_position: Sequence[float],
+               tensions: Sequence[float]) -> list[MarkerSpec]:
+        """Write one tick's formation into the specs (UAV positions [m] and ZYX Euler angles
+        [rad], payload position [m], cable tensions [N]); returns `specs`."""
+        n = self.n_uavs
+        if len(uav_positions) != n or len(tensions) != n:
+            raise ValueError(f'formation_markers: scenario {self.scenario.name} has {n} UAVs, '
+                             f'got a snapshot of {len(uav_positions)} and {len(tensions)} '
+                             'tensions')
+        payload = (float(payload_position[0]), float(payload_position[1]),
+                   float(payload_position[2]))
+        self.payload.position[:] = payload
+        for position, euler, tension, body, heading, cable in zip(
+                uav_positions, uav_euler, tensions, self.bodies, self.headings, self.cables):
+            xyz = (float(position[0]), float(position[1]), float(position[2]))
+            body.position[:] = xyz
+            body.orientation[:] = quaternion(euler)
+            heading.position[:] = xyz
+            heading.orientation[:] = body.orientation
+            cable.points[0], cable.points[1] = xyz, payload
+            cable.color[:3] = tension_color(float(tension), self.reference_tension)
+        return self.specs

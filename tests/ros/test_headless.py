@@ -18,7 +18,8 @@ MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 @pytest.fixture(scope='module')
 def twin_bags(tmp_path_factory):
     root = tmp_path_factory.mktemp('headless')
-    env = dict(os.environ, ROS_DOMAIN_ID='51', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    env = dict(os.environ, ROS_DOMAIN_ID=os.environ.get('MULTILIFT_TEST_DOMAIN', '51'),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     for mode in ('ros', 'headless'):
         args = [MULTILIFT, 'run', 'twin_lift', '--duration', '6', '--bag', str(root / mode)]
         if mode == 'headless':
@@ -69,3 +70,23 @@ def test_headless_bad_scenario_is_exit_2(tmp_path):
     out = subprocess.run([MULTILIFT, 'run', 'nope', '--headless'], capture_output=True,
                          text=True, timeout=60)
     assert out.returncode == 2 and 'unknown scenario' in out.stderr
+
+
+def test_headless_bags_are_byte_identical(tmp_path):
+    """The headless bag packs its CDR with zeroed padding and writes no wall-clock time: two
+    runs of a scenario give the same bytes (metadata.yaml included)."""
+    import dataclasses
+
+    from multilift_sim import scenario as scenario_io
+    from multilift_tools.headless_bag import record_headless
+    scenario = scenario_io.load('twin_lift')
+    scenario = dataclasses.replace(scenario, simulation=dataclasses.replace(
+        scenario.simulation, duration=0.5))
+    for run in ('a', 'b'):
+        record_headless(scenario, tmp_path / run / 'bag')
+    first, second = tmp_path / 'a' / 'bag', tmp_path / 'b' / 'bag'
+    assert sorted(p.name for p in first.iterdir()) == ['bag_0.mcap', 'metadata.yaml']
+    for name in ('bag_0.mcap', 'metadata.yaml'):
+        assert (first / name).read_bytes() == (second / name).read_bytes(), name
+    with AnyReader([first]) as reader:
+        assert {c.topic: c.msgcount for c in reader.connections}['/formation/state'] == 51

@@ -62,7 +62,7 @@ class HeadlessBag:
         self._errors: dict[int, cdr.FloatSequences] = {}
         self._tf = (cdr.TFMessage([uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME])
                     if TF_TOPIC in self._topics else None)
-        self._pending: tuple[int, Snapshot, list] | None = None  # tick t awaiting its tension
+        self._pending: tuple | None = None  # (tick, snapshot, speeds, (g, g_dot)) of tick t
 
     def tick(self, sim: FormationSimulator, snap: Snapshot,
              answers: list[ControllerAnswer]) -> None:

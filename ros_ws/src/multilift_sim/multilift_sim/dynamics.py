@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from multilift_sim import kernels
 from multilift_sim.disturbances import Gust, gust_velocity
 from multilift_sim.frames import seed_to_world_vector
 from multilift_sim.multirotor import MultirotorParams, rotational_kinetic_energy
@@ -236,6 +237,7 @@ class FormationModel:
             (float(self.uav_masses[i]), float(self._lengths_sq[i]),
              *self._inv_inertia[:, i].tolist(), *self._gyro_coefficients[:, i].tolist())
             for i in range(n)]
+        self._compiled: tuple | None = None  # kernels.model_constants, made on first use
 
     # ----------------------------------------------------------------------------- inputs
     def wrenches(self, rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
@@ -301,6 +303,12 @@ class FormationModel:
         period of seed Algorithm 1). The wrenches are formed once (the speeds are held) and
         the tension is that of the first stage of the first step (the multipliers at x)."""
         wrenches = self.wrenches(rotor_speeds)
+        if self.uses_float_kernel and kernels.enabled():  # the same kernel, compiled
+            if self._compiled is None:
+                self._compiled = kernels.model_constants(self)
+            state, multipliers, g, g_dot = kernels.integrate(self._compiled, x, wrenches, dt,
+                                                             steps)
+            return Integration(state, 2.0 * self.cable_lengths * multipliers, g, g_dot)
         if self.uses_float_kernel:
             w = wrenches.tolist()
             state, multipliers = self.rk4_floats(list(map(float, x)), w, dt)

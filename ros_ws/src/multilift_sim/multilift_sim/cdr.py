@@ -17,6 +17,8 @@ from __future__ import annotations
 import struct
 from typing import Sequence
 
+import numpy as np
+
 from multilift_sim.msgvalues import WORLD_FRAME, stamp
 from multilift_sim.scene import MarkerSpec
 
@@ -218,10 +220,14 @@ class FormationSnapshot:
         if entry is None:
             raise ValueError(f'{len(previous)} previous rotor speeds for rotor counts '
                              f'{self._counts}')
-        return entry[1].pack(ENCAPSULATION, *stamp(t_ns), *self._frame, rows, *position,
-                             rows, *velocity, rows, *euler, rows, *body_rates,
-                             *payload_position, *payload_velocity, len(self._counts),
-                             *self._counts, len(previous), *previous)
+        # one conversion to Python floats (unpacking numpy arrays element by element is slow)
+        flat = np.concatenate((position, velocity, euler, body_rates, payload_position,
+                               payload_velocity, previous)).tolist()
+        r = rows
+        return entry[1].pack(ENCAPSULATION, *stamp(t_ns), *self._frame, r, *flat[:r],
+                             r, *flat[r:2 * r], r, *flat[2 * r:3 * r], r, *flat[3 * r:4 * r],
+                             *flat[4 * r:4 * r + 6], len(self._counts), *self._counts,
+                             len(previous), *flat[4 * r + 6:])
 
 
 class RotorCommand:

@@ -39,6 +39,7 @@ THIRD_PARTY = {
     'rosbags': 'python3-rosbags', 'foxglove': 'python3-foxglove-sdk', 'dask': 'python3-dask',
     'distributed': 'python3-distributed', 'pyarrow': 'python3-pyarrow',
     'pandas': 'python3-pandas', 'psutil': 'python3-psutil', 'jinja2': 'python3-jinja2',
+    'numba': 'python3-numba',
     'zstandard': 'python3-zstandard', 'tqdm': 'python3-tqdm', 'lark': 'python3-lark',
 }
 # ROS packages imported by their own name that are the ROS runtime (not messages)

@@ -29,6 +29,7 @@ from multilift_sim.scene import (BODY_DIAMETER_ARMS, BODY_HEIGHT, CABLE_WIDTH,  
                                  FormationScene, MarkerSpec, mission_corners, tension_color)
 from multilift_sim.simulation import Snapshot
 
+
 def _point(xyz: Sequence[float]) -> Point:
     return Point(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2]))
 

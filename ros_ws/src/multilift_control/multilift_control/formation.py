@@ -335,8 +335,9 @@ class FormationFollower:
       `altitude_offset` (default: the d_z of a linear geometry, zero for the seed's):
       F_z = hover_mass (g + kp_z e - kd_z zi_dot + ki_z int e dt), e = z_d,i - z_i: the
       reference z_1 is updated in the outer loop and the damping is on the follower's own
-      vertical velocity (seed §4.3: hence the follower's lag in the climb, Fig. 4.7), the integral clamped to +-g/2 as the cascade's; the z entries of
-      the scenario's position gains. (`from_scenario` sets altitude_offset from the start: equal
+      vertical velocity (seed §4.3: hence the follower's lag in the climb, Fig. 4.7), the
+      integral clamped to +-g/2 as the cascade's; the z entries of the scenario's position
+      gains. (`from_scenario` sets altitude_offset from the start: equal
       cables cannot hold every UAV of a V of five at the leader's height.)
     - yaw held at `yaw` (default: the yaw measured at the first tick);
     - roll, pitch, thrust from Eq. 3.13 (`cascade.attitude_from_force`), then the cascade's

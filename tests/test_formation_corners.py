@@ -24,8 +24,8 @@ def _fly(name: str) -> dict:
     scenario = scenario_io.load(name)
     t, thrust, tilt, z, saturated = [], [], [], [], []
 
-    def on_tick(sim, outputs):
-        snap = sim.snapshot()
+    def on_tick(sim, snap, answers):
+        outputs = [a.output for a in answers]
         t.append(sim.t)
         thrust.append([u.vehicle.thrust_coefficient * float(np.sum(o.rotor_speeds ** 2))
                        for u, o in zip(scenario.uavs, outputs)])
@@ -33,9 +33,10 @@ def _fly(name: str) -> dict:
         z.append([u.position[2] for u in snap.uavs])
         saturated.append([bool(np.any(o.saturated)) for o in outputs])
 
-    sim = run_headless(scenario, on_tick)
-    return dict(scenario=scenario, stats=sim.stats, t=np.array(t), thrust=np.array(thrust),
-                tilt=np.array(tilt), z=np.array(z), saturated=np.array(saturated))
+    run = run_headless(scenario, on_tick)
+    return dict(scenario=scenario, stats=run.simulator.stats, t=np.array(t),
+                thrust=np.array(thrust), tilt=np.array(tilt), z=np.array(z),
+                saturated=np.array(saturated))
 
 
 @pytest.fixture(scope='module')

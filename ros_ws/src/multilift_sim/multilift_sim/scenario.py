@@ -28,6 +28,7 @@ class ScenarioError(ValueError):
 
 
 CONTROL_MODES = ('cascade', 'constant_rotor_speed')
+CABLE_MODELS = ('rigid', 'slack')  # the seed's two-way rod; pulls only (multilift_sim.slack)
 FORMATION_GEOMETRIES = ('linear', 'distance', 'v', 'circle')  # seed Table 3.1
 
 
@@ -126,6 +127,7 @@ class Scenario:
     mission: MissionConfig
     formation: FormationConfig | None = None
     warnings: tuple[str, ...] = field(default=())
+    cable_model: str = 'rigid'       # one of CABLE_MODELS
 
     @property
     def n_uavs(self) -> int:
@@ -295,6 +297,11 @@ def _scenario(data: Any, where: str) -> Scenario:
     name = top.text('name')
     description = top.text('description', '')
     top.text('frame', 'world', choices=('world',))
+    cable_model = top.text('cable_model', 'rigid', choices=CABLE_MODELS)
+    # a slack cable may start with the payload above its UAV (it falls and snaps taut)
+    release_limit = 180.0 if cable_model == 'slack' else 90.0
+    release_rule = f'must be within (-{release_limit:g}, {release_limit:g}) degrees' + (
+        '' if cable_model == 'slack' else ' (beyond 90 needs cable_model: slack)')
 
     s = top.section('simulation')
     duration = s.positive('duration')
@@ -359,8 +366,9 @@ def _scenario(data: Any, where: str) -> Scenario:
     p = top.section('payload')
     payload = PayloadConfig(mass=p.positive('mass'),
                             drag_coefficient=p.non_negative('drag_coefficient', 0.0),
-                            alpha=math.radians(p.number('alpha_deg', 0.0, lambda a: abs(a) < 90,
-                                                        'must be within (-90, 90) degrees')),
+                            alpha=math.radians(p.number('alpha_deg', 0.0,
+                                                        lambda a: abs(a) < release_limit,
+                                                        release_rule)),
                             beta=math.radians(p.number('beta_deg', 0.0, lambda a: abs(a) < 90,
                                                        'must be within (-90, 90) degrees')),
                             swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
@@ -433,8 +441,12 @@ def _scenario(data: Any, where: str) -> Scenario:
                         uavs=tuple(uavs), payload=payload, gusts=tuple(gusts), control=control,
                         mission=MissionConfig(start=start, segments=tuple(segments),
                                               reference_filter_time=reference_filter_time),
-                        formation=formation, warnings=tuple(warnings))
+                        formation=formation, warnings=tuple(warnings),
+                        cable_model=cable_model)
     _check_feasible(scenario)
+    if cable_model == 'slack' and sim.integrator != 'baumgarte':
+        raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
+                            f'baumgarte, got {sim.integrator!r}')
     return scenario
 
 

@@ -86,6 +86,7 @@ def test_leader_needs_more_thrust_in_the_climb(twin):
     z = twin.uav_positions()[:, twin.t < 2.0, 2]
     assert np.mean(z[1]) < np.mean(z[0])  # the follower lags in altitude
     assert excess['onset'] > 1.0
+    assert excess['climb'] == pytest.approx(6.14, abs=1.5)
 
 
 def test_v_leader_rotor_speed_drops_against_twin(twin, multi):

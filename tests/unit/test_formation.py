@@ -294,7 +294,8 @@ def test_follower_iteration_converges_to_the_follower_only_solution(geometry, ow
         a_i = u[i] / masses[i] - G * np.array([0, 0, 1.0])
         expected = a_leader + 2 * ALPHA * gdot[i - 1] + BETA ** 2 * g[i - 1]
         assert np.allclose(a_i[:2], expected[:2], atol=1e-8)
-        assert abs(a_i[2]) < 1e-9                               # same height, same climb rate
+        # same height: the altitude loop damps the follower's own climb rate (seed §4.3)
+        assert a_i[2] == pytest.approx(-GAINS.position_kd[2] * v[i, 2], abs=1e-9)
         assert np.linalg.norm(expected[:2] - a_leader[:2]) > 0.1  # not a trivial fixed point
     _, lam = virtual_forces(c, r, v, u, masses, G, ALPHA, BETA)
     lam = lam.reshape(n - 1, 3)
@@ -305,10 +306,12 @@ def test_follower_altitude_loop_tracks_the_leader_height():
     c, masses, (follower,) = _followers(TWIN)
     r = c.nominal_positions(np.array([0.0, 0.0, 3.0]))
     r[1, 2] = 2.5                                                # 0.5 m below the leader
-    states = [_state(r[0], [0, 0, 0.2]), _state(r[1], np.zeros(3))]
+    # the leader climbs at 0.2 m/s, the follower at 0.1 m/s: z_1 is a reference the outer loop
+    # updates, so the damping acts on the follower's own climb rate only (seed §4.3)
+    states = [_state(r[0], [0, 0, 0.2]), _state(r[1], [0, 0, 0.1])]
     u = masses[:, None] * G * np.array([0, 0, 1.0])
     force, _, _ = follower.desired_force(0.0, states, u)
-    expected = masses[1] * (G + GAINS.position_kp[2] * 0.5 + GAINS.position_kd[2] * 0.2)
+    expected = masses[1] * (G + GAINS.position_kp[2] * 0.5 - GAINS.position_kd[2] * 0.1)
     assert force[2] == pytest.approx(expected)
     force, _, _ = follower.desired_force(1.0, states, u)         # one second of integral
     assert force[2] == pytest.approx(expected + masses[1] * GAINS.position_ki[2] * 0.5)

@@ -46,9 +46,24 @@ def test_swing_release_angles():
     assert s.control.mode == 'constant_rotor_speed'
 
 
-def test_seed_inertia_warns_but_loads():
-    s = scenario_io.load('single_lift')
+@pytest.mark.parametrize('path', sorted(SCENARIOS.glob('*.yaml')), ids=lambda p: p.stem)
+def test_shipped_scenarios_load_without_a_warning(path):
+    """The seed's inertia is a documented choice of the shipped files (inertia_source: seed)."""
+    assert scenario_io.load(str(path)).warnings == ()
+
+
+def test_seed_inertia_in_a_users_file_warns_but_loads():
+    s = scenario_io.loads(_edited('single_lift', lambda d: d['vehicle'].pop('inertia_source')))
     assert any('triangle inequality' in w for w in s.warnings)
+    s = scenario_io.loads(_edited(
+        'twin_lift', lambda d: d['uavs'][1].update(inertia=[0.2, 0.9, 0.3])))
+    assert [w for w in s.warnings if 'uavs[1].inertia' in w]
+
+
+def test_inertia_source_seed_must_be_the_seeds_inertia():
+    text = _edited('single_lift', lambda d: d['vehicle'].update(inertia=[0.5, 0.5, 0.9]))
+    with pytest.raises(scenario_io.ScenarioError, match='vehicle.inertia_source'):
+        scenario_io.loads(text)
 
 
 BAD = [
@@ -64,6 +79,9 @@ BAD = [
     (lambda d: d['mission']['segments'][1].update(until=5.0), 'mission.segments[1]'),
     (lambda d: d['vehicle'].update(mass='heavy'), "vehicle.mass: 'heavy' must be a number"),
     (lambda d: d['vehicle'].update(mass=float('nan')), 'vehicle.mass: nan must be finite'),
+    (lambda d: d['mission'].update(reference_filter_time=-1.0),
+     'mission.reference_filter_time: -1.0 must be >= 0'),
+    (lambda d: d['vehicle'].update(inertia_source='cad'), "vehicle.inertia_source: 'cad'"),
     (lambda d: d['simulation'].update(integrator='euler'),
      "simulation.integrator: 'euler' must be one of baumgarte, nullspace"),
 ]

@@ -333,9 +333,11 @@ class FormationFollower:
       acceleration. u_vf has no component there, so the law is unchanged where rows act.
     - vertical: an altitude loop to z_d,i = z_1 (the leader's altitude, seed §3.2) plus
       `altitude_offset` (default: the d_z of a linear geometry, zero for the seed's):
-      F_z = hover_mass (g + kp_z e + kd_z e_dot + ki_z int e dt), e = z_d,i - z_i,
-      e_dot = z1_dot - zi_dot, the integral clamped to +-g/2 as the cascade's; the z entries of
-      the scenario's position gains. (`from_scenario` sets altitude_offset from the start: equal
+      F_z = hover_mass (g + kp_z e - kd_z zi_dot + ki_z int e dt), e = z_d,i - z_i: the
+      reference z_1 is updated in the outer loop and the damping is on the follower's own
+      vertical velocity (seed §4.3: hence the follower's lag in the climb, Fig. 4.7), the
+      integral clamped to +-g/2 as the cascade's; the z entries of the scenario's position
+      gains. (`from_scenario` sets altitude_offset from the start: equal
       cables cannot hold every UAV of a V of five at the leader's height.)
     - yaw held at `yaw` (default: the yaw measured at the first tick);
     - roll, pitch, thrust from Eq. 3.13 (`cascade.attitude_from_force`), then the cascade's
@@ -455,8 +457,12 @@ class FormationFollower:
             residual = rates = None
         dt = 0.0 if self._t_prev is None else max(0.0, t - self._t_prev)
         self._t_prev = t
-        error = r[0, 2] + self.altitude_offset - r[i, 2]   # z_d,i = z_1 (seed §3.2)
-        error_rate = v[0, 2] - v[i, 2]
+        # z_d,i = z_1 (seed §3.2, after Eq. 3.13), a reference the outer loop updates each tick:
+        # the damping acts on the follower's own climb rate, not on z_1_dot - z_i_dot, hence
+        # the follower's lag in the climb (§4.3, Fig. 4.7) and the leader's larger thrust
+        # (Fig. 4.8)
+        error = r[0, 2] + self.altitude_offset - r[i, 2]
+        error_rate = -v[i, 2]
         self.integral = float(np.clip(self.integral + self.gains.position_ki[2] * error * dt,
                                       -self.integral_limit, self.integral_limit))
         force = np.empty(3)

@@ -28,6 +28,7 @@ class ScenarioError(ValueError):
 
 
 CONTROL_MODES = ('cascade', 'constant_rotor_speed')
+CABLE_MODELS = ('rigid', 'slack')  # the seed's two-way rod; pulls only (multilift_sim.slack)
 FORMATION_GEOMETRIES = ('linear', 'distance', 'v', 'circle')  # seed Table 3.1
 
 
@@ -109,6 +110,8 @@ class MissionSegment:
 class MissionConfig:
     start: tuple[float, float, float]  # reference position at t = 0, world [m]
     segments: tuple[MissionSegment, ...]
+    # tau of the leader's reference prefilter [s] (not in the seed; 0 = the raw corners)
+    reference_filter_time: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -124,6 +127,7 @@ class Scenario:
     mission: MissionConfig
     formation: FormationConfig | None = None
     warnings: tuple[str, ...] = field(default=())
+    cable_model: str = 'rigid'       # one of CABLE_MODELS
 
     @property
     def n_uavs(self) -> int:
@@ -262,8 +266,26 @@ def _vehicle(sec: _Section, base: dict[str, Any] | None) -> MultirotorParams:
                             moment_coefficient=k_d, rotor_speed_min=w_min, rotor_speed_max=w_max)
 
 
-def _inertia_warning(where: str, key: str, inertia: tuple[float, ...]) -> list[str]:
+SEED_INERTIA = (0.957, 0.486, 0.355)  # seed Table 4.1 / 4.2 [kg m^2]
+INERTIA_SOURCES = ('given', 'seed')
+
+
+def _inertia_source(sec: _Section, inertia: tuple[float, ...], default: str = 'given') -> str:
+    """`inertia_source: seed` says the inertia is the seed's printed diag(0.957, 0.486, 0.355),
+    which breaks the triangle inequality of a rigid body, kept on purpose: no warning then.
+    Any other inertia with it is an error."""
+    source = sec.text('inertia_source', default, choices=INERTIA_SOURCES)
+    if source == 'seed' and any(abs(x - y) > 1e-12 for x, y in zip(inertia, SEED_INERTIA)):
+        raise sec.fail('inertia_source', source, f'says the inertia is the seed\'s '
+                       f'{list(SEED_INERTIA)}, but it is {list(inertia)}')
+    return source
+
+
+def _inertia_warning(where: str, key: str, inertia: tuple[float, ...],
+                     source: str = 'given') -> list[str]:
     a, b, c = inertia
+    if source == 'seed':  # the seed's printed value, a documented choice of the file
+        return []
     if a + b < c or a + c < b or b + c < a:
         return [f'{where}: {key}: {list(inertia)} breaks the triangle inequality of a rigid '
                 'body (the seed\'s own Table 4.1 value does); used as given']
@@ -275,6 +297,11 @@ def _scenario(data: Any, where: str) -> Scenario:
     name = top.text('name')
     description = top.text('description', '')
     top.text('frame', 'world', choices=('world',))
+    cable_model = top.text('cable_model', 'rigid', choices=CABLE_MODELS)
+    # a slack cable may start with the payload above its UAV (it falls and snaps taut)
+    release_limit = 180.0 if cable_model == 'slack' else 90.0
+    release_rule = f'must be within (-{release_limit:g}, {release_limit:g}) degrees' + (
+        '' if cable_model == 'slack' else ' (beyond 90 needs cable_model: slack)')
 
     s = top.section('simulation')
     duration = s.positive('duration')
@@ -298,8 +325,10 @@ def _scenario(data: Any, where: str) -> Scenario:
 
     v = top.section('vehicle')
     base_vehicle = dataclasses.asdict(_vehicle(v, None))
+    base_source = _inertia_source(v, tuple(base_vehicle['inertia']))
     v.done()
-    warnings = _inertia_warning(where, 'vehicle.inertia', tuple(base_vehicle['inertia']))
+    warnings = _inertia_warning(where, 'vehicle.inertia', tuple(base_vehicle['inertia']),
+                                base_source)
 
     # n comes from formation.n, or from the length of `uavs` (per-UAV overrides), or is 1
     n_formation = None
@@ -321,8 +350,10 @@ def _scenario(data: Any, where: str) -> Scenario:
     for i, entry in enumerate(uav_list):
         u = _Section(entry, f'uavs[{i}]', where)
         vehicle = _vehicle(u, base_vehicle)
-        if vehicle.inertia != tuple(base_vehicle['inertia']):
-            warnings += _inertia_warning(where, u.key('inertia'), vehicle.inertia)
+        source = _inertia_source(u, vehicle.inertia,
+                                 base_source if vehicle.inertia == SEED_INERTIA else 'given')
+        if vehicle.inertia != tuple(base_vehicle['inertia']) or source != base_source:
+            warnings += _inertia_warning(where, u.key('inertia'), vehicle.inertia, source)
         if i > 0 and u.has('position'):
             raise u.fail('position', u.data['position'],
                          'is not allowed: follower positions come from the formation geometry')
@@ -335,8 +366,9 @@ def _scenario(data: Any, where: str) -> Scenario:
     p = top.section('payload')
     payload = PayloadConfig(mass=p.positive('mass'),
                             drag_coefficient=p.non_negative('drag_coefficient', 0.0),
-                            alpha=math.radians(p.number('alpha_deg', 0.0, lambda a: abs(a) < 90,
-                                                        'must be within (-90, 90) degrees')),
+                            alpha=math.radians(p.number('alpha_deg', 0.0,
+                                                        lambda a: abs(a) < release_limit,
+                                                        release_rule)),
                             beta=math.radians(p.number('beta_deg', 0.0, lambda a: abs(a) < 90,
                                                        'must be within (-90, 90) degrees')),
                             swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
@@ -401,14 +433,20 @@ def _scenario(data: Any, where: str) -> Scenario:
         seg.done()
         segments.append(MissionSegment(velocity=velocity, end_time=end))
         t_prev = end
+    reference_filter_time = m.non_negative('reference_filter_time', 0.0)
     m.done()
     top.done()
 
     scenario = Scenario(name=name, description=description, source=where, simulation=sim,
                         uavs=tuple(uavs), payload=payload, gusts=tuple(gusts), control=control,
-                        mission=MissionConfig(start=start, segments=tuple(segments)),
-                        formation=formation, warnings=tuple(warnings))
+                        mission=MissionConfig(start=start, segments=tuple(segments),
+                                              reference_filter_time=reference_filter_time),
+                        formation=formation, warnings=tuple(warnings),
+                        cable_model=cable_model)
     _check_feasible(scenario)
+    if cable_model == 'slack' and sim.integrator != 'baumgarte':
+        raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
+                            f'baumgarte, got {sim.integrator!r}')
     return scenario
 
 

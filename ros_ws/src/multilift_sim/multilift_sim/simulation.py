@@ -15,6 +15,7 @@ from multilift_sim.dynamics import Integration, StateLayout, initial_state_singl
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
+from multilift_sim.slack import SlackCableModel
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import RunStatistics, payload_swing_at
 
@@ -73,8 +74,11 @@ class FormationSimulator:
                  baumgarte_beta: float | None = None):
         self.scenario = scenario
         sim = scenario.simulation
-        self.model = make_formulation(sim.integrator,
-                                      scenario.formation_params(baumgarte_alpha, baumgarte_beta))
+        params = scenario.formation_params(baumgarte_alpha, baumgarte_beta)
+        if scenario.cable_model == 'slack':  # cables that pull only (multilift_sim.slack)
+            self.model = SlackCableModel(params)
+        else:
+            self.model = make_formulation(sim.integrator, params)
         self.n = scenario.n_uavs
         self.state = initial_state(scenario)
         self.tick = 0
@@ -142,6 +146,12 @@ class FormationSimulator:
         return Snapshot(self.t_ns, uavs, self.state[6 * n:nq].copy(),
                         self.state[nq + 6 * n:].copy())
 
+    @property
+    def taut(self) -> np.ndarray:
+        """Which cables are taut, (n,) bool (always all with cable_model: rigid)."""
+        taut = getattr(self.model, 'taut', None)
+        return np.ones(self.n, dtype=bool) if taut is None else taut.copy()
+
     def cable_state(self, rotor_speeds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray,
                                                                     np.ndarray]:
         """(tension [N], g [m^2], g_dot [m^2/s]) at the current tick under `rotor_speeds`."""
@@ -202,6 +212,9 @@ class FormationSimulator:
             self.model.constraint_residuals(self.state)
         self.residuals = (g, g_dot)
         abs_g, abs_g_dot = np.abs(g), np.abs(g_dot)
+        taut = getattr(self.model, 'taut', None)
+        if taut is not None:  # the tolerances hold for taut cables only (cable_model: slack)
+            abs_g, abs_g_dot = np.where(taut, abs_g, 0.0), np.where(taut, abs_g_dot, 0.0)
         worst, worst_rate = int(np.argmax(abs_g)), int(np.argmax(abs_g_dot))
         peak, peak_rate = float(abs_g[worst]), float(abs_g_dot[worst_rate])
         stats = self.stats

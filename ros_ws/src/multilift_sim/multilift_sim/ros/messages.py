@@ -43,10 +43,12 @@ def gust(t_ns: int, velocity: np.ndarray) -> Vector3Stamped:
 
 
 def formation_state(t_ns: int, tension: np.ndarray, g: np.ndarray,
-                    g_dot: np.ndarray) -> FormationState:
+                    g_dot: np.ndarray, taut: np.ndarray | None = None) -> FormationState:
+    """`taut`: per cable (None: every cable taut, the rigid model)."""
+    taut = [True] * len(tension) if taut is None else [bool(v) for v in taut]
     msg = FormationState(cable_tension=[float(v) for v in tension],
                          constraint_position=[float(v) for v in g],
-                         constraint_velocity=[float(v) for v in g_dot])
+                         constraint_velocity=[float(v) for v in g_dot], taut=taut)
     msg.header.stamp = stamp_from_ns(t_ns)
     msg.header.frame_id = WORLD_FRAME
     return msg

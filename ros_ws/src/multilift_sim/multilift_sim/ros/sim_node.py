@@ -110,7 +110,8 @@ class SimNode(Node):
 
     def publish_formation(self, speeds: list[np.ndarray]) -> None:
         tension, g, g_dot = self.sim.cable_state(speeds)
-        self.formation_pub.publish(messages.formation_state(self.sim.t_ns, tension, g, g_dot))
+        self.formation_pub.publish(messages.formation_state(self.sim.t_ns, tension, g, g_dot,
+                                                            self.sim.taut))
         if self.sim.tick % MARKER_DECIMATION == 0:
             self.marker_pub.publish(formation_markers(self.sim.snapshot(), tension,
                                                       self.scenario, self.sim.t_ns))

@@ -147,9 +147,10 @@ def test_tracking_reference(typestore):
 def test_float_sequences(n, typestore):
     rng = np.random.default_rng(n)
     a, b, c = rng.normal(size=(3, n))
+    taut = rng.random(n) < 0.5
     packer = cdr.formation_state(n)
-    check(packer.pack(T_NS, a.tolist(), b.tolist(), c.tolist()), packer,
-          messages.formation_state(T_NS, a, b, c), typestore)
+    check(packer.pack(T_NS, a.tolist(), b.tolist(), c.tolist(), taut.tolist()), packer,
+          messages.formation_state(T_NS, a, b, c, taut), typestore)
     packer = cdr.virtual_constraint_error(n)
     check(packer.pack(T_NS, a.tolist(), b.tolist()), packer,
           messages.formation_error(T_NS, a, b), typestore)

@@ -164,18 +164,39 @@ class FloatSequences:
         self.layout, self._struct = layout, layout.compile()
 
     def pack(self, t_ns: int, *sequences: Sequence[float]) -> bytes:
+        return self._struct.pack(*self._arguments(t_ns, sequences))
+
+    def _arguments(self, t_ns: int, sequences: Sequence[Sequence[float]]) -> list:
         args = [ENCAPSULATION, *stamp(t_ns), *self._frame]
         for length, values in zip(self._lengths, sequences, strict=True):
             if len(values) != length:
                 raise ValueError(f'a sequence of {len(values)} values for a layout of {length}')
             args.append(length)
             args.extend(values)
-        return self._struct.pack(*args)
+        return args
 
 
-def formation_state(n: int) -> FloatSequences:
+class FormationState(FloatSequences):
+    """multilift_msgs/FormationState of n cables: pack(t_ns, tension, g, g_dot, taut)."""
+
+    def __init__(self, n: int, frame: str = WORLD_FRAME) -> None:
+        super().__init__((n, n, n), frame)
+        self.layout.primitive('I')
+        self.layout.primitive('?', n)
+        self._struct = self.layout.compile()
+        self._n = n
+
+    def pack(self, t_ns: int, tension: Sequence[float], g: Sequence[float],
+             g_dot: Sequence[float], taut: Sequence[bool]) -> bytes:
+        if len(taut) != self._n:
+            raise ValueError(f'{len(taut)} taut flags for {self._n} cables')
+        args = self._arguments(t_ns, (tension, g, g_dot))
+        return self._struct.pack(*args, self._n, *(bool(v) for v in taut))
+
+
+def formation_state(n: int) -> FormationState:
     """multilift_msgs/FormationState of n cables."""
-    return FloatSequences((n, n, n))
+    return FormationState(n)
 
 
 def virtual_constraint_error(m: int) -> FloatSequences:

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 
 from multilift_sim.dynamics import FormationModel, FormationParams, Integration, StateLayout
 from multilift_sim.nullspace import NullSpaceModel
+from multilift_sim.slack import SlackCableModel
 
 
 class Formulation(Protocol):
@@ -48,10 +49,19 @@ FORMULATIONS: dict[str, Callable[[FormationParams], Formulation]] = {
 }
 
 
-def make_formulation(name: str, params: FormationParams) -> Formulation:
-    """The formulation a scenario's `simulation.integrator` names (ValueError otherwise)."""
+# the formulations for cables that can go slack (`cable_model: slack`), by integrator name
+SLACK_FORMULATIONS: dict[str, Callable[[FormationParams], Formulation]] = {
+    'baumgarte': SlackCableModel,
+}
+
+
+def make_formulation(name: str, params: FormationParams,
+                     cable_model: str = 'rigid') -> Formulation:
+    """The formulation a scenario's `simulation.integrator` names for its `cable_model`
+    (ValueError otherwise)."""
+    registry = SLACK_FORMULATIONS if cable_model == 'slack' else FORMULATIONS
     try:
-        return FORMULATIONS[name](params)
+        return registry[name](params)
     except KeyError:
-        raise ValueError(f'unknown integrator {name!r}; valid integrators are '
-                         f'{", ".join(FORMULATIONS)}') from None
+        raise ValueError(f'unknown integrator {name!r} for cable_model {cable_model!r}; valid '
+                         f'integrators are {", ".join(registry)}') from None

@@ -20,7 +20,7 @@ from multilift_sim.disturbances import Gust
 from multilift_sim.dynamics import FormationParams
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.multirotor import MultirotorParams
-from multilift_sim.formulations import FORMULATIONS
+from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
 
 
 class ScenarioError(ValueError):
@@ -444,7 +444,7 @@ def _scenario(data: Any, where: str) -> Scenario:
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model)
     _check_feasible(scenario)
-    if cable_model == 'slack' and sim.integrator != 'baumgarte':
+    if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario

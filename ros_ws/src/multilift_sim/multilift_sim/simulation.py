@@ -15,7 +15,6 @@ from multilift_sim.dynamics import Integration, StateLayout, initial_state_singl
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
-from multilift_sim.slack import SlackCableModel
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import RunStatistics, payload_swing_at
 
@@ -75,10 +74,7 @@ class FormationSimulator:
         self.scenario = scenario
         sim = scenario.simulation
         params = scenario.formation_params(baumgarte_alpha, baumgarte_beta)
-        if scenario.cable_model == 'slack':  # cables that pull only (multilift_sim.slack)
-            self.model = SlackCableModel(params)
-        else:
-            self.model = make_formulation(sim.integrator, params)
+        self.model = make_formulation(sim.integrator, params, scenario.cable_model)
         self.n = scenario.n_uavs
         self.state = initial_state(scenario)
         self.tick = 0

@@ -107,14 +107,14 @@ class HeadlessBag:
                 write(error_topic, packer.pack(t_ns, answer.formation_error.tolist(),
                                                answer.formation_error_rate.tolist()), t_ns)
         self._pending = (sim.tick, snap, [a.output.rotor_speeds for a in answers],
-                         sim.residuals)
+                         sim.residuals, sim.taut)
 
     def finish_pending(self, sim: FormationSimulator) -> None:
         """Write `/formation/state` (and the markers) of the tick before: from the integration
         that left it when the simulator has moved on, else solved here (the last tick)."""
         if self._pending is None:
             return
-        tick, snap, speeds, (g, g_dot) = self._pending
+        tick, snap, speeds, (g, g_dot), taut = self._pending
         self._pending = None
         if sim.tick == tick + 1 and sim.last_step is not None:
             tension = sim.last_step.cable_tension
@@ -122,7 +122,7 @@ class HeadlessBag:
             tension, g, g_dot = sim.cable_state(speeds)
         t_ns = snap.t_ns
         self._write('/formation/state', self._state.pack(t_ns, tension.tolist(), g.tolist(),
-                                                         g_dot.tolist()), t_ns)
+                                                         g_dot.tolist(), taut.tolist()), t_ns)
         if tick % MARKER_DECIMATION == 0:
             self._scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
                                snap.payload_position, tension)

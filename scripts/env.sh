@@ -12,6 +12,12 @@ export CMAKE_PREFIX_PATH="$ML_VENV${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
 for _pkg in multilift_msgs multilift_sim multilift_control multilift_tools; do
   PYTHONPATH="$ML_INSTALL/$_pkg/lib/python3.11/site-packages${PYTHONPATH:+:$PYTHONPATH}"
 done
-export PYTHONPATH
 export LD_LIBRARY_PATH="$ML_INSTALL/multilift_msgs/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+# tf2_msgs built from ros_ws/src/tf2_msgs_fallback where the environment has none (scripts/setup)
+if [ -d "$ML_INSTALL/tf2_msgs" ]; then
+  AMENT_PREFIX_PATH="$AMENT_PREFIX_PATH:$ML_INSTALL/tf2_msgs"
+  PYTHONPATH="$PYTHONPATH:$ML_INSTALL/tf2_msgs/lib/python3.11/site-packages"
+  LD_LIBRARY_PATH="$LD_LIBRARY_PATH:$ML_INSTALL/tf2_msgs/lib"
+fi
+export PYTHONPATH
 unset _pkg

@@ -93,6 +93,27 @@ def wait_for_text(process: subprocess.Popen, text: str, timeout: float = 30.0) -
     raise AssertionError(f'no {text!r} within {timeout} s:\n{output(process)}')
 
 
+def wait_for_subscriptions(topic: str, count: int, process: subprocess.Popen,
+                           timeout: float = 30.0) -> None:
+    """Wait until `topic` has `count` subscriptions in the graph (seen by a node of this
+    process on the tools' domain)."""
+    import rclpy
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=DOMAIN)
+    node = rclpy.create_node('bag_tools_test_graph', context=context,
+                             start_parameter_services=False)
+    try:
+        deadline = time.monotonic() + timeout
+        while node.count_subscribers(topic) < count:
+            assert process.poll() is None, output(process)
+            assert time.monotonic() < deadline, f'{topic}: {node.count_subscribers(topic)} ' \
+                f'subscriptions after {timeout} s'
+            time.sleep(0.05)
+    finally:
+        node.destroy_node()
+        context.try_shutdown()
+
+
 def run_tool(tool: str, *args: str, timeout: float = 60.0) -> subprocess.CompletedProcess:
     return subprocess.run(command(tool, *args), env=ENV, capture_output=True, text=True,
                           timeout=timeout)
@@ -357,6 +378,9 @@ def test_record_play_record_gives_the_same_messages(synthetic_bag, spawn, tmp_pa
     echo = spawn(command('topic', 'echo', '/test/label', 'std_msgs/msg/String', '--once'),
                  'echo')
     wait_for_text(recorder, 'recording into')
+    # the player lives a few seconds: a subscriber that matches after it exited cannot get the
+    # latched label from anyone, so the player starts once both readers are in the graph
+    wait_for_subscriptions('/test/label', 2, echo)
     player = spawn(command('bag', 'play', str(directory), '--wait-for-subscribers'), 'play')
     assert player.wait(timeout=90) == 0, output(player)
     assert '754 messages published' in output(player)

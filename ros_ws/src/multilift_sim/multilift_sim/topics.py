@@ -19,6 +19,7 @@ ROTOR_COMMAND_TYPE = 'multilift_msgs/msg/RotorCommand'
 ATTITUDE_SETPOINT_TYPE = 'multilift_msgs/msg/AttitudeSetpoint'
 TRACKING_REFERENCE_TYPE = 'multilift_msgs/msg/TrackingReference'
 FORMATION_ERROR_TYPE = 'multilift_msgs/msg/VirtualConstraintError'
+TF_TYPE = 'tf2_msgs/msg/TFMessage'
 
 # topics of the whole run
 CLOCK = '/clock'                        # simulated time, the simulator only
@@ -27,6 +28,7 @@ PAYLOAD_GUST = '/payload/gust'          # gust velocity at the payload [m/s], wo
 FORMATION_STATE = '/formation/state'    # per cable: tension, g_i, g_i_dot
 FORMATION_SNAPSHOT = '/formation/snapshot'  # what the controllers read, one message a tick
 MARKERS = '/visualization/markers'      # the formation drawn for RViz / Foxglove
+TF = '/tf'                              # world -> uav{i}/base_link, world -> payload
 
 # leaves of the per-UAV topics /uav{i}/{leaf}
 ODOM = 'odom'                           # UAV i's state (every UAV)
@@ -41,7 +43,7 @@ UAV_TYPES = {ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
 RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
              PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
-             MARKERS: MARKER_ARRAY_TYPE}
+             MARKERS: MARKER_ARRAY_TYPE, TF: TF_TYPE}
 
 _UAV_TOPIC = re.compile(r'^/uav([1-9][0-9]*)/(' + '|'.join(UAV_TYPES) + r')$')
 

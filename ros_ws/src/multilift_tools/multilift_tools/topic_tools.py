@@ -25,6 +25,7 @@ DISCOVERY_WAIT = 3.0  # [s] longest wait for the graph (Fast DDS may take 2.5 s 
 SETTLE = 0.5  # [s] without graph change, once another node is seen, that ends the wait
 HZ_WINDOW = 10000  # messages `topic hz` averages over by default (ros2 topic hz's default)
 HZ_DEPTH = 100  # keep_last depth of `topic hz`'s subscription
+ADAPT_PERIOD = 0.2  # [s] how often `topic echo` compares its QoS with the publishers' offers
 
 
 def _spin_graph(node, until=None, timeout: float = DISCOVERY_WAIT) -> None:
@@ -89,7 +90,6 @@ def _topic_echo(node, args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f'topic echo: {error}', file=sys.stderr)
         return 1
-    qos = introspection.adapted_qos(node.get_publishers_info_by_topic(args.topic), depth=10)
     received = []
 
     def on_message(msg) -> None:
@@ -99,9 +99,17 @@ def _topic_echo(node, args: argparse.Namespace) -> int:
         sys.stdout.write(introspection.message_to_yaml(msg) + '---\n')
         sys.stdout.flush()
 
-    node.create_subscription(msg_type, args.topic, on_message, qos)
+    # QoS adapted to the publishers, and again when one appears that it would not match
+    # (a transient_local request misses a volatile publisher): a latched message is printed
+    # whichever of the publisher and this subscription came first
+    subscription = introspection.AdaptiveSubscription(node, msg_type, args.topic, on_message,
+                                                      depth=10)
+    next_check = time.monotonic() + ADAPT_PERIOD
     while rclpy.ok() and not (args.once and received):
         rclpy.spin_once(node, timeout_sec=0.1)
+        if time.monotonic() >= next_check:
+            next_check = time.monotonic() + ADAPT_PERIOD
+            subscription.adapt()
     return 0
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import array
 import importlib
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 import yaml
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSProfile,
@@ -101,3 +101,72 @@ def adapted_qos(endpoints: Iterable[Any], depth: int = RECORD_QOS_DEPTH) -> QoSP
         reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
         durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE,
         liveliness=LivelinessPolicy.AUTOMATIC)
+
+
+def compatible(offered: QoSProfile, requested: QoSProfile) -> bool:
+    """Whether a publisher offering `offered` matches a subscription requesting `requested`
+    (reliability and durability, the policies our endpoints set): a reliable request needs a
+    reliable offer, a transient_local request a transient_local offer."""
+    if (requested.reliability == ReliabilityPolicy.RELIABLE
+            and offered.reliability != ReliabilityPolicy.RELIABLE):
+        return False
+    return not (requested.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                and offered.durability != DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+class AdaptiveSubscription:
+    """A subscription whose QoS follows the publishers' offers, as `ros2 topic echo` and
+    `ros2 bag record` choose theirs (`adapted_qos`), and that follows them again when a
+    publisher appears that the current request would not match (`adapt()`, to be called on
+    graph changes or periodically): a latched topic keeps being read transient_local, and a
+    node publishing with the defaults (reliable, volatile) is still heard.
+
+    When it adapts, the new subscription is created before the old one is destroyed, so nothing
+    of the matched publishers is lost in between (a message may arrive twice then).
+    """
+
+    def __init__(self, node: Any, msg_type: type, topic: str, callback: Callable[..., None],
+                 depth: int = RECORD_QOS_DEPTH, raw: bool = False,
+                 durability: DurabilityPolicy | None = None,
+                 on_adapt: Callable[[QoSProfile], None] | None = None) -> None:
+        self.node, self.msg_type, self.topic = node, msg_type, topic
+        self.callback, self.depth, self.raw = callback, depth, raw
+        self.durability = durability
+        self.on_adapt = on_adapt
+        self.qos = self._wanted()
+        self.subscription = self._create(self.qos)
+
+    def _wanted(self) -> QoSProfile:
+        qos = adapted_qos(self.node.get_publishers_info_by_topic(self.topic), self.depth)
+        if self.durability is not None:
+            qos.durability = self.durability
+        return qos
+
+    def _create(self, qos: QoSProfile) -> Any:
+        return self.node.create_subscription(self.msg_type, self.topic, self.callback, qos,
+                                             raw=self.raw)
+
+    def matches_publishers(self) -> bool:
+        """Whether every publisher of the topic known now matches the current request."""
+        return all(compatible(info.qos_profile, self.qos)
+                   for info in self.node.get_publishers_info_by_topic(self.topic))
+
+    def adapt(self) -> bool:
+        """Re-subscribe with the QoS the publishers now allow if one of them does not match;
+        True if it did."""
+        if self.matches_publishers():
+            return False
+        qos = self._wanted()
+        old, self.subscription, self.qos = self.subscription, self._create(qos), qos
+        self.node.destroy_subscription(old)
+        if self.on_adapt is not None:
+            self.on_adapt(qos)
+        return True
+
+    def destroy(self) -> None:
+        self.node.destroy_subscription(self.subscription)
+
+
+def qos_text(qos: QoSProfile) -> str:
+    """`reliable, transient_local`: the two policies a log line names."""
+    return f'{_policy_name(qos.reliability)}, {_policy_name(qos.durability)}'

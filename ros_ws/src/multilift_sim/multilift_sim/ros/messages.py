@@ -7,14 +7,18 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
-from geometry_msgs.msg import Point, Vector3, Vector3Stamped
+from geometry_msgs.msg import Point, TransformStamped, Vector3, Vector3Stamped
 from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, FormationState,
                                 RotorCommand, TrackingReference, VirtualConstraintError)
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+from tf2_msgs.msg import TFMessage
 
 from multilift_sim import msgvalues
-from multilift_sim.ros.common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
+from multilift_sim.ros.common import (WORLD_FRAME, fill_odometry, quaternion_from_euler,
+                                      stamp_from_ns, uav_frame)
+
+PAYLOAD_FRAME = 'payload'
 
 
 def clock(t_ns: int) -> Clock:
@@ -28,7 +32,30 @@ def uav_odometry(t_ns: int, index: int, uav) -> Odometry:
 
 
 def payload_odometry(t_ns: int, position: np.ndarray, velocity: np.ndarray) -> Odometry:
-    return fill_odometry(Odometry(), t_ns, 'payload', position, velocity, None, None, None)
+    return fill_odometry(Odometry(), t_ns, PAYLOAD_FRAME, position, velocity, None, None, None)
+
+
+def _transform(t_ns: int, child: str, position: Sequence[float],
+               quaternion: Sequence[float]) -> TransformStamped:
+    msg = TransformStamped(child_frame_id=child)
+    msg.header.stamp = stamp_from_ns(t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    tr = msg.transform.translation
+    tr.x, tr.y, tr.z = (float(v) for v in position)
+    q = msg.transform.rotation
+    q.x, q.y, q.z, q.w = (float(v) for v in quaternion)
+    return msg
+
+
+def transforms(t_ns: int, snapshot) -> TFMessage:
+    """/tf of a simulation.Snapshot: world -> uav{i}/base_link (i from 1) and world -> payload
+    (no rotation), the poses of the odometry published with it."""
+    frames = [_transform(t_ns, uav_frame(i + 1), uav.position,
+                         quaternion_from_euler(*(float(a) for a in uav.euler)))
+              for i, uav in enumerate(snapshot.uavs)]
+    frames.append(_transform(t_ns, PAYLOAD_FRAME, snapshot.payload_position,
+                             (0.0, 0.0, 0.0, 1.0)))
+    return TFMessage(transforms=frames)
 
 
 def _vector(values: Sequence[float]) -> Vector3:

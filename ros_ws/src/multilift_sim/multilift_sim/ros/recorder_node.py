@@ -5,14 +5,16 @@
                   [-p flush_period:=1.0]
 
 - `topics` are subscribed at once; with `all` (default true) every other topic that has a
-  publisher is added when it appears (graph polled every 0.5 s), except /rosout,
+  publisher is added when it appears (graph polled every 0.5 s), the user's own nodes' topics
+  included, except /rosout,
   /parameter_events and hidden topics.
 - Subscriptions are raw (the CDR bytes go into the bag untouched), keep_last 1000, reliable +
   transient_local (our publishers are reliable + transient_local, so a recorder that starts late
   still gets their startup messages). Where publishers already offer less when the topic is
   subscribed, the request is lowered to match them, as rosbag2 does (`introspection.adapted_qos`);
-  a volatile or best-effort publisher that appears only later on a listed topic does not match
-  (rclpy logs the incompatible QoS).
+  a publisher that appears later and would not match (a node publishing with the defaults:
+  reliable, volatile) makes the recorder subscribe again with the lowered request
+  (`introspection.AdaptiveSubscription`, checked at every graph poll).
 - Log time: rosbag2 stamps receive (wall) time. Our simulation runs in lockstep on simulated time,
   usually faster than real time, so wall times would stretch or squeeze the run and differ from
   run to run. With `time_source` auto (default) a bag whose first message finds /clock published
@@ -95,9 +97,10 @@ class RecorderNode(Node):
         for topic, type_name in specs:
             self._subscribe(topic, type_name)
         record_all = self.get_parameter('all').value
+        self._record_all = record_all
         if record_all:
             self._discover()
-            self.create_timer(POLL_PERIOD, self._discover)
+        self.create_timer(POLL_PERIOD, self._discover)
         self.create_timer(self.get_parameter('flush_period').value, self._flush)
         self.get_logger().info(f'recording into {self.bag.directory} '
                                f'({len(specs)} listed topics, all={record_all})')
@@ -109,17 +112,23 @@ class RecorderNode(Node):
             self.get_logger().error(f'not recording {topic}: {error}')
             self._skipped.add(topic)
             return
-        qos = introspection.adapted_qos(self.get_publishers_info_by_topic(topic))
         self._types[topic] = type_name
-        self._recorded[topic] = self.create_subscription(
-            msg_type, topic, functools.partial(self._on_message, topic), qos, raw=True)
+        self._recorded[topic] = introspection.AdaptiveSubscription(
+            self, msg_type, topic, functools.partial(self._on_message, topic), raw=True,
+            on_adapt=lambda qos: self.get_logger().info(
+                f'a new publisher on {topic}: subscribed again '
+                f'({introspection.qos_text(qos)})'))
         self.get_logger().info(f'subscribed to {topic} [{type_name}] '
-                               f'({qos.reliability.name.lower()}, {qos.durability.name.lower()})')
+                               f'({introspection.qos_text(self._recorded[topic].qos)})')
 
     def _discover(self) -> None:
         for topic, types in self.get_topic_names_and_types():
-            if (topic in self._recorded or topic in self._skipped
-                    or not recording.is_recordable(topic) or self.count_publishers(topic) == 0):
+            if topic in self._recorded:
+                self._recorded[topic].adapt()
+                continue
+            if (not self._record_all or topic in self._skipped
+                    or not recording.is_recordable(topic)
+                    or self.count_publishers(topic) == 0):
                 continue
             if len(types) > 1:
                 self.get_logger().warn(f'{topic} has several types {types}; recording {types[0]}')
@@ -135,7 +144,7 @@ class RecorderNode(Node):
         if topic not in self._in_bag:
             self._add_to_bag(topic)
         self.bag.write(topic, data, self._stamp(), info['source_timestamp'])
-        subscription = self._recorded[topic]
+        subscription = self._recorded[topic].subscription
         for _ in range(TAKE_BATCH):
             with subscription.handle:
                 taken = subscription.handle.take_message(subscription.msg_type, True)

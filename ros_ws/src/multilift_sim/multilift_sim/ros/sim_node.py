@@ -2,13 +2,19 @@
 
 Each control tick it publishes `/clock`, `/formation/snapshot` (every UAV's and the payload's
 state at t and the rotor speeds applied up to t: what the controllers read, one message a tick),
-and for users, tools and bags the state at t as `/uav{i}/odom`, `/payload/odom` and
-`/payload/gust` (the gust velocity at the payload, world frame; `/visualization/markers` every
-tenth tick); it waits for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes
-`/formation/state`, and integrates to the next tick. No command within `command_timeout` wall
-seconds stops the run naming the silent UAV. Parameters: scenario (name or path), record
-(wait for a recorder), realtime (pace to the wall clock), duration (override t_max, s),
-summary_dir, progress_file.
+and for users, tools and bags the state at t as `/uav{i}/odom`, `/payload/odom`, `/tf`
+(world -> uav{i}/base_link and world -> payload, the odometry's poses) and `/payload/gust` (the
+gust velocity at the payload, world frame; `/visualization/markers` every tenth tick); it waits
+for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes `/formation/state`, and integrates
+to the next tick. No command within `command_timeout` wall seconds stops the run naming the
+silent UAV. Parameters: scenario (name or path), record (wait for a recorder), realtime (pace to
+the wall clock), duration (override t_max, s), summary_dir, progress_file, external (`uav1,uav3`:
+UAVs flown by the user's own controller nodes; before t = 0 the simulator waits for a node
+subscribing to their odometry (or to /formation/snapshot) and publishing their rotor commands),
+startup_timeout (wall seconds to wait for the graph, s; 0: STARTUP_TIMEOUT).
+
+The rotor command subscriptions adapt to the publishers' QoS (`introspection.
+AdaptiveSubscription`): any reliable publisher is heard, transient_local or volatile.
 """
 from __future__ import annotations
 
@@ -20,14 +26,17 @@ from multilift_msgs.msg import FormationSnapshot, FormationState, RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
+from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
 from multilift_sim.ros import messages
 from multilift_sim.ros.markers import formation_markers
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (MARKER_DECIMATION, PUBLISHER_QOS, STARTUP_TIMEOUT,
-                                      SUBSCRIBER_QOS, Fatal, ns_from_stamp, recorder_missing,
-                                      run_node, wait_until, write_summary)
+from multilift_sim.ros.common import (MARKER_DECIMATION, PUBLISHER_QOS, RECORDER_NODE,
+                                      STARTUP_TIMEOUT, Fatal, ns_from_stamp, parse_external,
+                                      recorder_hears, recorder_missing, run_node, wait_until,
+                                      write_summary)
+from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import uav_topic
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
@@ -41,6 +50,9 @@ class SimNode(Node):
         duration = float(self.declare_parameter('duration', 0.0).value)
         self.summary_dir = self.declare_parameter('summary_dir', '').value
         self.progress_file = self.declare_parameter('progress_file', '').value
+        external = str(self.declare_parameter('external', '').value)
+        self.startup_timeout = float(self.declare_parameter('startup_timeout', 0.0).value) \
+            or STARTUP_TIMEOUT
         if not name:
             raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
         scenario = scenario_io.load(name)
@@ -51,6 +63,10 @@ class SimNode(Node):
         self.scenario = scenario
         self.sim = FormationSimulator(scenario)
         n = scenario.n_uavs
+        try:
+            self.external = parse_external(external, n)
+        except ValueError as error:
+            raise Fatal(f'parameter "external": {error}') from None
         self.clock_pub = self.create_publisher(Clock, '/clock', PUBLISHER_QOS)
         self.odom_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, 'odom'), PUBLISHER_QOS)
                           for i in range(n)]
@@ -64,10 +80,12 @@ class SimNode(Node):
         self.gust_pub = self.create_publisher(Vector3Stamped, '/payload/gust', PUBLISHER_QOS)
         self.marker_pub = self.create_publisher(MarkerArray, '/visualization/markers',
                                                 PUBLISHER_QOS)
+        self.tf_pub = self.create_publisher(TFMessage, '/tf', PUBLISHER_QOS)
         self.commands: list[RotorCommand | None] = [None] * n
-        self.cmd_subs = [self.create_subscription(
-            RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
-            lambda msg, i=i: self._on_command(i, msg), SUBSCRIBER_QOS) for i in range(n)]
+        self.cmd_subs = [AdaptiveSubscription(
+            self, RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
+            lambda msg, i=i: self._on_command(i, msg), depth=PUBLISHER_QOS.depth)
+            for i in range(n)]
 
     def _on_command(self, index: int, msg: RotorCommand) -> None:
         if ns_from_stamp(msg.header.stamp) == self.sim.t_ns:
@@ -75,12 +93,31 @@ class SimNode(Node):
 
     def missing_peers(self) -> str | None:
         """What the lockstep still waits for before t = 0, or None."""
+        missing = []
         for i, sub in enumerate(self.cmd_subs):
-            if sub.get_publisher_count() < 1:
-                return f'a controller publishing {uav_topic(i + 1, "rotor_cmd")}'
+            sub.adapt()
+            topic = uav_topic(i + 1, 'rotor_cmd')
+            if i + 1 not in self.external:
+                if sub.subscription.get_publisher_count() < 1:
+                    missing.append(f'a controller publishing {topic}')
+                continue
+            # a user's node: it must hear the state at t = 0 (a volatile reader gets only what
+            # is published after it matched) and answer on the command topic
+            odom = uav_topic(i + 1, 'odom')
+            if not any(info.node_name != RECORDER_NODE
+                       for state in (odom, '/formation/snapshot')
+                       for info in self.get_subscriptions_info_by_topic(state)):
+                missing.append(f'the external controller of uav{i + 1} to subscribe to {odom}')
+            if sub.subscription.get_publisher_count() < 1:
+                missing.append(f'the external controller of uav{i + 1} to publish {topic}')
+            elif self.record and not recorder_hears(self, topic):
+                missing.append(f'the recorder to subscribe to {topic}')
+        if missing:
+            return '; '.join(missing)
         if self.record:
             return recorder_missing(self, [self.clock_pub, self.payload_pub, self.formation_pub,
                                            self.snapshot_pub, self.gust_pub, self.marker_pub,
+                                           self.tf_pub,
                                            *self.odom_pubs])
         return None
 
@@ -97,10 +134,16 @@ class SimNode(Node):
                                                            snap.payload_velocity))
         gust = self.sim.model.gust_velocity_at_payload(self.sim.t, self.sim.state)
         self.gust_pub.publish(messages.gust(t_ns, gust))
+        self.tf_pub.publish(messages.transforms(t_ns, snap))
 
     def wait_for_commands(self) -> None:
         deadline = time.monotonic() + self.scenario.simulation.command_timeout
+        next_adapt = time.monotonic() + 0.5
         while any(c is None for c in self.commands):
+            if time.monotonic() > next_adapt:  # a controller came back with other QoS
+                next_adapt = time.monotonic() + 0.5
+                for sub in self.cmd_subs:
+                    sub.adapt()
             if time.monotonic() > deadline:
                 silent = [f'uav{i + 1}' for i, c in enumerate(self.commands) if c is None]
                 raise Fatal(f'no rotor command from {", ".join(silent)} within '
@@ -117,7 +160,7 @@ class SimNode(Node):
                                                       self.scenario, self.sim.t_ns))
 
     def run(self) -> None:
-        wait_until(self, self.missing_peers, STARTUP_TIMEOUT)
+        wait_until(self, self.missing_peers, self.startup_timeout)
         wall_start = time.monotonic()
         last_progress = 0.0
         try:

@@ -22,5 +22,7 @@ setup(
         'console_scripts': [
             'multilift = multilift_tools.cli:main',
         ],
+        # the fixtures of multilift_tools.testing in every pytest run of a sourced workspace
+        'pytest11': ['multilift = multilift_tools.testing'],
     },
 )

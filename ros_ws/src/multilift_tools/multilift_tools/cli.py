@@ -1,6 +1,7 @@
 """`scripts/multilift`: the command line of multilift (what ros2cli and launch give elsewhere).
 
     multilift run SCENARIO [--bag DIR] [--duration S] [--realtime] [--headless]
+                           [--external uav1[,uav3,...]]
     multilift node PKG EXECUTABLE [args...]
     multilift topic list | echo TOPIC [--once] | info TOPIC
     multilift plot BAG [--out DIR] | animate BAG [--out FILE.gif] | compare BAG_A BAG_B
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import signal
 import sys
@@ -22,6 +24,7 @@ from pathlib import Path
 
 from multilift_sim import scenario as scenario_io
 from multilift_tools.launcher import Child, Supervisor, find_executable
+from multilift_sim.ros.common import parse_external
 from multilift_sim.topics import run_topics
 
 
@@ -139,6 +142,9 @@ def cmd_run(args: argparse.Namespace) -> int:
         return 2
     for warning in scenario.warnings:
         print(f'warning: {warning}', file=sys.stderr)
+    if args.startup_timeout is not None and args.startup_timeout <= 0:
+        print(f'error: --startup-timeout: {args.startup_timeout} must be > 0', file=sys.stderr)
+        return 2
     if args.duration is not None and args.duration <= 0:
         print(f'error: --duration: {args.duration} must be > 0', file=sys.stderr)
         return 2
@@ -146,7 +152,15 @@ def cmd_run(args: argparse.Namespace) -> int:
         import dataclasses
         scenario = dataclasses.replace(scenario, simulation=dataclasses.replace(
             scenario.simulation, duration=float(args.duration)))
+    try:
+        external = parse_external(args.external or '', scenario.n_uavs)
+    except ValueError as exc:
+        print(f'error: --external: {exc}', file=sys.stderr)
+        return 2
     if args.headless:
+        if external:
+            print('error: --external needs the ROS graph (not --headless)', file=sys.stderr)
+            return 2
         return _run_headless(scenario, None if args.bag is None else Path(args.bag))
     scenario_path = str(scenario_io.resolve(args.scenario).resolve())
     work = Path(tempfile.mkdtemp(prefix=f'multilift-{scenario.name}-'))
@@ -162,27 +176,44 @@ def cmd_run(args: argparse.Namespace) -> int:
     except FileNotFoundError as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2
-    sim_params = dict(common, realtime=args.realtime, progress_file=str(work / 'progress'))
+    sim_params = dict(common, realtime=args.realtime, progress_file=str(work / 'progress'),
+                      external=','.join(f'uav{i}' for i in external))
+    if args.startup_timeout is not None:
+        sim_params['startup_timeout'] = float(args.startup_timeout)
     if args.duration is not None:
         sim_params['duration'] = float(args.duration)
     children = [Child('sim_node', [str(sim_exe), *_ros_args(sim_params)],
-                      work / 'sim_node.log', 'sim'),
-                Child('leader_node', [str(leader_exe), *_ros_args(common)],
-                      work / 'leader_node.log', 'controller')]
+                      work / 'sim_node.log', 'sim')]
+    if 1 not in external:
+        children.append(Child('leader_node', [str(leader_exe), *_ros_args(common)],
+                              work / 'leader_node.log', 'controller'))
     if scenario.n_uavs > 1:
         for i in range(2, scenario.n_uavs + 1):
+            if i in external:
+                continue
             argv = [str(follower_exe), *_ros_args(dict(common, uav_index=i)),
                     '-r', f'__node:=follower{i}']
             children.append(Child(f'follower_node (uav{i})', argv,
                                   work / f'follower{i}_node.log', 'controller'))
     if record:
         _fresh_bag_dir(bag)
-        topics = [f'{name}|{kind}' for name, kind in run_topics(scenario.n_uavs)]
+        # an external controller's topics are recorded as they appear (the recorder records
+        # every topic of the graph, with the QoS their publishers offer); the simulator waits
+        # for the recorder to hear its rotor commands before t = 0
+        ours = {f'/uav{i}/{leaf}' for i in external
+                for leaf in ('rotor_cmd', 'reference', 'attitude_setpoint', 'formation_error')}
+        topics = [f'{name}|{kind}' for name, kind in run_topics(scenario.n_uavs)
+                  if name not in ours]
         children.append(Child('recorder_node', [str(recorder_exe), *_ros_args(
             {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder'))
     progress = Progress(work / 'progress', sys.stdout.isatty())
     print(f'multilift run {scenario.name}: {scenario.n_uavs} UAV(s), '
           f'{args.duration or scenario.simulation.duration:g} s, logs in {work}', flush=True)
+    if external:
+        names = ', '.join(f'uav{i}' for i in external)
+        print(f'waiting for external controllers of {names} (ROS_DOMAIN_ID '
+              f'{os.environ.get("ROS_DOMAIN_ID", "0")}): each subscribes to /uavN/odom and '
+              'answers every state with a /uavN/rotor_cmd of the same stamp', flush=True)
     outcome, dead = Supervisor(children).run(on_tick=progress)
     progress()
     progress.close()
@@ -290,6 +321,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument('--bag', help='record every topic to this rosbag2 (MCAP) directory')
     run.add_argument('--duration', type=float, help='simulated seconds (default: scenario)')
     run.add_argument('--realtime', action='store_true', help='pace to the wall clock')
+    run.add_argument('--external', metavar='uav1[,uav3,...]',
+                     help="UAVs flown by your own controller nodes: ours are not started for "
+                          "them and the simulator waits for yours (docs/external_controller.md)")
+    run.add_argument('--startup-timeout', type=float, metavar='S',
+                     help='wall seconds the simulator waits for the other nodes (default 60)')
     run.add_argument('--headless', action='store_true',
                      help='no ROS graph: the same physics and control laws in one process, '
                           'the same bag')

@@ -25,6 +25,7 @@ from geometry_msgs.msg import Vector3Stamped
 from multilift_msgs.msg import FormationSnapshot, FormationState, RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
@@ -82,9 +83,12 @@ class SimNode(Node):
                                                 PUBLISHER_QOS)
         self.tf_pub = self.create_publisher(TFMessage, '/tf', PUBLISHER_QOS)
         self.commands: list[RotorCommand | None] = [None] * n
+        # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
+        # controllers offer transient_local, which the request adapts to)
         self.cmd_subs = [AdaptiveSubscription(
             self, RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
-            lambda msg, i=i: self._on_command(i, msg), depth=PUBLISHER_QOS.depth)
+            lambda msg, i=i: self._on_command(i, msg), depth=PUBLISHER_QOS.depth,
+            durability=DurabilityPolicy.VOLATILE if i + 1 in self.external else None)
             for i in range(n)]
 
     def _on_command(self, index: int, msg: RotorCommand) -> None:

@@ -1,0 +1,94 @@
+"""`multilift run SCENARIO --external uav1` with the example leader of examples/ (built with
+colcon as a user would), through the `multilift_run` fixture of multilift_tools.testing (the
+pytest plugin a user's own tests get): the user's node, written with default QoS, flies the
+formation; the bag holds its commands; a missing node is named at the startup timeout.
+"""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+from pathlib import Path
+
+import pytest
+import yaml
+from mcap.reader import make_reader
+from multilift_msgs.msg import RotorCommand
+from nav_msgs.msg import Odometry
+from rclpy.serialization import deserialize_message
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLE = ROOT / 'examples' / 'multilift_example_leader'
+
+
+@pytest.fixture(scope='module')
+def example_install(tmp_path_factory) -> Path:
+    """examples/multilift_example_leader built with `colcon build`: its install prefix."""
+    work = tmp_path_factory.mktemp('example_ws')
+    result = subprocess.run(
+        ['colcon', 'build', '--base-paths', str(EXAMPLE), '--build-base', str(work / 'build'),
+         '--install-base', str(work / 'install'), '--event-handlers', 'console_cohesion-'],
+        cwd=work, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return work / 'install' / 'multilift_example_leader'
+
+
+def start_example_leader(prefix: Path, log: Path) -> subprocess.Popen:
+    """The example's `leader` executable, as `ros2 run` would start it from a sourced install."""
+    site = prefix / 'lib' / 'python3.11' / 'site-packages'
+    env = dict(os.environ, PYTHONPATH=f'{site}{os.pathsep}{os.environ.get("PYTHONPATH", "")}',
+               PYTHONUNBUFFERED='1')
+    return subprocess.Popen([str(prefix / 'lib' / 'multilift_example_leader' / 'leader'),
+                             '--ros-args', '-p', 'scenario:=single_lift'], env=env,
+                            stdout=open(log, 'w'), stderr=subprocess.STDOUT,
+                            stdin=subprocess.DEVNULL, start_new_session=True)
+
+
+def read_bag(bag: Path) -> dict[str, list[bytes]]:
+    [path] = bag.glob('*.mcap')
+    messages: dict[str, list[bytes]] = {}
+    with open(path, 'rb') as stream:
+        for _, channel, message in make_reader(stream).iter_messages(log_time_order=True):
+            messages.setdefault(channel.topic, []).append(message.data)
+    return messages
+
+
+def test_the_example_leader_flies_single_lift_and_is_recorded(multilift_run, example_install,
+                                                               tmp_path):
+    bag = tmp_path / 'bag'
+    run = multilift_run('single_lift', external='uav1', duration=2.0, bag=bag)
+    run.wait_for_output('waiting for external controllers of uav1')
+    leader = start_example_leader(example_install, tmp_path / 'leader.log')
+    try:
+        assert run.wait(timeout=180) == 0, run.output()
+    finally:
+        os.killpg(leader.pid, signal.SIGINT)
+        leader.wait(timeout=30)
+    assert 'leader tracking' not in run.output()  # none of our controllers ran
+    recorded = read_bag(bag)
+    commands = [deserialize_message(d, RotorCommand) for d in recorded['/uav1/rotor_cmd']]
+    states = [deserialize_message(d, Odometry) for d in recorded['/uav1/odom']]
+    assert len(states) == 201  # t = 0, 0.01, .. 2 s
+    # every state answered once by the user's node, with the state's stamp
+    assert [c.header.stamp for c in commands] == [s.header.stamp for s in states]
+    assert all(len(c.angular_velocity) == 4 and min(c.angular_velocity) > 0 for c in commands)
+    metadata = yaml.safe_load((bag / 'metadata.yaml').read_text())
+    topics = {t['topic_metadata']['name']: t['topic_metadata']
+              for t in metadata['rosbag2_bagfile_information']['topics_with_message_count']}
+    offered = topics['/uav1/rotor_cmd']['offered_qos_profiles']
+    offered = yaml.safe_load(offered) if isinstance(offered, str) else offered
+    assert [q['durability'] for q in offered] == ['volatile']  # the user's default QoS
+    assert '/tf' in topics and '/uav1/attitude_setpoint' not in topics
+
+
+def test_the_startup_timeout_names_the_missing_external_controller(multilift_run):
+    run = multilift_run('twin_lift', external='uav2', duration=1.0, startup_timeout=3.0)
+    assert run.wait(timeout=120) == 1, run.output()
+    assert ('the external controller of uav2 to subscribe to /uav2/odom; the external '
+            'controller of uav2 to publish /uav2/rotor_cmd') in run.output()
+
+
+def test_external_names_a_uav_of_the_scenario(multilift_run):
+    run = multilift_run('single_lift', external='uav2')
+    assert run.wait(timeout=60) == 2
+    assert 'uav2' in run.output() and 'uav1..uav1' in run.output()

@@ -176,8 +176,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     except FileNotFoundError as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2
-    sim_params = dict(common, realtime=args.realtime, progress_file=str(work / 'progress'),
-                      external=','.join(f'uav{i}' for i in external))
+    sim_params = dict(common, realtime=args.realtime, progress_file=str(work / 'progress'))
+    if external:
+        sim_params['external'] = ','.join(f'uav{i}' for i in external)
     if args.startup_timeout is not None:
         sim_params['startup_timeout'] = float(args.startup_timeout)
     if args.duration is not None:

@@ -1,22 +1,37 @@
 """`multilift foxglove [--port P] [--host H]`: the live ROS graph over the Foxglove WebSocket
 protocol, for the Foxglove app (Open connection -> Foxglove WebSocket -> ws://localhost:8765).
+`multilift foxglove --layout FILE SCENARIO` writes a Foxglove layout for a scenario instead.
 
 A node (`multilift_foxglove`) polls the graph every POLL_PERIOD s and subscribes raw to every
 topic that has a publisher (hidden topics and /parameter_events excepted); each topic is a
-channel of a foxglove-sdk WebSocket server (subprotocol `foxglove.sdk.v1`) with message encoding
-`cdr` and a `ros2msg` schema named `pkg/msg/Type` holding the full message definition
-(`msgdefs.message_definition`, as in our bags), so the app decodes custom messages too. The CDR
-bytes go out untouched. A topic whose publishers are gone loses its channel (the app is told);
-it comes back when a publisher does.
+channel with message encoding `cdr` and a `ros2msg` schema named `pkg/msg/Type` holding the full
+message definition (`msgdefs.message_definition`, as in our bags), so the app decodes custom
+messages too. The CDR bytes go out untouched. The WebSocket server is this module's own
+(`FoxgloveServer`, the `websockets` package, subprotocols foxglove.websocket.v1 and
+foxglove.sdk.v1): a channel is registered before it is advertised, so a client that subscribes
+as soon as it sees the advertisement is never refused; a topic without publishers for
+REMOVE_AFTER s loses its channel (the app is told) and gets it back, under the same id, when a
+publisher returns. Server info names the ROS distribution (`metadata.ROS_DISTRO`, from the
+environment, else jazzy), which the app uses to pick its ROS 2 profile.
 
-Subscriptions: keep_last SUBSCRIPTION_DEPTH, reliable and transient_local when every publisher
-offers it (`introspection.adapted_qos`), so a client that connects during a run still gets the
-last messages our publishers keep.
+Subscriptions: keep_last SUBSCRIPTION_DEPTH, QoS adapted to the publishers (reliable and
+transient_local when every publisher offers it, again when a new publisher appears:
+`introspection.AdaptiveSubscription`), so a client that connects during a run still gets the
+last messages our publishers keep. A backlog is read in batches (TAKE_BATCH), as the recorder
+does, so the bridge keeps up with a run at 10x real time.
 
-Time: while /clock has a publisher (a simulation runs) each message is stamped with the
-simulated time of the latest /clock message and the server broadcasts that time (capability
-Time), so the app's clock and plots follow simulated time as in a bag; otherwise with wall time.
-When the base changes (a run starts or ends) the server starts a new session so clients reset.
+Time: each message goes out with its own time: its header stamp (`header.stamp`, the stamp of a
+Clock, or of the first element of an array of stamped messages such as /tf and
+/visualization/markers); a message without one gets the latest /clock time while /clock has a
+publisher, else wall time. The server broadcasts the /clock time (capability Time), so the
+app's clock follows simulated time as in a bag; wall time otherwise. When the base changes (a
+run starts or ends) the server starts a new session so clients reset.
+
+Drops: each client has a queue of CLIENT_BACKLOG messages; what does not fit (a client slower
+than the run) is dropped, counted per topic and logged, and the total is printed at the end.
+Not counted: a subscription overrun (more than SUBSCRIPTION_DEPTH messages of a topic waiting
+to be taken), which the batched takes make unlikely; a message does not name its publisher, so
+gaps in publication sequence numbers cannot be told apart from another publisher's numbers.
 
 The server listens on 127.0.0.1 by default (--host 0.0.0.0 to serve other machines; the data is
 not encrypted). SIGINT or SIGTERM stops it: exit code 0; a port in use is exit code 1.
@@ -25,8 +40,13 @@ not encrypted). SIGINT or SIGTERM stops it: exit code 0; a port in use is exit c
 from __future__ import annotations
 
 import argparse
+import asyncio
+import collections
 import functools
+import json
+import os
 import signal
+import struct
 import sys
 import threading
 import time
@@ -37,10 +57,16 @@ from multilift_sim.topics import CLOCK
 DEFAULT_PORT = 8765
 DEFAULT_HOST = '127.0.0.1'
 POLL_PERIOD = 0.5  # [s] graph poll for new and vanished topics
-SUBSCRIPTION_DEPTH = 100  # keep_last depth of the raw subscriptions
+REMOVE_AFTER = 2.0  # [s] without a publisher before a topic's channel is removed
+SUBSCRIPTION_DEPTH = 1000  # keep_last depth of the raw subscriptions
+TAKE_BATCH = 256  # messages of one topic taken in one callback (see recorder_node)
+CLIENT_BACKLOG = 200_000  # messages queued for one client before drops
 TIME_BROADCAST_PERIOD = 0.02  # [s] shortest wall interval between two time broadcasts
+DROP_LOG_PERIOD = 2.0  # [s] shortest wall interval between two drop reports
 EXCLUDED_TOPICS = frozenset({'/parameter_events'})
 SUBPROTOCOL = 'foxglove.sdk.v1'
+SUBPROTOCOLS = ('foxglove.websocket.v1', SUBPROTOCOL)  # the app's, foxglove-sdk's
+MESSAGE_DATA, TIME = 0x01, 0x02  # binary opcodes (server -> client)
 
 
 def is_bridged(topic: str) -> bool:
@@ -51,39 +77,257 @@ def is_bridged(topic: str) -> bool:
 
 
 def stamp_ns(clock_ns: int | None, sim_time: bool, wall_ns: int) -> int:
-    """Log time [ns] of a message: the latest /clock time (0 before the first one) when
-    stamping with simulated time, else wall time."""
+    """Time [ns] of a message without a stamp of its own: the latest /clock time (0 before the
+    first one) when stamping with simulated time, else wall time."""
     if sim_time:
         return clock_ns or 0
     return wall_ns
 
 
+def stamp_offset(msg_type: type) -> tuple[int, bool] | None:
+    """Where a message's own time is in its CDR bytes: (offset of `sec`, whether it is the first
+    element of a sequence) for a message whose first field is a std_msgs/Header or a
+    builtin_interfaces/Time, or a sequence of such messages; None without one."""
+    from multilift_sim.ros.introspection import import_message_type
+    fields = list(msg_type.get_fields_and_field_types().values())
+    if not fields:
+        return None
+    first = fields[0]
+    if first in ('std_msgs/Header', 'builtin_interfaces/Time'):
+        return 4, False
+    if first.startswith('sequence<') and '/' in first:
+        element = first[len('sequence<'):].rstrip('>').split(',')[0]
+        package, name = element.split('/')
+        try:
+            inner = import_message_type(f'{package}/msg/{name}')
+        except ValueError:
+            return None
+        if stamp_offset(inner) == (4, False):
+            return 8, True
+    return None
+
+
+def cdr_stamp(data: bytes, where: tuple[int, bool] | None) -> int | None:
+    """The stamp [ns] at `where` (`stamp_offset`) in CDR `data`, or None (none there)."""
+    if where is None or len(data) < where[0] + 8:
+        return None
+    order = '<' if data[1] & 1 else '>'
+    offset, in_sequence = where
+    if in_sequence and struct.unpack_from(order + 'I', data, 4)[0] == 0:
+        return None
+    sec, nanosec = struct.unpack_from(order + 'iI', data, offset)
+    return sec * 1_000_000_000 + nanosec
+
+
+class _Client:
+    def __init__(self, ws: Any) -> None:
+        self.ws = ws
+        self.subscriptions: dict[int, int] = {}  # subscription id -> channel id
+        self.by_channel: dict[int, int] = {}  # channel id -> subscription id
+        self.queue: collections.deque = collections.deque()
+        self.ready = asyncio.Event()
+
+
+class FoxgloveServer:
+    """A Foxglove WebSocket protocol server (the parts a live view uses: server info,
+    advertise/unadvertise, subscribe/unsubscribe, message data, time, status), on an asyncio
+    loop in a thread of its own. `add_channel`, `remove_channel`, `log`, `broadcast_time` and
+    `clear_session` may be called from any thread."""
+
+    def __init__(self, host: str, port: int, name: str, metadata: dict[str, str],
+                 log=print) -> None:
+        self.name, self.metadata, self.log_line = name, metadata, log
+        self.channels: dict[int, dict] = {}
+        self._ids: dict[str, int] = {}  # topic -> channel id (kept, reused on return)
+        self._lock = threading.Lock()
+        self._clients: set[_Client] = set()
+        self._pending: collections.deque = collections.deque()
+        self._scheduled = False
+        self.session_id = str(time.time_ns())
+        self.dropped: collections.Counter = collections.Counter()  # topic -> messages
+        self.loop = asyncio.new_event_loop()
+        self._thread = threading.Thread(target=self.loop.run_forever, daemon=True,
+                                        name='foxglove-server')
+        self._thread.start()
+        try:
+            self._server = asyncio.run_coroutine_threadsafe(self._serve(host, port),
+                                                            self.loop).result()
+        except OSError as error:
+            self.loop.call_soon_threadsafe(self.loop.stop)
+            self._thread.join(timeout=5)
+            raise RuntimeError(str(error)) from None
+        self.port = self._server.sockets[0].getsockname()[1]
+
+    async def _serve(self, host: str, port: int):
+        from websockets.asyncio.server import serve
+        return await serve(self._handle, host, port, subprotocols=list(SUBPROTOCOLS),
+                           compression=None, max_size=None, max_queue=None)
+
+    # -- from any thread -------------------------------------------------------------------
+    def add_channel(self, topic: str, schema_name: str, schema: str) -> int:
+        """Register a channel (its id) and then advertise it."""
+        with self._lock:
+            channel_id = self._ids.setdefault(topic, len(self._ids) + 1)
+            self.channels[channel_id] = {
+                'id': channel_id, 'topic': topic, 'encoding': 'cdr', 'schemaName': schema_name,
+                'schema': schema, 'schemaEncoding': 'ros2msg'}
+        self._call(self._broadcast_json, {'op': 'advertise',
+                                          'channels': [self.channels[channel_id]]})
+        return channel_id
+
+    def remove_channel(self, channel_id: int) -> None:
+        with self._lock:
+            self.channels.pop(channel_id, None)
+        self._call(self._unadvertise, channel_id)
+
+    def log(self, channel_id: int, log_time: int, data: bytes) -> None:
+        """Send one message of a channel to every client subscribed to it."""
+        self._pending.append((channel_id, log_time, data))
+        if not self._scheduled:
+            self._scheduled = True
+            self._call(self._dispatch)
+
+    def broadcast_time(self, t_ns: int) -> None:
+        self._call(self._broadcast_binary, struct.pack('<BQ', TIME, max(0, t_ns)))
+
+    def clear_session(self) -> None:
+        """A new session id: clients reset their state (new server info)."""
+        self.session_id = str(time.time_ns())
+        self._call(self._broadcast_json, self._server_info())
+
+    def stop(self) -> None:
+        async def close() -> None:
+            self._server.close()
+            await self._server.wait_closed()
+        try:
+            asyncio.run_coroutine_threadsafe(close(), self.loop).result(timeout=5)
+        except Exception:  # noqa: BLE001 - stopping anyway
+            pass
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self._thread.join(timeout=5)
+
+    def _call(self, function, *args) -> None:
+        try:
+            self.loop.call_soon_threadsafe(function, *args)
+        except RuntimeError:  # the loop is closed: stopping
+            pass
+
+    # -- on the loop -----------------------------------------------------------------------
+    def _server_info(self) -> dict:
+        return {'op': 'serverInfo', 'name': self.name, 'capabilities': ['time'],
+                'supportedEncodings': [], 'metadata': dict(self.metadata),
+                'sessionId': self.session_id}
+
+    def _dispatch(self) -> None:
+        self._scheduled = False
+        pending, self._pending = self._pending, collections.deque()
+        for channel_id, log_time, data in pending:
+            for client in self._clients:
+                sub_id = client.by_channel.get(channel_id)
+                if sub_id is None:
+                    continue
+                if len(client.queue) >= CLIENT_BACKLOG:
+                    channel = self.channels.get(channel_id)
+                    self.dropped[channel['topic'] if channel else '?'] += 1
+                    continue
+                client.queue.append(struct.pack('<BIQ', MESSAGE_DATA, sub_id, log_time) + data)
+                client.ready.set()
+
+    def _enqueue(self, client: _Client, frame) -> None:
+        client.queue.append(frame)
+        client.ready.set()
+
+    def _broadcast_json(self, message: dict) -> None:
+        text = json.dumps(message)
+        for client in self._clients:
+            self._enqueue(client, text)
+
+    def _broadcast_binary(self, frame: bytes) -> None:
+        for client in self._clients:
+            self._enqueue(client, frame)
+
+    def _unadvertise(self, channel_id: int) -> None:
+        for client in self._clients:
+            sub_id = client.by_channel.pop(channel_id, None)
+            if sub_id is not None:
+                client.subscriptions.pop(sub_id, None)
+        self._broadcast_json({'op': 'unadvertise', 'channelIds': [channel_id]})
+
+    async def _handle(self, ws) -> None:
+        client = _Client(ws)
+        self._enqueue(client, json.dumps(self._server_info()))
+        with self._lock:
+            channels = list(self.channels.values())
+        if channels:
+            self._enqueue(client, json.dumps({'op': 'advertise', 'channels': channels}))
+        self._clients.add(client)
+        writer = asyncio.ensure_future(self._write(client))
+        try:
+            async for text in ws:
+                if isinstance(text, str):
+                    self._on_client_message(client, text)
+        except Exception:  # noqa: BLE001 - a client that went away
+            pass
+        finally:
+            self._clients.discard(client)
+            writer.cancel()
+
+    async def _write(self, client: _Client) -> None:
+        while True:
+            await client.ready.wait()
+            client.ready.clear()
+            while client.queue:
+                await client.ws.send(client.queue.popleft())
+
+    def _status(self, client: _Client, level: int, message: str) -> None:
+        self._enqueue(client, json.dumps({'op': 'status', 'level': level, 'message': message}))
+
+    def _on_client_message(self, client: _Client, text: str) -> None:
+        try:
+            message = json.loads(text)
+        except ValueError:
+            return
+        if message.get('op') == 'subscribe':
+            for sub in message.get('subscriptions', []):
+                channel_id, sub_id = sub.get('channelId'), sub.get('id')
+                if channel_id not in self.channels:
+                    self._status(client, 2, f'Unknown channel ID: {channel_id}')
+                    continue
+                client.subscriptions[sub_id] = channel_id
+                client.by_channel[channel_id] = sub_id
+        elif message.get('op') == 'unsubscribe':
+            for sub_id in message.get('subscriptionIds', []):
+                channel_id = client.subscriptions.pop(sub_id, None)
+                if channel_id is not None:
+                    client.by_channel.pop(channel_id, None)
+
+
 class FoxgloveBridge:
-    """The bridge node and its foxglove-sdk server (see the module docstring)."""
+    """The bridge node and its WebSocket server (see the module docstring)."""
 
     def __init__(self, port: int = DEFAULT_PORT, host: str = DEFAULT_HOST,
                  log=print) -> None:
-        import foxglove
         from rclpy.node import Node
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from rosgraph_msgs.msg import Clock
-        from foxglove.websocket import Capability
 
-        self._foxglove = foxglove
         self.log = log
-        self.context = foxglove.Context()
-        self.server = foxglove.start_server(
-            name='multilift', host=host, port=port, capabilities=[Capability.Time],
-            supported_encodings=['cdr'], context=self.context)
+        self.server = FoxgloveServer(host, port, 'multilift',
+                                     {'ROS_DISTRO': os.environ.get('ROS_DISTRO') or 'jazzy'},
+                                     log)
         self.node = Node('multilift_foxglove', start_parameter_services=False)
-        self.channels: dict[str, Any] = {}  # topic -> foxglove Channel
-        self.subscriptions: dict[str, Any] = {}  # topic -> rclpy Subscription
+        self.channels: dict[str, int] = {}  # topic -> channel id
+        self.subscriptions: dict[str, Any] = {}  # topic -> AdaptiveSubscription
         self.types: dict[str, str] = {}  # topic -> pkg/msg/Type
+        self._stamps: dict[str, tuple[int, bool] | None] = {}
+        self._silent_since: dict[str, float] = {}
         self._skipped: set[str] = set()
         self.clock_ns: int | None = None
         self.sim_time = False
         self.forwarded = 0
         self._last_broadcast = 0.0
+        self._last_drop_log = 0.0
+        self._reported_drops = 0
         self.node.create_subscription(
             Clock, CLOCK, self._on_clock,
             QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT,
@@ -96,6 +340,11 @@ class FoxgloveBridge:
         """The port the server listens on."""
         return self.server.port
 
+    @property
+    def dropped(self) -> int:
+        """Messages not forwarded to a client that fell CLIENT_BACKLOG messages behind."""
+        return sum(self.server.dropped.values())
+
     # -- graph -----------------------------------------------------------------------------
     def poll(self) -> None:
         """Add channels for new topics, drop those without publishers, pick the time base."""
@@ -107,14 +356,19 @@ class FoxgloveBridge:
                 self.clock_ns = None
             self.server.clear_session()
             self.log(f'time base: {"simulated (/clock)" if sim_time else "wall"}')
+        now = time.monotonic()
         for topic in list(self.channels):
-            if topic not in graph or self.node.count_publishers(topic) == 0:
+            if topic in graph and self.node.count_publishers(topic) > 0:
+                self._silent_since.pop(topic, None)
+                self.subscriptions[topic].adapt()
+            elif now - self._silent_since.setdefault(topic, now) >= REMOVE_AFTER:
                 self._remove(topic)
         for topic, types in sorted(graph.items()):
             if (topic in self.channels or topic in self._skipped or not is_bridged(topic)
                     or self.node.count_publishers(topic) == 0):
                 continue
             self._add(topic, types[0])
+        self._report_drops()
 
     def _add(self, topic: str, type_name: str) -> None:
         from multilift_sim import msgdefs
@@ -126,28 +380,42 @@ class FoxgloveBridge:
             self.log(f'not bridging {topic}: {error}')
             self._skipped.add(topic)
             return
-        schema = self._foxglove.Schema(name=type_name, encoding=msgdefs.SCHEMA_ENCODING,
-                                       data=definition.encode('utf-8'))
-        channel = self._foxglove.Channel(topic, message_encoding='cdr', schema=schema,
-                                         context=self.context)
-        qos = introspection.adapted_qos(self.node.get_publishers_info_by_topic(topic),
-                                        depth=SUBSCRIPTION_DEPTH)
-        self.channels[topic] = channel
+        self._stamps[topic] = stamp_offset(msg_type)
         self.types[topic] = type_name
-        self.subscriptions[topic] = self.node.create_subscription(
-            msg_type, topic, functools.partial(self._on_message, channel), qos, raw=True)
+        channel_id = self.server.add_channel(topic, type_name, definition)
+        self.channels[topic] = channel_id
+        self.subscriptions[topic] = introspection.AdaptiveSubscription(
+            self.node, msg_type, topic, functools.partial(self._on_message, topic, channel_id),
+            depth=SUBSCRIPTION_DEPTH, raw=True)
         self.log(f'bridging {topic} [{type_name}]')
 
     def _remove(self, topic: str) -> None:
-        self.node.destroy_subscription(self.subscriptions.pop(topic))
-        self.channels.pop(topic).close()
+        self.subscriptions.pop(topic).destroy()
+        self.server.remove_channel(self.channels.pop(topic))
         self.types.pop(topic, None)
+        self._silent_since.pop(topic, None)
         self.log(f'{topic} has no publisher any more; channel closed')
 
     # -- messages --------------------------------------------------------------------------
-    def _on_message(self, channel: Any, data: bytes) -> None:
-        channel.log(data, log_time=stamp_ns(self.clock_ns, self.sim_time, time.time_ns()))
+    def _forward(self, topic: str, channel_id: int, data: bytes) -> None:
+        stamp = cdr_stamp(data, self._stamps.get(topic))
+        if stamp is None:
+            stamp = stamp_ns(self.clock_ns, self.sim_time, time.time_ns())
+        self.server.log(channel_id, stamp, data)
         self.forwarded += 1
+
+    def _on_message(self, topic: str, channel_id: int, data: bytes) -> None:
+        self._forward(topic, channel_id, data)
+        subscription = self.subscriptions.get(topic)
+        if subscription is None:
+            return
+        handle = subscription.subscription.handle
+        for _ in range(TAKE_BATCH):
+            with handle:
+                taken = handle.take_message(subscription.msg_type, True)
+            if taken is None:
+                return
+            self._forward(topic, channel_id, taken[0])
 
     def _on_clock(self, msg: Any) -> None:
         self.clock_ns = msg.clock.sec * 1_000_000_000 + msg.clock.nanosec
@@ -156,6 +424,17 @@ class FoxgloveBridge:
             self._last_broadcast = now
             self.server.broadcast_time(self.clock_ns)
 
+    def _report_drops(self, final: bool = False) -> None:
+        dropped = self.dropped
+        now = time.monotonic()
+        if dropped != self._reported_drops and (final or now - self._last_drop_log
+                                                >= DROP_LOG_PERIOD):
+            self._last_drop_log = now
+            self._reported_drops = dropped
+            worst = self.server.dropped.most_common(3)
+            self.log(f'dropped {dropped} messages so far (' + ', '.join(
+                f'{topic}: {count}' for topic, count in worst) + ')')
+
     def broadcast_wall_time(self) -> None:
         """Tell clients the wall time when there is no simulated time."""
         if not self.sim_time:
@@ -163,6 +442,7 @@ class FoxgloveBridge:
 
     def close(self) -> None:
         """Stop the server and destroy the node."""
+        self._report_drops(final=True)
         self.server.stop()
         self.node.destroy_node()
 
@@ -218,7 +498,8 @@ def foxglove_main(argv: list[str]) -> int:
         pass
     finally:
         if bridge is not None:
-            log(f'stopped after forwarding {bridge.forwarded} messages')
+            log(f'stopped after forwarding {bridge.forwarded} messages '
+                f'({bridge.dropped} dropped)')
             bridge.close()
         rclpy.try_shutdown()
     return 0

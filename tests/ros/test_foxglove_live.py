@@ -1,0 +1,166 @@
+"""The live view of a whole run: a Foxglove WebSocket client connected to `multilift foxglove`
+before `multilift run` starts subscribes to every channel as soon as it is advertised (as the
+app does) and decodes every message with the channel's ros2msg schema (mcap_ros2's dynamic
+decoder, not our message classes). It must receive every message the run recorded, each with its
+header stamp as its time, and never be refused a subscription; the server's time follows /clock.
+At full speed and with --realtime.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import struct
+import subprocess
+import threading
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+from mcap_ros2._dynamic import generate_dynamic
+from websockets.sync.client import connect
+
+ROOT = Path(__file__).resolve().parents[2]
+MULTILIFT = ROOT / 'scripts' / 'multilift'
+TIMEOUT = 60.0  # [s] for the bridge, the run and the last messages on a loaded machine
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(('127.0.0.1', 0))
+        return probe.getsockname()[1]
+
+
+class Client:
+    """A Foxglove WebSocket client in a thread: subscribes to every advertised channel at once,
+    decodes messages with the advertised schema."""
+
+    def __init__(self, port: int) -> None:
+        deadline = time.monotonic() + TIMEOUT
+        while True:
+            try:
+                self.ws = connect(f'ws://127.0.0.1:{port}',
+                                  subprotocols=['foxglove.websocket.v1'], max_size=None)
+                break
+            except OSError:
+                assert time.monotonic() < deadline, 'the bridge does not accept connections'
+                time.sleep(0.2)
+        self.info = json.loads(self.ws.recv(timeout=TIMEOUT))
+        self.channels: dict[int, dict] = {}
+        self.decoders: dict[int, object] = {}
+        self.by_sub: dict[int, int] = {}
+        self.messages: dict[str, list] = defaultdict(list)  # topic -> [(log_time, message)]
+        self.times: list[int] = []
+        self.errors: list[str] = []
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        try:
+            for frame in self.ws:
+                if isinstance(frame, str):
+                    self._on_json(json.loads(frame))
+                elif frame[0] == 0x01:
+                    sub_id, log_time = struct.unpack_from('<IQ', frame, 1)
+                    channel = self.channels[self.by_sub[sub_id]]
+                    decoded = self.decoders[channel['id']](frame[13:])
+                    self.messages[channel['topic']].append((log_time, decoded))
+                elif frame[0] == 0x02:
+                    self.times.append(struct.unpack_from('<Q', frame, 1)[0])
+        except Exception:  # noqa: BLE001 - the connection closed at teardown
+            pass
+
+    def _on_json(self, message: dict) -> None:
+        if message['op'] == 'advertise':
+            subscriptions = []
+            for channel in message['channels']:
+                self.channels[channel['id']] = channel
+                self.decoders[channel['id']] = generate_dynamic(
+                    channel['schemaName'], channel['schema'])[channel['schemaName']]
+                self.by_sub[channel['id']] = channel['id']
+                subscriptions.append({'id': channel['id'], 'channelId': channel['id']})
+            self.ws.send(json.dumps({'op': 'subscribe', 'subscriptions': subscriptions}))
+        elif message['op'] == 'status' and message.get('level', 0) >= 2:
+            self.errors.append(message['message'])
+
+    def close(self) -> None:
+        self.ws.close()
+        self.thread.join(timeout=10)
+
+
+def recorded_counts(bag: Path) -> dict[str, int]:
+    [path] = bag.glob('*.mcap')
+    with open(path, 'rb') as stream:
+        summary = make_reader(stream).get_summary()
+    return {summary.channels[cid].topic: n
+            for cid, n in summary.statistics.channel_message_counts.items()}
+
+
+def stamp(message) -> int | None:
+    """The stamp the bridge should use: header, Clock, first element of an array."""
+    if hasattr(message, 'header'):
+        s = message.header.stamp
+    elif hasattr(message, 'clock'):
+        s = message.clock
+    elif getattr(message, 'transforms', None):
+        s = message.transforms[0].header.stamp
+    elif getattr(message, 'markers', None):
+        s = message.markers[0].header.stamp
+    else:
+        return None
+    return s.sec * 1_000_000_000 + s.nanosec
+
+
+@pytest.fixture
+def bridge(tmp_path, ros_env):
+    port = free_port()
+    log = open(tmp_path / 'bridge.log', 'w+')
+    process = subprocess.Popen([str(MULTILIFT), 'foxglove', '--port', str(port)], env=ros_env,
+                               stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                               start_new_session=True)
+    client = Client(port)
+    yield client, tmp_path / 'bridge.log', process
+    client.close()
+    if process.poll() is None:
+        os.killpg(process.pid, signal.SIGINT)
+        process.wait(timeout=30)
+    log.close()
+
+
+@pytest.mark.parametrize('scenario, duration, pace', [('twin_lift', 4.0, []),
+                                                      ('single_lift', 2.0, ['--realtime'])])
+def test_a_client_gets_every_message_of_a_run_with_its_stamp(bridge, ros_env, tmp_path,
+                                                             scenario, duration, pace):
+    client, log, process = bridge
+    assert client.info['metadata']['ROS_DISTRO'] == 'jazzy'
+    assert 'time' in client.info['capabilities']
+    bag = tmp_path / 'bag'
+    run = subprocess.run([str(MULTILIFT), 'run', scenario, '--duration', str(duration),
+                          '--bag', str(bag), *pace], env=ros_env, capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    expected = recorded_counts(bag)
+    assert '/tf' in expected
+    deadline = time.monotonic() + TIMEOUT
+    while any(len(client.messages[t]) < n for t, n in expected.items()):
+        assert time.monotonic() < deadline, (
+            {t: (len(client.messages[t]), n) for t, n in expected.items()
+             if len(client.messages[t]) != n}, log.read_text()[-3000:])
+        assert process.poll() is None, log.read_text()
+        time.sleep(0.1)
+    assert client.errors == []
+    for topic, n in expected.items():
+        got = client.messages[topic]
+        assert len(got) == n, topic
+        for log_time, message in got:
+            own = stamp(message)
+            if own is not None:
+                assert log_time == own, topic
+    clock = [log_time for log_time, _ in client.messages['/clock']]
+    assert clock == sorted(clock) and clock[-1] == int(duration * 1e9)
+    simulated = [t for t in client.times if t <= int(duration * 1e9)]  # else wall time
+    assert simulated and simulated == sorted(simulated)
+    assert 'dropped' not in log.read_text()

@@ -214,8 +214,11 @@ def _field_type(message_class, path: str) -> object:
     return kind
 
 
-def test_layout_shows_markers_in_world_and_plots_real_fields():
-    layout = json.loads((ROOT / 'docs' / 'foxglove_layout.json').read_text())
+def _check_layout(layout: dict, scenario) -> set[str]:
+    """The layout shows every panel once, the 3D panel follows world with markers and /tf, and
+    every plotted series is a real numeric field plotted against its header stamp; the
+    plotted topics."""
+    from multilift_msgs.msg import AttitudeSetpoint, TrackingReference, VirtualConstraintError
     panels = layout['configById']
 
     def leaves(node) -> list[str]:
@@ -223,21 +226,54 @@ def test_layout_shows_markers_in_world_and_plots_real_fields():
             return [node]
         return leaves(node['first']) + leaves(node['second'])
 
-    shown = leaves(layout['layout'])
-    assert sorted(shown) == sorted(panels)
+    assert sorted(leaves(layout['layout'])) == sorted(panels)
     three_d = [p for key, p in panels.items() if key.startswith('3D!')]
     assert len(three_d) == 1
     assert three_d[0]['followTf'] == 'world'
     assert three_d[0]['topics']['/visualization/markers']['visible'] is True
-    plots = {key: p for key, p in panels.items() if key.startswith('Plot!')}
-    types = {'/formation/state': FormationState, '/uav1/rotor_cmd': RotorCommand,
-             '/uav2/rotor_cmd': RotorCommand}
+    assert three_d[0]['topics']['/tf']['visible'] is True
     plotted = set()
-    for plot in plots.values():
+    for key, plot in panels.items():
+        if not key.startswith('Plot!'):
+            continue
         for series in plot['paths']:
+            assert series['timestampMethod'] == 'headerStamp'
             topic, _, path = series['value'].partition('.')
-            assert _field_type(types[topic], path) == 'sequence<double>', series['value']
+            leaf = topic.rsplit('/', 1)[1]
+            kind = {'state': FormationState, 'rotor_cmd': RotorCommand, 'odom': Odometry,
+                    'reference': TrackingReference, 'attitude_setpoint': AttitudeSetpoint,
+                    'formation_error': VirtualConstraintError}[leaf]
+            assert _field_type(kind, path) in ('double', 'sequence<double>'), series['value']
             plotted.add(topic)
-    assert plotted == set(types)
-    assert any('cable_tension' in s['value'] for p in plots.values() for s in p['paths'])
-    assert any('angular_velocity' in s['value'] for p in plots.values() for s in p['paths'])
+    for i, uav in enumerate(scenario.uavs, start=1):
+        rotors = panels[f'Plot!rotors{i}']['paths']
+        assert [s['value'] for s in rotors] == [
+            f'/uav{i}/rotor_cmd.angular_velocity[{k}]' for k in range(uav.vehicle.n_rotors)]
+    tensions = [s['value'] for s in panels['Plot!tensions']['paths']]
+    assert tensions == [f'/formation/state.cable_tension[{k}]' for k in range(scenario.n_uavs)]
+    return plotted
+
+
+def test_the_shipped_layout_is_the_twin_lift_layout():
+    from multilift_sim import scenario as scenario_io
+    from multilift_tools.foxglove_layout import layout
+    twin = scenario_io.load('twin_lift')
+    shipped = json.loads((ROOT / 'docs' / 'foxglove_layout.json').read_text())
+    assert shipped == json.loads(json.dumps(layout(twin)))
+    assert _check_layout(shipped, twin) == {
+        '/formation/state', '/uav1/rotor_cmd', '/uav2/rotor_cmd', '/uav1/reference',
+        '/uav1/odom', '/uav1/attitude_setpoint', '/uav2/attitude_setpoint',
+        '/uav2/formation_error'}
+
+
+def test_layout_of_any_scenario_from_the_command_line(tmp_path):
+    from multilift_sim import scenario as scenario_io
+    path = tmp_path / 'v5.json'
+    result = subprocess.run(bridge_command('--layout', str(path), 'v5'), env=ENV,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    v5 = scenario_io.load('v5')
+    plotted = _check_layout(json.loads(path.read_text()), v5)
+    assert {f'/uav{i}/formation_error' for i in range(2, 6)} <= plotted
+    errors = json.loads(path.read_text())['configById']['Plot!formation']['paths']
+    assert len(errors) == 4 * 3  # four followers, three rows each in the V

@@ -448,17 +448,35 @@ class FoxgloveBridge:
 
 
 def foxglove_main(argv: list[str]) -> int:
-    """`foxglove [--port P] [--host H]` (argv without the word `foxglove`); the exit code."""
+    """`foxglove [--port P] [--host H]` or `foxglove --layout FILE SCENARIO` (argv without the
+    word `foxglove`); the exit code."""
     parser = argparse.ArgumentParser(prog='multilift foxglove', description=__doc__.split('\n')[0],
                                      epilog='See the foxglove_bridge module docstring.')
     parser.add_argument('--port', type=int, default=DEFAULT_PORT,
                         help=f'TCP port (default {DEFAULT_PORT}; 0: any free port)')
     parser.add_argument('--host', default=DEFAULT_HOST,
                         help=f'address to listen on (default {DEFAULT_HOST})')
+    parser.add_argument('--layout', metavar='FILE',
+                        help='write a Foxglove layout for SCENARIO to FILE and exit')
+    parser.add_argument('scenario', nargs='?', help='with --layout: a name in scenarios/ or a '
+                                                    'YAML path')
     try:
         args = parser.parse_args(argv)
     except SystemExit as exit_:
         return int(exit_.code or 0)
+    if args.layout or args.scenario:
+        if not (args.layout and args.scenario):
+            print('foxglove: --layout FILE and SCENARIO go together', file=sys.stderr)
+            return 2
+        from multilift_sim.scenario import ScenarioError
+        from multilift_tools.foxglove_layout import write_layout
+        try:
+            print(f'foxglove: layout of {args.scenario} written to '
+                  f'{write_layout(args.layout, args.scenario)}')
+        except (ScenarioError, OSError) as error:
+            print(f'foxglove: {error}', file=sys.stderr)
+            return 2
+        return 0
     if not 0 <= args.port <= 65535:
         print(f'foxglove: --port {args.port} is not a TCP port', file=sys.stderr)
         return 2

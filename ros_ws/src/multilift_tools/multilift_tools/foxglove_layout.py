@@ -1,0 +1,105 @@
+"""A Foxglove layout for any scenario (`multilift foxglove --layout FILE SCENARIO`).
+
+The layout has the 3D panel (the markers of /visualization/markers and the tf frames of /tf,
+following `world`) beside plots, every series against its message's header stamp: every
+cable's tension, every UAV's rotor speeds (as many as its frame type has), the leader's position
+against its mission reference, every UAV's attitude set-point, and every follower's formation
+(virtual-constraint) errors.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+COLORS = ['#4e98e2', '#f5774d', '#61cbff', '#b87fd6', '#71c26a', '#f7df71', '#e96d9f',
+          '#9b9b9b']
+
+
+def _series(value: str, label: str, k: int) -> dict:
+    return {'value': value, 'enabled': True, 'timestampMethod': 'headerStamp',
+            'label': label, 'color': COLORS[k % len(COLORS)]}
+
+
+def _plot(title: str, series: list[dict]) -> dict:
+    return {'paths': series, 'minYValue': '', 'maxYValue': '', 'showXAxisLabels': True,
+            'showYAxisLabels': True, 'showLegend': True, 'legendDisplay': 'floating',
+            'showPlotValuesInLegend': True, 'isSynced': True, 'xAxisVal': 'timestamp',
+            'sidebarDimension': 240, 'foxglovePanelTitle': title}
+
+
+def _three_d(frames: list[str]) -> dict:
+    return {
+        'cameraState': {'perspective': True, 'distance': 45, 'phi': 60, 'thetaOffset': 45,
+                        'targetOffset': [0, 0, 0], 'target': [0, 0, 0],
+                        'targetOrientation': [0, 0, 0, 1], 'fovy': 45, 'near': 0.5,
+                        'far': 5000},
+        'followMode': 'follow-none', 'followTf': 'world',
+        'scene': {'enableStats': False, 'transforms': {'showLabel': True, 'axisScale': 0.5}},
+        'transforms': {f'frame:{f}': {'visible': True} for f in frames},
+        'topics': {'/visualization/markers': {'visible': True}, '/tf': {'visible': True}},
+        'layers': {'grid': {'visible': True, 'frameLocked': True, 'label': 'Grid (1 m)',
+                            'instanceId': 'grid', 'layerId': 'foxglove.Grid',
+                            'frameId': 'world', 'size': 60, 'divisions': 60, 'lineWidth': 1,
+                            'color': '#248eff40', 'position': [0, 0, 0],
+                            'rotation': [0, 0, 0], 'order': 1}},
+        'publish': {'type': 'point'}, 'imageMode': {},
+        'foxglovePanelTitle': 'Formation (world, markers and tf frames)'}
+
+
+def _stack(panels: list[str], direction: str = 'column'):
+    """A binary split tree showing `panels` in equal parts."""
+    if len(panels) == 1:
+        return panels[0]
+    half = len(panels) // 2
+    return {'direction': direction, 'splitPercentage': round(100 * half / len(panels)),
+            'first': _stack(panels[:half], direction),
+            'second': _stack(panels[half:], direction)}
+
+
+def formation_rows(scenario) -> list[int]:
+    """How many virtual-constraint errors each follower (uav2..) publishes."""
+    from multilift_control.formation import FormationFollower
+    return [len(FormationFollower.from_scenario(scenario, i).constraints.rows_of(i))
+            for i in range(1, scenario.n_uavs)]
+
+
+def layout(scenario) -> dict:
+    """The layout of `scenario` (a scenario.Scenario) as the Foxglove app reads it."""
+    n = scenario.n_uavs
+    plots: dict[str, dict] = {}
+    plots['Plot!tensions'] = _plot('Cable tension [N] (/formation/state)', [
+        _series(f'/formation/state.cable_tension[{k}]', f'cable {k + 1}', k) for k in range(n)])
+    for i, uav in enumerate(scenario.uavs, start=1):
+        role = ' (leader)' if i == 1 else ''
+        plots[f'Plot!rotors{i}'] = _plot(
+            f'Rotor speeds [rad/s], uav{i}{role} ({uav.vehicle.frame_type})', [
+                _series(f'/uav{i}/rotor_cmd.angular_velocity[{k}]', f'rotor {k + 1}', k)
+                for k in range(uav.vehicle.n_rotors)])
+    tracking = []
+    for k, axis in enumerate('xyz'):
+        tracking.append(_series(f'/uav1/reference.position.{axis}', f'reference {axis}', k))
+        tracking.append(_series(f'/uav1/odom.pose.pose.position.{axis}', f'uav1 {axis}', k + 3))
+    plots['Plot!tracking'] = _plot('Leader position and reference [m]', tracking)
+    plots['Plot!setpoints'] = _plot('Attitude set-points [rad]', [
+        _series(f'/uav{i}/attitude_setpoint.{angle}', f'uav{i} {angle}', 3 * (i - 1) + a)
+        for i in range(1, n + 1) for a, angle in enumerate(('roll', 'pitch'))])
+    if n > 1:
+        plots['Plot!formation'] = _plot('Formation errors g_vc [m]', [
+            _series(f'/uav{i}/formation_error.error[{k}]', f'uav{i} row {k + 1}', j)
+            for j, (i, k) in enumerate((i, k) for i, rows in
+                                       zip(range(2, n + 1), formation_rows(scenario))
+                                       for k in range(rows))])
+    frames = ['world', 'payload'] + [f'uav{i}/base_link' for i in range(1, n + 1)]
+    config = {'3D!multilift': _three_d(frames), **plots}
+    return {'configById': config, 'globalVariables': {}, 'userNodes': {},
+            'playbackConfig': {'speed': 1},
+            'layout': {'direction': 'row', 'splitPercentage': 55, 'first': '3D!multilift',
+                       'second': _stack(list(plots))}}
+
+
+def write_layout(path: str | Path, scenario_name: str) -> Path:
+    """Write the layout of a scenario (name or path) to `path`."""
+    from multilift_sim import scenario as scenario_io
+    path = Path(path)
+    path.write_text(json.dumps(layout(scenario_io.load(scenario_name)), indent=1) + '\n')
+    return path

@@ -90,3 +90,28 @@ def test_headless_bags_are_byte_identical(tmp_path):
         assert (first / name).read_bytes() == (second / name).read_bytes(), name
     with AnyReader([first]) as reader:
         assert {c.topic: c.msgcount for c in reader.connections}['/formation/state'] == 51
+
+
+def test_tf_is_the_odometry_at_every_tick(twin_bags):
+    """/tf: world -> uav{i}/base_link and world -> payload at every state tick, the poses of
+    the odometry, in the ROS bag and the headless bag alike."""
+    for bag in twin_bags:
+        poses: dict[tuple[str, int], tuple] = {}
+        frames: dict[tuple[str, int], tuple] = {}
+        with AnyReader([bag]) as reader:
+            wanted = [c for c in reader.connections
+                      if c.topic in ('/tf', '/uav1/odom', '/uav2/odom', '/payload/odom')]
+            for connection, _, raw in reader.messages(connections=wanted):
+                msg = reader.deserialize(raw, connection.msgtype)
+                if connection.topic == '/tf':
+                    for tf in msg.transforms:
+                        t = tf.header.stamp.sec * 10**9 + tf.header.stamp.nanosec
+                        assert tf.header.frame_id == 'world'
+                        p, q = tf.transform.translation, tf.transform.rotation
+                        frames[tf.child_frame_id, t] = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
+                else:
+                    t = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+                    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+                    poses[msg.child_frame_id, t] = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
+        assert len(poses) == 3 * 601
+        assert frames == poses

@@ -9,6 +9,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 
 import pytest
 import rclpy
@@ -118,6 +119,41 @@ def test_echo_once_prints_the_latched_message(publishers):
     assert data['child_frame_id'] == 'uav1/base_link'
     assert data['pose']['pose']['position']['z'] == 2.5
     assert data['pose']['covariance'] == [0.0] * 35 + [0.25]
+
+
+def _echo_process(topic: str, type_name: str) -> subprocess.Popen:
+    return subprocess.Popen([str(ROOT / 'scripts' / 'multilift'), 'topic', 'echo', topic,
+                             type_name, '--once'], env=ENV, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+
+
+@pytest.mark.parametrize('qos, leaf', [(LATCHED, 'latched'), (10, 'volatile')])
+def test_echo_started_first_prints_what_a_later_publisher_sends(publishers, qos, leaf):
+    """The subscription comes first (no publisher known: reliable, transient_local); then a
+    latched publisher sends once, or a publisher with the defaults (volatile: it does not
+    match that request, so echo subscribes again) keeps sending: echo prints it either way."""
+    topic = f'/tools_test/late_{leaf}'
+    echo = _echo_process(topic, 'std_msgs/msg/Int64')
+    try:
+        deadline = time.monotonic() + 30
+        while publishers.count_subscribers(topic) < 1:  # echo has subscribed
+            assert echo.poll() is None, echo.communicate()
+            assert time.monotonic() < deadline, 'echo never subscribed'
+            time.sleep(0.05)
+        publisher = publishers.create_publisher(Int64, topic, qos)
+        publisher.publish(Int64(data=7))
+        while echo.poll() is None:
+            assert time.monotonic() < deadline, 'echo printed nothing'
+            if qos == 10:  # a volatile message reaches only readers matched when it is sent
+                publisher.publish(Int64(data=7))
+            time.sleep(0.1)
+        out, err = echo.communicate()
+        assert echo.returncode == 0, err
+        assert out == 'data: 7\n---\n'
+    finally:
+        if echo.poll() is None:
+            os.killpg(echo.pid, 9)
+            echo.wait()
 
 
 def test_echo_of_an_unknown_topic_says_so():

@@ -84,8 +84,8 @@ def test_the_example_leader_flies_single_lift_and_is_recorded(multilift_run, exa
 def test_the_startup_timeout_names_the_missing_external_controller(multilift_run):
     run = multilift_run('twin_lift', external='uav2', duration=1.0, startup_timeout=3.0)
     assert run.wait(timeout=120) == 1, run.output()
-    assert ('the external controller of uav2 to subscribe to /uav2/odom; the external '
-            'controller of uav2 to publish /uav2/rotor_cmd') in run.output()
+    assert ('waiting for the external controller of uav2 to subscribe to /uav2/odom; the '
+            'external controller of uav2 to publish /uav2/rotor_cmd') in run.output()
 
 
 def test_external_names_a_uav_of_the_scenario(multilift_run):

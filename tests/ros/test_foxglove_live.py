@@ -115,6 +115,13 @@ def stamp(message) -> int | None:
 
 
 @pytest.fixture
+def ros_env(multilift_domain) -> dict:
+    """The test's own domain (multilift_tools.testing: MULTILIFT_TEST_DOMAIN when given), so no
+    other run on this machine shows up in the bridge."""
+    return dict(os.environ)
+
+
+@pytest.fixture
 def bridge(tmp_path, ros_env):
     port = free_port()
     log = open(tmp_path / 'bridge.log', 'w+')

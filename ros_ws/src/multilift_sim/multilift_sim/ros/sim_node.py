@@ -10,7 +10,7 @@ to the next tick. No command within `command_timeout` wall seconds stops the run
 silent UAV. Parameters: scenario (name or path), record (wait for a recorder), realtime (pace to
 the wall clock), duration (override t_max, s), summary_dir, progress_file, external (`uav1,uav3`:
 UAVs flown by the user's own controller nodes; before t = 0 the simulator waits for a node
-subscribing to their odometry (or to /formation/snapshot) and publishing their rotor commands),
+subscribing to their odometry and publishing their rotor commands),
 startup_timeout (wall seconds to wait for the graph, s; 0: STARTUP_TIMEOUT).
 
 The rotor command subscriptions adapt to the publishers' QoS (`introspection.
@@ -109,8 +109,7 @@ class SimNode(Node):
             # is published after it matched) and answer on the command topic
             odom = uav_topic(i + 1, 'odom')
             if not any(info.node_name != RECORDER_NODE
-                       for state in (odom, '/formation/snapshot')
-                       for info in self.get_subscriptions_info_by_topic(state)):
+                       for info in self.get_subscriptions_info_by_topic(odom)):
                 missing.append(f'the external controller of uav{i + 1} to subscribe to {odom}')
             if sub.subscription.get_publisher_count() < 1:
                 missing.append(f'the external controller of uav{i + 1} to publish {topic}')

@@ -17,8 +17,10 @@ environment, else jazzy), which the app uses to pick its ROS 2 profile.
 Subscriptions: keep_last SUBSCRIPTION_DEPTH, QoS adapted to the publishers (reliable and
 transient_local when every publisher offers it, again when a new publisher appears:
 `introspection.AdaptiveSubscription`), so a client that connects during a run still gets the
-last messages our publishers keep. A backlog is read in batches (TAKE_BATCH), as the recorder
-does, so the bridge keeps up with a run at 10x real time.
+last messages our publishers keep; and a new subscription first gets the last REPLAY messages
+the channel carried (so the messages that arrive between the advertisement and the client's
+subscribe are not lost, and a client that subscribes late sees the recent past). A backlog is
+read in batches (TAKE_BATCH), as the recorder does, so the bridge keeps up with a fast run.
 
 Time: each message goes out with its own time: its header stamp (`header.stamp`, the stamp of a
 Clock, or of the first element of an array of stamped messages such as /tf and
@@ -61,6 +63,7 @@ REMOVE_AFTER = 2.0  # [s] without a publisher before a topic's channel is remove
 SUBSCRIPTION_DEPTH = 1000  # keep_last depth of the raw subscriptions
 TAKE_BATCH = 256  # messages of one topic taken in one callback (see recorder_node)
 CLIENT_BACKLOG = 200_000  # messages queued for one client before drops
+REPLAY = 1000  # last messages of a channel a new subscription gets first (as transient_local)
 TIME_BROADCAST_PERIOD = 0.02  # [s] shortest wall interval between two time broadcasts
 DROP_LOG_PERIOD = 2.0  # [s] shortest wall interval between two drop reports
 EXCLUDED_TOPICS = frozenset({'/parameter_events'})
@@ -142,6 +145,7 @@ class FoxgloveServer:
         self._lock = threading.Lock()
         self._clients: set[_Client] = set()
         self._pending: collections.deque = collections.deque()
+        self._history: dict[int, collections.deque] = {}  # channel id -> (log_time, data)
         self._scheduled = False
         self.session_id = str(time.time_ns())
         self.dropped: collections.Counter = collections.Counter()  # topic -> messages
@@ -222,6 +226,10 @@ class FoxgloveServer:
         self._scheduled = False
         pending, self._pending = self._pending, collections.deque()
         for channel_id, log_time, data in pending:
+            history = self._history.get(channel_id)
+            if history is None:
+                history = self._history[channel_id] = collections.deque(maxlen=REPLAY)
+            history.append((log_time, data))
             for client in self._clients:
                 sub_id = client.by_channel.get(channel_id)
                 if sub_id is None:
@@ -247,6 +255,7 @@ class FoxgloveServer:
             self._enqueue(client, frame)
 
     def _unadvertise(self, channel_id: int) -> None:
+        self._history.pop(channel_id, None)
         for client in self._clients:
             sub_id = client.by_channel.pop(channel_id, None)
             if sub_id is not None:
@@ -295,6 +304,13 @@ class FoxgloveServer:
                     continue
                 client.subscriptions[sub_id] = channel_id
                 client.by_channel[channel_id] = sub_id
+                # what the channel carried before this subscription (a client subscribes a
+                # moment after the advertisement, when the publishers' kept messages may have
+                # arrived already): the last REPLAY messages, then the live ones
+                for log_time, data in self._history.get(channel_id, ()):
+                    client.queue.append(struct.pack('<BIQ', MESSAGE_DATA, sub_id, log_time)
+                                        + data)
+                client.ready.set()
         elif message.get('op') == 'unsubscribe':
             for sub_id in message.get('subscriptionIds', []):
                 channel_id = client.subscriptions.pop(sub_id, None)

@@ -37,6 +37,7 @@ THIRD_PARTY = {
     'matplotlib': 'python3-matplotlib', 'mpl_toolkits': 'python3-matplotlib',
     'PIL': 'python3-pil', 'mcap': 'python3-mcap', 'mcap_ros2': 'python3-mcap-ros2-support',
     'rosbags': 'python3-rosbags', 'foxglove': 'python3-foxglove-sdk', 'dask': 'python3-dask',
+    'websockets': 'python3-websockets', 'pytest': 'python3-pytest',
     'distributed': 'python3-distributed', 'pyarrow': 'python3-pyarrow',
     'pandas': 'python3-pandas', 'psutil': 'python3-psutil', 'jinja2': 'python3-jinja2',
     'numba': 'python3-numba',

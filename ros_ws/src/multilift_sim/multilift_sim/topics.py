@@ -79,3 +79,17 @@ def run_topics(n_uavs: int) -> list[tuple[str, str]]:
         if i > 1:
             topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
     return topics
+
+
+def parse_external(text: str, n_uavs: int) -> list[int]:
+    """`uav1,uav3` (or `1,3`) -> [1, 3]: the UAVs whose controllers are the user's own."""
+    indices = []
+    for part in (p.strip() for p in text.split(',')):
+        if not part:
+            continue
+        digits = part[3:] if part.startswith('uav') else part
+        if not digits.isdigit() or not 1 <= int(digits) <= n_uavs:
+            raise ValueError(f'external UAV {part!r} is not one of uav1..uav{n_uavs}')
+        if int(digits) not in indices:
+            indices.append(int(digits))
+    return sorted(indices)

@@ -24,8 +24,7 @@ from pathlib import Path
 
 from multilift_sim import scenario as scenario_io
 from multilift_tools.launcher import Child, Supervisor, find_executable
-from multilift_sim.ros.common import parse_external
-from multilift_sim.topics import run_topics
+from multilift_sim.topics import parse_external, run_topics
 
 
 def _ros_args(params: dict) -> list[str]:

@@ -120,20 +120,6 @@ def recorder_hears(node: Node, topic: str) -> bool:
     return bool(readers) and all(any(compatible(w, r) for r in readers) for w in writers)
 
 
-def parse_external(text: str, n_uavs: int) -> list[int]:
-    """`uav1,uav3` (or `1,3`) -> [1, 3]: the UAVs whose controllers are the user's own."""
-    indices = []
-    for part in (p.strip() for p in text.split(',')):
-        if not part:
-            continue
-        digits = part[3:] if part.startswith('uav') else part
-        if not digits.isdigit() or not 1 <= int(digits) <= n_uavs:
-            raise ValueError(f'external UAV {part!r} is not one of uav1..uav{n_uavs}')
-        if int(digits) not in indices:
-            indices.append(int(digits))
-    return sorted(indices)
-
-
 def controller_peers_missing(node: Node, command_publisher, record: bool) -> str | None:
     """What a controller node waits for before it answers: the simulator subscribed to its rotor
     commands and, when recording, the recorder subscribed to every topic it publishes."""

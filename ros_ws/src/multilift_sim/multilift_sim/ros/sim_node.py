@@ -34,11 +34,10 @@ from multilift_sim.ros import messages
 from multilift_sim.ros.markers import formation_markers
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (MARKER_DECIMATION, PUBLISHER_QOS, RECORDER_NODE,
-                                      STARTUP_TIMEOUT, Fatal, ns_from_stamp, parse_external,
-                                      recorder_hears, recorder_missing, run_node, wait_until,
-                                      write_summary)
+                                      STARTUP_TIMEOUT, Fatal, ns_from_stamp, recorder_hears,
+                                      recorder_missing, run_node, wait_until, write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import uav_topic
+from multilift_sim.topics import parse_external, uav_topic
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 

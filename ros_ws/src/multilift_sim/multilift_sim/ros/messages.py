@@ -15,8 +15,10 @@ from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
 from multilift_sim import msgvalues
-from multilift_sim.ros.common import (WORLD_FRAME, fill_odometry, quaternion_from_euler,
-                                      stamp_from_ns, uav_frame)
+from multilift_sim.kinematics import quaternion_from_euler
+from multilift_sim.ros.common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
+
+PAYLOAD_FRAME = 'payload'
 
 PAYLOAD_FRAME = 'payload'
 
@@ -51,7 +53,7 @@ def transforms(t_ns: int, snapshot) -> TFMessage:
     """/tf of a simulation.Snapshot: world -> uav{i}/base_link (i from 1) and world -> payload
     (no rotation), the poses of the odometry published with it."""
     frames = [_transform(t_ns, uav_frame(i + 1), uav.position,
-                         quaternion_from_euler(*(float(a) for a in uav.euler)))
+                         quaternion_from_euler(uav.euler))
               for i, uav in enumerate(snapshot.uavs)]
     frames.append(_transform(t_ns, PAYLOAD_FRAME, snapshot.payload_position,
                              (0.0, 0.0, 0.0, 1.0)))

@@ -38,6 +38,10 @@ def test_payload_released_above_its_uav_falls_freely_then_snaps_taut():
                                                                           abs=1e-9)
             slack_ticks += 1
     assert slack_ticks > 10
+    # the run statistics count the slack time (at least the whole-tick free fall seen here)
+    period = scenario.simulation.control_period
+    assert sim.stats.slack_time[0] >= slack_ticks * period - 1e-9
+    assert sim.stats.slack_time[0] < scenario.simulation.duration
     assert sim.taut[0]  # it fell below the UAV and snapped taut
     g_now, _ = sim.model.constraint_residuals(sim.state)
     assert abs(g_now[0]) < scenario.simulation.constraint_tolerance

@@ -26,7 +26,7 @@ def typestore():
                  'multilift_msgs/msg/AttitudeSetpoint', 'multilift_msgs/msg/TrackingReference',
                  'multilift_msgs/msg/VirtualConstraintError', 'multilift_msgs/msg/FormationState',
                  'visualization_msgs/msg/MarkerArray', 'geometry_msgs/msg/TransformStamped',
-                 'multilift_msgs/msg/FormationSnapshot'):
+                 'multilift_msgs/msg/FormationSnapshot', 'tf2_msgs/msg/TFMessage'):
         store.register(get_types_from_msg(msgdefs.message_definition(name), name))
     return store
 

@@ -16,6 +16,7 @@ from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.markers import (BODY_DIAMETER_ARMS, FormationMarkers, formation_markers,
                                    mission_corners, tension_color)
 from multilift_sim.simulation import FormationSimulator
+from multilift_sim.scene import CABLE_SEGMENTS
 
 
 @pytest.fixture(scope='module')
@@ -77,12 +78,27 @@ def test_bodies_cables_and_payload_follow_the_snapshot(twin):
         assert np.allclose(_rotation(heading.pose.orientation) @ [1, 0, 0],
                            uav.rotation[:, 0])  # the arrow points along body x
         cable = markers[('cable', i)]
-        assert cable.type == Marker.LINE_STRIP and len(cable.points) == 2
-        assert np.allclose(xyz(cable.points[0]), uav.position)
-        assert np.allclose(xyz(cable.points[1]), snapshot.payload_position)
-        length = np.linalg.norm(xyz(cable.points[1]) - xyz(cable.points[0]))
+        assert cable.type == Marker.LINE_LIST and len(cable.points) == 2 * CABLE_SEGMENTS
+        points = np.array([xyz(p) for p in cable.points])
+        assert np.allclose(points[0], uav.position)
+        assert np.allclose(points[-1], snapshot.payload_position)
+        # taut: the segments join end to end into one solid line
+        assert np.allclose(points[1:-1:2], points[2::2])
+        length = np.linalg.norm(points[-1] - points[0])
         assert length == pytest.approx(scenario.uavs[i - 1].cable_length, rel=1e-3)
     assert not np.allclose(snapshot.uavs[0].euler, 0.0)  # the check above saw an attitude
+
+
+def test_a_slack_cable_is_dashed(twin):
+    scenario, snapshot = twin
+    markers = by_key(formation_markers(snapshot, [0.0, 5.0], scenario, 0, taut=[False, True]))
+    slack = np.array([xyz(p) for p in markers[('cable', 1)].points])
+    taut = np.array([xyz(p) for p in markers[('cable', 2)].points])
+    gaps = np.linalg.norm(slack[2::2] - slack[1:-1:2], axis=1)
+    dashes = np.linalg.norm(slack[1::2] - slack[::2], axis=1)
+    assert np.allclose(gaps, dashes[1:]) and np.all(gaps > 0)   # half drawn, half gap
+    assert np.allclose(slack[0], snapshot.uavs[0].position)
+    assert np.allclose(taut[1:-1:2], taut[2::2])             # the other cable stays solid
 
 
 def test_cables_coloured_by_tension():

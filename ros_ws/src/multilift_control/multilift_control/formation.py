@@ -360,7 +360,7 @@ class FormationFollower:
                              f'{free_mode_gain!r}')
         self.own_thrust = own_thrust
         self.free_mode_gain = free_mode_gain
-        self.thrust_coefficient = vehicle.thrust_coefficient
+        self.vehicle = vehicle
         self.index = index
         self.constraints = constraints
         self.masses = np.asarray(masses, dtype=float).reshape(constraints.n)
@@ -502,6 +502,6 @@ class FormationFollower:
             self.yaw = float(state.euler[2])  # hold the initial heading
         out = self.cascade.command(state, force, self.yaw)  # Eq. 3.13, attitude loop, mixer
         # what the rotors will give after saturation, along the thrust axis asked for
-        thrust = self.thrust_coefficient * float(np.sum(out.rotor_speeds ** 2))
+        thrust = self.vehicle.collective_thrust(out.rotor_speeds)
         self.lift = _thrust_axis(*out.attitude_setpoint.tolist()) * thrust
         return out, errors, rates

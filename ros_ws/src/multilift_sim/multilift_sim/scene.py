@@ -9,7 +9,8 @@ markers (world frame, z up, metres):
 - ns `uav`, id i (1 = leader), CYLINDER: the UAV body, a disc BODY_DIAMETER_ARMS arm lengths
   across and BODY_HEIGHT thick, at the UAV's pose;
 - ns `uav_heading`, id i, ARROW: the body x axis (front), 2 arm lengths long;
-- ns `cable`, id i, LINE_STRIP: UAV i's centre of mass to the payload, coloured by tension;
+- ns `cable`, id i, LINE_LIST of CABLE_SEGMENTS segments: UAV i's centre of mass to the
+  payload, coloured by tension; solid while taut, dashed while slack (`cable_model: slack`);
 - ns `payload`, id 0, SPHERE: the payload, PAYLOAD_DIAMETER across;
 - ns `mission_path`, id 0, LINE_STRIP: the leader's reference path through the corners of
   `scenario.mission` (start, then the end of each segment);
@@ -34,12 +35,13 @@ PAYLOAD_DIAMETER = 0.3  # [m] drawn size of the payload (the model's payload is 
 BODY_DIAMETER_ARMS = 2.6  # UAV disc diameter in arm lengths
 BODY_HEIGHT = 0.06  # [m] UAV disc thickness
 CABLE_WIDTH = 0.03  # [m] line width of a cable
+CABLE_SEGMENTS = 8  # a cable is drawn as this many segments: end to end (taut) or half (slack)
 PATH_WIDTH = 0.05  # [m] line width of the mission path
 GUST_ALPHA = 0.15  # opacity of a gust zone
 GUST_MARGIN = 1.0  # [m] a gust zone reaches this far above and below the payload's heights
 
 # visualization_msgs/Marker types and action used here
-ARROW, SPHERE, CYLINDER, LINE_STRIP = 0, 2, 3, 4
+ARROW, SPHERE, CYLINDER, LINE_STRIP, LINE_LIST = 0, 2, 3, 4, 5
 ADD = 0
 
 _LEADER = (0.95, 0.55, 0.05)  # orange
@@ -116,6 +118,18 @@ def _static_specs(scenario: Scenario) -> list[MarkerSpec]:
     return specs
 
 
+def _cable_points(start: tuple[float, float, float], end: tuple[float, float, float],
+                  taut: bool) -> list[tuple[float, float, float]]:
+    """The LINE_LIST points of a cable from `start` to `end`: CABLE_SEGMENTS segments end to
+    end when taut, each half its length (a dashed line) when slack."""
+    fill = 1.0 if taut else 0.5
+    points = []
+    for k in range(CABLE_SEGMENTS):
+        for s in (k / CABLE_SEGMENTS, (k + fill) / CABLE_SEGMENTS):
+            points.append(tuple(a + s * (b - a) for a, b in zip(start, end)))
+    return points
+
+
 class FormationScene:
     """The marker specs of one scenario, in MarkerArray order: per UAV body, heading, cable;
     then the payload, the mission path and the gust zones. `update` rewrites the moving parts."""
@@ -136,9 +150,9 @@ class FormationScene:
                                             scale=(2.0 * arm, 0.25 * arm, 0.25 * arm),
                                             color=_rgba(rgb)))
             self.cables.append(MarkerSpec(
-                'cable', i + 1, LINE_STRIP, scale=(CABLE_WIDTH, 0.0, 0.0),
+                'cable', i + 1, LINE_LIST, scale=(CABLE_WIDTH, 0.0, 0.0),
                 color=_rgba(tension_color(0.0, self.reference_tension)),
-                points=[(0.0, 0.0, 0.0), (0.0, 0.0, 0.0)]))
+                points=[(0.0, 0.0, 0.0)] * (2 * CABLE_SEGMENTS)))
         self.payload = MarkerSpec('payload', 0, SPHERE, scale=(PAYLOAD_DIAMETER,) * 3,
                                   color=_rgba(_PAYLOAD))
         self.specs = ([m for trio in zip(self.bodies, self.headings, self.cables)
@@ -150,9 +164,11 @@ class FormationScene:
 
     def update(self, uav_positions: Sequence[Sequence[float]],
                uav_euler: Sequence[Sequence[float]], payload_position: Sequence[float],
-               tensions: Sequence[float]) -> list[MarkerSpec]:
+               tensions: Sequence[float],
+               taut: Sequence[bool] | None = None) -> list[MarkerSpec]:
         """Write one tick's formation into the specs (UAV positions [m] and ZYX Euler angles
-        [rad], payload position [m], cable tensions [N]); returns `specs`."""
+        [rad], payload position [m], cable tensions [N], which cables are taut: None for
+        all); returns `specs`."""
         n = self.n_uavs
         if len(uav_positions) != n or len(tensions) != n:
             raise ValueError(f'formation_markers: scenario {self.scenario.name} has {n} UAVs, '
@@ -161,13 +177,16 @@ class FormationScene:
         payload = (float(payload_position[0]), float(payload_position[1]),
                    float(payload_position[2]))
         self.payload.position[:] = payload
-        for position, euler, tension, body, heading, cable in zip(
-                uav_positions, uav_euler, tensions, self.bodies, self.headings, self.cables):
+        if taut is None:
+            taut = [True] * n
+        for position, euler, tension, is_taut, body, heading, cable in zip(
+                uav_positions, uav_euler, tensions, taut, self.bodies, self.headings,
+                self.cables):
             xyz = (float(position[0]), float(position[1]), float(position[2]))
             body.position[:] = xyz
             body.orientation[:] = quaternion(euler)
             heading.position[:] = xyz
             heading.orientation[:] = body.orientation
-            cable.points[0], cable.points[1] = xyz, payload
+            cable.points[:] = _cable_points(xyz, payload, bool(is_taut))
             cable.color[:3] = tension_color(float(tension), self.reference_tension)
         return self.specs

@@ -165,6 +165,8 @@ class FormationSimulator:
         self.state = step.state
         self.last_step = step
         self.stats.add_tensions(step.cable_tension)
+        if self.scenario.cable_model == 'slack':
+            self.stats.add_slack(self.taut, self.period_ns * 1e-9)
         self.tick += 1
         self.stats.simulated_time = self.t
         self._check(self.t, (step.constraint, step.constraint_rate))

@@ -255,11 +255,19 @@ class RunStatistics:
     max_tension: float = -math.inf         # [N]
     simulated_time: float = 0.0            # [s]
     max_gust_speed: float = 0.0            # peak gust speed met by the payload [m/s]
+    slack_time: list = field(default_factory=list)        # per cable, time slack [s]
     swing: PeakRms = field(default_factory=PeakRms)      # payload swing [m]
 
     def __post_init__(self) -> None:
         self.max_rotor_speed = [0.0] * self.n_uavs
         self.saturated_time = [0.0] * self.n_uavs
+        self.slack_time = [0.0] * self.n_uavs
+
+    def add_slack(self, taut, period: float) -> None:
+        """A control period [s] ending with these cables taut (cable_model: slack)."""
+        for i, is_taut in enumerate(taut):
+            if not is_taut:
+                self.slack_time[i] += period
 
     def add_commands(self, peak_speeds, saturated, period: float) -> None:
         """One control period [s] of commands: each UAV's peak rotor speed [rad/s] and its
@@ -308,6 +316,7 @@ def summary_row(summary: dict) -> dict:
         'payload_swing_max': sim.get('max_payload_swing'),
         'payload_swing_rms': sim.get('rms_payload_swing'),
         'max_gust_speed': sim.get('max_gust_speed'),
+        'slack_time': sum(sim['slack_time']) if sim.get('slack_time') else None,
         'tracking_error_max': leader.get('max_tracking_error') if tracked else None,
         'tracking_error_rms': leader.get('rms_tracking_error') if tracked else None,
         'formation_error_max': (max(f['max_abs_formation_error'] for f in followers)

@@ -28,6 +28,7 @@ PAYLOAD_GUST = '/payload/gust'          # gust velocity at the payload [m/s], wo
 FORMATION_STATE = '/formation/state'    # per cable: tension, g_i, g_i_dot
 FORMATION_SNAPSHOT = '/formation/snapshot'  # what the controllers read, one message a tick
 MARKERS = '/visualization/markers'      # the formation drawn for RViz / Foxglove
+MARKER_DECIMATION = 10                  # MARKERS every this many control ticks
 TF = '/tf'                              # world -> uav{i}/base_link, world -> payload
 
 # leaves of the per-UAV topics /uav{i}/{leaf}

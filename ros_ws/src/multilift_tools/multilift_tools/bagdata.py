@@ -47,8 +47,12 @@ def _odometry(msg: Any) -> dict[str, list[float]]:
 
 
 def _formation_state(msg: Any) -> dict[str, Any]:
+    # bags from before the `taut` field (rigid cables) hold every cable taut
+    taut = getattr(msg, 'taut', None)
+    if taut is None or len(taut) != len(msg.cable_tension):
+        taut = [True] * len(msg.cable_tension)
     return {'tension': msg.cable_tension, 'g': msg.constraint_position,
-            'g_dot': msg.constraint_velocity}
+            'g_dot': msg.constraint_velocity, 'taut': [bool(v) for v in taut]}
 
 
 def _rotor_command(msg: Any) -> dict[str, Any]:
@@ -219,6 +223,10 @@ class Run:
     def tensions(self) -> np.ndarray:
         """(T, n) cable tensions [N]; positive = taut, negative = compression of the rod."""
         return self.topic(FORMATION_STATE)['tension']
+
+    def taut(self) -> np.ndarray:
+        """(T, n) bool: which cables are taut (always all with cable_model: rigid)."""
+        return self.topic(FORMATION_STATE)['taut'].astype(bool)
 
     def g(self) -> np.ndarray:
         """(T, n) cable constraints g_i = |r_p - r_i|^2 - l_i^2 [m^2]."""

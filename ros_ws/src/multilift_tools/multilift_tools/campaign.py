@@ -356,20 +356,12 @@ def run_statistics_row(scenario, bag: Path | None = None) -> tuple[dict[str, Any
     Other exceptions propagate. The one place a row's statistics come from: the run's summary
     through `multilift_sim.statistics.summary_row`, what `run` reports."""
     from multilift_control.headless import run_headless
-    from multilift_sim.simulation import SimulationStopped
 
     if bag is None:
         run = run_headless(scenario, raise_on_stop=False)
-        return _statistics(run.summary()), run.error or ''
-    from multilift_tools.headless_bag import record_headless
-    seen: list = []
-    try:
-        run = record_headless(scenario, bag, seen.append)
-    except SimulationStopped as exc:
-        # record_headless raises with no run to summarise: the simulator's own figures
-        # (the controllers' tracking and formation errors are then empty)
-        sim = dict(seen[-1].stats.as_dict()) if seen else {}
-        return _statistics({'sim': sim}), str(exc)
+    else:
+        from multilift_tools.headless_bag import record_headless
+        run = record_headless(scenario, bag, raise_on_stop=False)
     return _statistics(run.summary()), run.error or ''
 
 

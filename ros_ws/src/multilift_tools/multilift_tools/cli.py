@@ -111,6 +111,9 @@ def _summary(name: str, data: dict, bag: Path | None, scenario) -> None:
             lines.append(f'  uav{i + 1} rotors      max {w:.1f} rad/s (limit {limit:g}), '
                          f'saturated {s:.2f} s')
         lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} N')
+        if any(sim.get('slack_time', [])):
+            lines.append('  slack cables     ' + ', '.join(
+                f'cable {i + 1} {s:.2f} s' for i, s in enumerate(sim['slack_time']) if s > 0))
         if 'max_payload_swing' in sim:
             lines.append(f'  payload swing    max {sim["max_payload_swing"]:.3f} m, '
                          f'rms {sim["rms_payload_swing"]:.3f} m (horizontal, from its rest '

@@ -211,11 +211,10 @@ def fig_thrust(ctx: Context) -> Figure:
         vehicle = vehicle_of(ctx, i)
         if vehicle is not None and run.has(uav_topic(i, ROTOR_CMD)):
             omega = run.rotor_speeds(i)
-            ax.plot(run.rotor_time(i), vehicle.thrust_coefficient * (omega ** 2).sum(axis=1),
+            ax.plot(run.rotor_time(i), vehicle.collective_thrust(omega),
                     color=uav_color(i), lw=0.8, ls='--', alpha=0.8,
                     label=f'{uav_label(i)} delivered $k_T \\sum\\omega^2$')
-            max_thrust.append(vehicle.thrust_coefficient * omega.shape[1]
-                              * vehicle.rotor_speed_max ** 2)
+            max_thrust.append(vehicle.max_thrust)
     if max_thrust and np.allclose(max_thrust, max_thrust[0]):
         ax.axhline(max_thrust[0], color='tab:red', lw=1.0, ls='-.',
                    label=f'max thrust {max_thrust[0]:.2f} N (all rotors at ω_max)')
@@ -288,13 +287,15 @@ def fig_payload_position(ctx: Context) -> Figure:
 
 
 def fig_tensions(ctx: Context) -> Figure:
-    """Cable tensions T_i [N]; negative values (compression of the rigid rod) shaded."""
+    """Cable tensions T_i [N]; negative values (compression of the rigid rod) shaded, and
+    the intervals a cable was slack (cable_model: slack) as a strip in its colour."""
     run = ctx.run
-    t, tension = run.formation_time, run.tensions()
+    t, tension, taut = run.formation_time, run.tensions(), run.taut()
     fig, ax = plt.subplots(figsize=(9, 4.8), layout='constrained')
     for k in range(tension.shape[1]):
         ax.plot(t, tension[:, k], color=uav_color(k + 1), lw=uav_width(k + 1, 1.0),
                 label=f'$T_{k + 1}$ (UAV {k + 1} - payload)')
+        shade_flags(ax, t, ~taut[:, k], f'cable {k + 1} slack', color=uav_color(k + 1))
     ax.axhline(0.0, color='0.3', lw=0.7)
     lo = tension.min()
     if lo < 0:

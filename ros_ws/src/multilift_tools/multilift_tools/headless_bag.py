@@ -23,11 +23,10 @@ from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
 from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, formation_snapshot, odometry,
                                      quaternion, uav_frame, vec3)
-from multilift_sim.ros.common import MARKER_DECIMATION
 from multilift_sim.scenario import Scenario
 from multilift_sim.scene import FormationScene
 from multilift_sim.simulation import FormationSimulator, Snapshot
-from multilift_sim.topics import run_topics, uav_topic
+from multilift_sim.topics import MARKER_DECIMATION, run_topics, uav_topic
 
 TF_TOPIC = '/tf'
 
@@ -125,15 +124,16 @@ class HeadlessBag:
                                                          g_dot.tolist(), taut.tolist()), t_ns)
         if tick % MARKER_DECIMATION == 0:
             self._scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
-                               snap.payload_position, tension)
+                               snap.payload_position, tension, taut)
             self._write('/visualization/markers', self._markers.pack(t_ns), t_ns)
 
 
 def record_headless(scenario: Scenario, bag_dir: Path,
-                    on_tick: Callable[[FormationSimulator], None] | None = None
-                    ) -> HeadlessRun:
+                    on_tick: Callable[[FormationSimulator], None] | None = None,
+                    raise_on_stop: bool = True) -> HeadlessRun:
     """Fly `scenario` without ROS and write every topic of a ROS run to `bag_dir`: the
-    simulator's state and every controller's answer as the nodes publish them."""
+    simulator's state and every controller's answer as the nodes publish them.
+    `raise_on_stop` as for `run_headless`."""
     writer = BagWriter(bag_dir)
     bag = HeadlessBag(scenario, writer)
     simulator: list[FormationSimulator] = []
@@ -146,7 +146,7 @@ def record_headless(scenario: Scenario, bag_dir: Path,
             on_tick(sim)
 
     try:
-        return run_headless(scenario, tick)
+        return run_headless(scenario, tick, raise_on_stop)
     finally:
         try:
             if simulator:

@@ -66,7 +66,7 @@ def _texts(r: Report, fx: SimpleNamespace) -> SimpleNamespace:
     s, tl, ml, sw = r.single, r.twin, r.multi, r.swing
     swing_sc, twin_sc, multi_sc = r.setup.swing, r.setup.twin, r.setup.multi
     vehicle = twin_sc.uavs[0].vehicle
-    max_thrust = vehicle.n_rotors * vehicle.thrust_coefficient * vehicle.rotor_speed_max ** 2
+    max_thrust = vehicle.max_thrust
     follower = tl.followers[0]
     mission = tl.phases
     climb = mission[0]

@@ -340,8 +340,7 @@ def phases(scenario: Scenario) -> list[Phase]:
 
 def delivered_thrust(run: Any, scenario: Scenario, i: int) -> np.ndarray:
     """k_T sum(omega^2) of UAV i's commands [N] (on its rotor_cmd stamps)."""
-    return scenario.uavs[i - 1].vehicle.thrust_coefficient * np.sum(run.rotor_speeds(i) ** 2,
-                                                                     axis=1)
+    return scenario.uavs[i - 1].vehicle.collective_thrust(run.rotor_speeds(i))
 
 
 def swing_by_phase(t: np.ndarray, swing: np.ndarray, mission: Sequence[Phase]

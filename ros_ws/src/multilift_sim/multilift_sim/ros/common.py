@@ -93,7 +93,6 @@ def write_summary(directory: str, name: str, data: dict) -> None:
 
 RECORDER_NODE = 'recorder'
 STARTUP_TIMEOUT = 60.0  # wall seconds a node waits for the graph to come together [s]
-MARKER_DECIMATION = 10  # /visualization/markers every this many control ticks
 
 
 def recorder_missing(node: Node, publishers) -> str | None:

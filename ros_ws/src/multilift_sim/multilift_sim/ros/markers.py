@@ -64,14 +64,15 @@ class FormationMarkers:
         # the moving markers: per UAV body, heading, cable; then the payload
         self._moving = list(zip(self._all[:3 * n + 1], self.scene.specs[:3 * n + 1]))
 
-    def build(self, snapshot: Snapshot, tensions: Sequence[float],
-              stamp: Time | int) -> MarkerArray:
-        """The array for `snapshot` with cable `tensions` [N] (one per UAV), every marker
-        stamped `stamp` (builtin_interfaces/Time or [ns]); rewritten by the next call."""
+    def build(self, snapshot: Snapshot, tensions: Sequence[float], stamp: Time | int,
+              taut: Sequence[bool] | None = None) -> MarkerArray:
+        """The array for `snapshot` with cable `tensions` [N] (one per UAV) and `taut` flags
+        (None: all taut), every marker stamped `stamp` (builtin_interfaces/Time or [ns]);
+        rewritten by the next call."""
         if not isinstance(stamp, Time):
             stamp = stamp_from_ns(int(stamp))
         self.scene.update([u.position for u in snapshot.uavs], [u.euler for u in snapshot.uavs],
-                          snapshot.payload_position, tensions)
+                          snapshot.payload_position, tensions, taut)
         for marker in self._all:
             marker.header.stamp = stamp
         for marker, spec in self._moving:
@@ -89,10 +90,11 @@ _builders: dict[int, FormationMarkers] = {}
 
 
 def formation_markers(snapshot: Snapshot, tensions: Sequence[float], scenario: Scenario,
-                      stamp: Time | int) -> MarkerArray:
+                      stamp: Time | int, taut: Sequence[bool] | None = None) -> MarkerArray:
     """Markers of the formation at `snapshot` (see the module docstring), frame `world`.
 
-    `tensions`: cable tension per UAV [N] (as /formation/state's cable_tension); `stamp`: the
+    `tensions`: cable tension per UAV [N] (as /formation/state's cable_tension); `taut`: per
+    cable (None: all taut; a slack cable is dashed); `stamp`: the
     header stamp of every marker, a builtin_interfaces/Time or an int [ns]. The builder
     (`FormationMarkers`) is cached on the scenario object's identity, so the array is rewritten
     by the next call with the same scenario: publish it before calling again.
@@ -102,4 +104,4 @@ def formation_markers(snapshot: Snapshot, tensions: Sequence[float], scenario: S
         builder = FormationMarkers(scenario)
         _builders.clear()  # one scenario per process in practice; never grow without bound
         _builders[id(scenario)] = builder
-    return builder.build(snapshot, tensions, stamp)
+    return builder.build(snapshot, tensions, stamp, taut)

@@ -33,11 +33,11 @@ from visualization_msgs.msg import MarkerArray
 from multilift_sim.ros import messages
 from multilift_sim.ros.markers import formation_markers
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (MARKER_DECIMATION, PUBLISHER_QOS, RECORDER_NODE,
-                                      STARTUP_TIMEOUT, Fatal, ns_from_stamp, recorder_hears,
-                                      recorder_missing, run_node, wait_until, write_summary)
+from multilift_sim.ros.common import (PUBLISHER_QOS, RECORDER_NODE, STARTUP_TIMEOUT, Fatal,
+                                      ns_from_stamp, recorder_hears, recorder_missing, run_node,
+                                      wait_until, write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import parse_external, uav_topic
+from multilift_sim.topics import MARKER_DECIMATION, parse_external, uav_topic
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 
@@ -155,11 +155,12 @@ class SimNode(Node):
 
     def publish_formation(self, speeds: list[np.ndarray]) -> None:
         tension, g, g_dot = self.sim.cable_state(speeds)
+        taut = self.sim.taut
         self.formation_pub.publish(messages.formation_state(self.sim.t_ns, tension, g, g_dot,
-                                                            self.sim.taut))
+                                                            taut))
         if self.sim.tick % MARKER_DECIMATION == 0:
             self.marker_pub.publish(formation_markers(self.sim.snapshot(), tension,
-                                                      self.scenario, self.sim.t_ns))
+                                                      self.scenario, self.sim.t_ns, taut))
 
     def run(self) -> None:
         wait_until(self, self.missing_peers, self.startup_timeout)

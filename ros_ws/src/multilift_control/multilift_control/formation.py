@@ -15,6 +15,7 @@ import numpy as np
 
 from multilift_control.cascade import CascadeController, ControlOutput, UavState
 from multilift_sim import formation_geometry  # start places and the V offsets v_1i, world
+from multilift_sim.kinematics import thrust_axis
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario import ControlConfig
 
@@ -256,15 +257,6 @@ class VirtualConstraints:
             g.offsets, g.distance, g.half_angle)
 
 
-def _thrust_axis(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """R(eta) e_z, the third column of kinematics.rotation_matrix, for one attitude [rad]."""
-    s_phi, c_phi = math.sin(roll), math.cos(roll)
-    s_theta, c_theta = math.sin(pitch), math.cos(pitch)
-    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
-    return np.array([c_psi * s_theta * c_phi + s_psi * s_phi,
-                     s_psi * s_theta * c_phi - c_psi * s_phi, c_theta * c_phi])
-
-
 def virtual_forces(constraints: VirtualConstraints, r: np.ndarray, v: np.ndarray,
                    thrust_vectors: np.ndarray, masses: np.ndarray, gravity: float,
                    alpha_vc: float, beta_vc: float) -> tuple[np.ndarray, np.ndarray]:
@@ -503,5 +495,5 @@ class FormationFollower:
         out = self.cascade.command(state, force, self.yaw)  # Eq. 3.13, attitude loop, mixer
         # what the rotors will give after saturation, along the thrust axis asked for
         thrust = self.vehicle.collective_thrust(out.rotor_speeds)
-        self.lift = _thrust_axis(*out.attitude_setpoint.tolist()) * thrust
+        self.lift = thrust_axis(*out.attitude_setpoint.tolist()) * thrust
         return out, errors, rates

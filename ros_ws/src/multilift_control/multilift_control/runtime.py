@@ -19,7 +19,7 @@ from multilift_control.cascade import ControlOutput, UavState
 from multilift_control.controllers import make_controller
 from multilift_control.formation import FormationFollower
 from multilift_control.mission import Reference
-from multilift_sim.kinematics import rotation_matrix
+from multilift_sim.kinematics import thrust_axis
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
 
@@ -73,7 +73,7 @@ class ThrustBook:
         for stamp in [k for k in self.leader if k < t_ns]:
             del self.leader[stamp]
         self.thrusts[0] = self.leader.pop(t_ns)
-        return np.array([rotation_matrix(s.euler)[:, 2] * u
+        return np.array([thrust_axis(*s.euler.tolist()) * u
                          for s, u in zip(states, self.thrusts)])
 
 

@@ -7,6 +7,8 @@ unchanged, in the seed's z-down/FRD frame (see frames.py).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -38,6 +40,16 @@ def rotation_matrix(eta: ArrayLike) -> np.ndarray:
     rot[..., 2, 1] = c_theta * s_phi
     rot[..., 2, 2] = c_theta * c_phi
     return rot
+
+
+def thrust_axis(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """R(eta) e_z [unit, world], the body z axis along which the rotors push: the third column
+    of `rotation_matrix` for one attitude [rad], in plain floats (the per-tick path)."""
+    s_phi, c_phi = math.sin(roll), math.cos(roll)
+    s_theta, c_theta = math.sin(pitch), math.cos(pitch)
+    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
+    return np.array([c_psi * s_theta * c_phi + s_psi * s_phi,
+                     s_psi * s_theta * c_phi - c_psi * s_phi, c_theta * c_phi])
 
 
 def euler_rate_matrix(eta: ArrayLike) -> np.ndarray:

@@ -13,11 +13,11 @@ for _pkg in multilift_msgs multilift_sim multilift_control multilift_tools; do
   PYTHONPATH="$ML_INSTALL/$_pkg/lib/python3.11/site-packages${PYTHONPATH:+:$PYTHONPATH}"
 done
 export LD_LIBRARY_PATH="$ML_INSTALL/multilift_msgs/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-# tf2_msgs built from ros_ws/src/tf2_msgs_fallback where the environment has none (scripts/setup)
-if [ -d "$ML_INSTALL/tf2_msgs" ]; then
-  AMENT_PREFIX_PATH="$AMENT_PREFIX_PATH:$ML_INSTALL/tf2_msgs"
-  PYTHONPATH="$PYTHONPATH:$ML_INSTALL/tf2_msgs/lib/python3.11/site-packages"
-  LD_LIBRARY_PATH="$LD_LIBRARY_PATH:$ML_INSTALL/tf2_msgs/lib"
-fi
+# tf2_msgs built from ros_ws/src/tf2_msgs_fallback where the environment has none (scripts/setup),
+# last on the paths so an environment's own tf2_msgs wins. Added whether or not it is built yet:
+# scripts/setup sources this file before its first build and imports tf2_msgs after it.
+AMENT_PREFIX_PATH="$AMENT_PREFIX_PATH:$ML_INSTALL/tf2_msgs"
+PYTHONPATH="$PYTHONPATH:$ML_INSTALL/tf2_msgs/lib/python3.11/site-packages"
+LD_LIBRARY_PATH="$LD_LIBRARY_PATH:$ML_INSTALL/tf2_msgs/lib"
 export PYTHONPATH
 unset _pkg

@@ -42,6 +42,21 @@ def pytest_collection_modifyitems(config, items) -> None:
             item.add_marker(getattr(pytest.mark, layer))
 
 
+@pytest.fixture(scope='module')
+def twin():
+    """(the twin_lift scenario, a snapshot 30 ticks after its start at uneven hover speeds:
+    tilted and swinging, off the symmetric start) for message and marker tests."""
+    import numpy as np
+    from multilift_sim import scenario as scenario_io
+    from multilift_sim.simulation import FormationSimulator
+    scenario = scenario_io.load('twin_lift')
+    simulator = FormationSimulator(scenario)
+    hover = [np.array([1500.0, 1490.0, 1500.0, 1510.0]) for _ in scenario.uavs]
+    for _ in range(30):
+        simulator.advance(hover, [np.zeros(u.vehicle.n_rotors, bool) for u in scenario.uavs])
+    return scenario, simulator.snapshot()
+
+
 @pytest.fixture
 def ros_env(monkeypatch) -> dict:
     """An environment on a ROS domain of its own, discovery limited to this machine."""

@@ -10,10 +10,8 @@ from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from multilift_sim import cdr, msgdefs, msgvalues
-from multilift_sim import scenario as scenario_io
 from multilift_sim.ros import messages
 from multilift_sim.ros.markers import FormationMarkers
-from multilift_sim.simulation import FormationSimulator
 
 T_NS = 12_340_000_001
 
@@ -29,16 +27,6 @@ def typestore():
                  'multilift_msgs/msg/FormationSnapshot', 'tf2_msgs/msg/TFMessage'):
         store.register(get_types_from_msg(msgdefs.message_definition(name), name))
     return store
-
-
-@pytest.fixture(scope='module')
-def twin():
-    scenario = scenario_io.load('twin_lift')
-    simulator = FormationSimulator(scenario)
-    hover = [np.array([1500.0, 1490.0, 1500.0, 1510.0]) for _ in scenario.uavs]
-    for _ in range(30):  # off the symmetric start: tilted, swinging
-        simulator.advance(hover, [np.zeros(u.vehicle.n_rotors, bool) for u in scenario.uavs])
-    return scenario, simulator.snapshot()
 
 
 def fields(value):

@@ -19,16 +19,6 @@ from multilift_sim.simulation import FormationSimulator
 from multilift_sim.scene import CABLE_SEGMENTS
 
 
-@pytest.fixture(scope='module')
-def twin():
-    scenario = scenario_io.load('twin_lift')
-    simulator = FormationSimulator(scenario)
-    hover = [np.array([1500.0, 1490.0, 1500.0, 1510.0]) for _ in scenario.uavs]
-    for _ in range(30):  # off the symmetric start: tilted, swinging
-        simulator.advance(hover, [np.zeros(u.vehicle.n_rotors, bool) for u in scenario.uavs])
-    return scenario, simulator.snapshot()
-
-
 def by_key(array: MarkerArray) -> dict[tuple[str, int], Marker]:
     return {(m.ns, m.id): m for m in array.markers}
 

@@ -488,3 +488,46 @@ def test_sigterm_leaves_no_process_and_a_closed_bag(tmp_path):
     data = _raw_messages(bag)
     assert len(data['/uav1/odom']) > 50
     assert abs(len(data['/uav1/odom']) - len(data['/uav2/rotor_cmd'])) <= 1
+
+
+# -- a node's teardown is bounded (run_node's TeardownGuard) -------------------------------------
+# Seen in CI: a follower whose run had finished never returned from the DDS teardown and ignored
+# SIGINT and SIGTERM until SIGKILL. The guard ends such a process itself; here the hang is made
+# on purpose, once with the GIL released (the Python watchdog: the node's own exit code and a
+# warning with the stacks) and once with the GIL held (faulthandler's C watchdog: exit code 1).
+GUARDED_HANG = '''
+import re, sys, time
+from multilift_sim.ros.common import TeardownGuard
+guard = TeardownGuard('probe_node')
+guard.arm(int(sys.argv[1]), 0.5)
+if sys.argv[2] == 'released':
+    time.sleep(60)                      # blocked in C with the GIL released
+else:
+    re.match(r'(a+)+$', 'a' * 64 + 'b')  # blocked in C holding the GIL
+'''
+
+
+@pytest.mark.parametrize('code', [0, 1])
+def test_a_teardown_that_hangs_ends_with_the_node_s_code_and_says_where(code):
+    out = subprocess.run(['python', '-c', GUARDED_HANG, str(code), 'released'],
+                         capture_output=True, text=True, timeout=30)
+    assert out.returncode == code, out.stderr
+    assert 'warning: probe_node: teardown still running after 0.5 s' in out.stderr
+    assert 'time.sleep' in out.stderr or 'line 7' in out.stderr, out.stderr
+
+
+def test_a_teardown_that_hangs_holding_the_gil_still_ends():
+    start = time.monotonic()
+    out = subprocess.run(['python', '-c', GUARDED_HANG, '0', 'held'],
+                         capture_output=True, text=True, timeout=30)
+    assert out.returncode == 1, out.stderr
+    assert 'Timeout' in out.stderr and 'line 9' in out.stderr, out.stderr
+    assert time.monotonic() - start < 20
+
+
+def test_a_teardown_that_ends_leaves_no_warning():
+    script = ('from multilift_sim.ros.common import TeardownGuard\n'
+              "guard = TeardownGuard('probe_node'); guard.arm(0, 0.5); guard.disarm()\n"
+              'import time; time.sleep(1.5)\n')
+    out = subprocess.run(['python', '-c', script], capture_output=True, text=True, timeout=30)
+    assert out.returncode == 0 and 'warning' not in out.stderr and not out.stderr, out.stderr

@@ -10,6 +10,8 @@ shared with the headless loop. Parameters: scenario, uav_index, record, summary_
 """
 from __future__ import annotations
 
+from typing import NoReturn
+
 import numpy as np
 from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorCommand,
                                 VirtualConstraintError)
@@ -83,10 +85,10 @@ class FollowerNode(Node):
                                                         answer.formation_error_rate))
 
 
-def main(args: list[str] | None = None) -> int:
-    return run_node(FollowerNode, lambda node: serve_controller(
+def main(args: list[str] | None = None) -> NoReturn:
+    run_node(FollowerNode, lambda node: serve_controller(
         node, node.runtime.name, node.runtime.summary), args)
 
 
 if __name__ == '__main__':
-    raise SystemExit(main())
+    main()

@@ -8,6 +8,8 @@ Parameters: scenario, record, summary_dir.
 """
 from __future__ import annotations
 
+from typing import NoReturn
+
 from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorCommand,
                                 TrackingReference)
 from rclpy.node import Node
@@ -51,10 +53,10 @@ class LeaderNode(Node):
             self.ref_pub.publish(messages.tracking_reference(t_ns, answer.reference))
 
 
-def main(args: list[str] | None = None) -> int:
-    return run_node(LeaderNode, lambda node: serve_controller(
+def main(args: list[str] | None = None) -> NoReturn:
+    run_node(LeaderNode, lambda node: serve_controller(
         node, node.runtime.name, node.runtime.summary), args)
 
 
 if __name__ == '__main__':
-    raise SystemExit(main())
+    main()

@@ -4,13 +4,16 @@ physics never sees it.
 """
 from __future__ import annotations
 
+import faulthandler
 import json
 import os
 import signal
 import sys
+import threading
 import time
+import traceback
 from pathlib import Path
-from typing import Callable
+from typing import Callable, NoReturn
 
 import numpy as np
 import rclpy
@@ -201,13 +204,57 @@ def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
 
+# How long a node's teardown (executor, node, rclpy context) may take beyond the flush of its
+# publishers [s]. Seen in CI: a follower whose run had finished, its summary written and its
+# publishers flushed, never returned from the DDS teardown and ignored SIGINT and SIGTERM (a
+# thread blocked in C code never runs Python's signal handlers) until the launcher's SIGKILL.
+TEARDOWN_LIMIT = 5.0
+
+
+class TeardownGuard:
+    """Bounds a node's teardown: if it has not finished `limit` s after `arm`, the node's
+    Python stacks go to stderr (its log) with a warning, and the process exits with the code it
+    was going to return: the flush that starts the teardown is itself bounded, so what the node
+    had to deliver was delivered (or given up on) by then.
+
+    Two watchdogs, because a hang may or may not hold the GIL: a Python thread that can exit
+    with the node's own code, and faulthandler's C thread (`limit` + 3 s, exit code 1) that
+    runs even when the GIL is never released."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self._done = threading.Event()
+
+    def arm(self, code: int, limit: float) -> None:
+        def watch() -> None:
+            if self._done.wait(limit):
+                return
+            print(f'warning: {self.name}: teardown still running after {limit:g} s '
+                  f'(exiting with {code}); where it hangs:', file=sys.stderr, flush=True)
+            faulthandler.dump_traceback(file=sys.stderr, all_threads=True)
+            sys.stderr.flush()
+            os._exit(code)
+
+        threading.Thread(target=watch, name='teardown-guard', daemon=True).start()
+        faulthandler.dump_traceback_later(limit + 3.0, exit=True, file=sys.stderr)
+
+    def disarm(self) -> None:
+        self._done.set()
+        faulthandler.cancel_dump_traceback_later()
+
+
 def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None = None,
-             args: list[str] | None = None) -> int:
-    """Create, run and shut down a node safely (SIGINT, SIGTERM, external shutdown).
+             args: list[str] | None = None) -> NoReturn:
+    """Create, run and shut down a node safely (SIGINT, SIGTERM, external shutdown), then end
+    the process: a node's process entry point.
 
     The node is added to an executor (`node.executor`). `body(node)` runs the node's own loop
-    if it has one; otherwise the node is spun.
-    Errors of kind Fatal, StartupError or ScenarioError print one line; exit code 1.
+    if it has one; otherwise the node is spun. Once the node's publishers are flushed, the
+    teardown runs under a `TeardownGuard`, and the process ends with `os._exit`: the
+    interpreter's finalization and the DDS library's static destructors, which would run in
+    threads no watchdog reaches, have nothing left to do.
+    Errors of kind Fatal, StartupError or ScenarioError print one line; exit code 1 (2 for a
+    ScenarioError).
     """
     from multilift_sim.scenario import ScenarioError
     # our own SIGINT/SIGTERM handling: rclpy's would shut the context down at once, before the
@@ -219,8 +266,10 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
     code = 0
     flush_timeout = FLUSH_TIMEOUT
     executor = make_executor()
+    guard = TeardownGuard(sys.argv[0].rsplit('/', 1)[-1] or 'node')
     try:
         node = make_node()
+        guard.name = node.get_name()
         executor.add_node(node)
         if body is None:
             spin(node)
@@ -231,12 +280,29 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
     except (Fatal, StartupError, ScenarioError) as exc:
         print(f'error: {exc}', file=sys.stderr, flush=True)
         code = 1 if not isinstance(exc, ScenarioError) else 2
+    except Exception:  # noqa: BLE001 - a bug: its traceback, exit code 1, the same teardown
+        traceback.print_exc()
+        code = 1
     finally:
+        # a further SIGINT/SIGTERM would only break the teardown off half-way; the guard bounds it
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        guard.arm(code, flush_timeout + TEARDOWN_LIMIT)
         if node is not None:
             flush_publishers(node, flush_timeout)
+        # the executor lets go of the node's callbacks before the node's entities are destroyed
+        try:
+            executor.shutdown(timeout_sec=1.0)
+        except Exception:  # noqa: BLE001 - shutting down anyway
+            pass
+        if node is not None:
             try:
                 node.destroy_node()
             except Exception:  # noqa: BLE001 - shutting down anyway
                 pass
         rclpy.try_shutdown()
-    return code
+        del executor, node
+        guard.disarm()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)

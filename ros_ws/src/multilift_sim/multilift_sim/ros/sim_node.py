@@ -19,6 +19,7 @@ AdaptiveSubscription`): any reliable publisher is heard, transient_local or vola
 from __future__ import annotations
 
 import time
+from typing import NoReturn
 
 import numpy as np
 from geometry_msgs.msg import Vector3Stamped
@@ -202,9 +203,9 @@ class SimNode(Node):
         write_summary(self.summary_dir, 'sim', stats)
 
 
-def main(args: list[str] | None = None) -> int:
-    return run_node(SimNode, lambda node: node.run(), args)
+def main(args: list[str] | None = None) -> NoReturn:
+    run_node(SimNode, lambda node: node.run(), args)
 
 
 if __name__ == '__main__':
-    raise SystemExit(main())
+    main()

@@ -231,8 +231,14 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f'the other processes were stopped; bag closed at {bag}', file=sys.stderr)
         print(f'logs: {work}', file=sys.stderr)
         return 1
+    warnings = [f'{child.name}: {line}' for child in children for line in child.warnings()]
+    for line in warnings:
+        print(line, file=sys.stderr)
     _summary(scenario.name, _read_summaries(summary_dir, scenario), bag, scenario)
-    shutil.rmtree(work, ignore_errors=True)
+    if warnings:
+        print(f'logs: {work}', file=sys.stderr)
+    else:
+        shutil.rmtree(work, ignore_errors=True)
     return 0
 
 

@@ -68,6 +68,15 @@ class Child:
             except ProcessLookupError:
                 pass
 
+    def warnings(self) -> list[str]:
+        """The child's own `warning:` lines (a node whose teardown had to be cut short says so:
+        multilift_sim.ros.common.TeardownGuard)."""
+        try:
+            text = self.log_path.read_text(errors='replace').splitlines()
+        except OSError:
+            return []
+        return [line for line in text if line.startswith('warning:')]
+
     def last_error(self, lines: int = 6) -> str:
         """The tail of the child's log: its own words on why it stopped."""
         try:

@@ -66,6 +66,17 @@ def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     return hanging_payload(uavs, [u.cable_length for u in scenario.uavs])
 
 
+@dataclass(frozen=True)
+class TickCables:
+    """What `/formation/state` of a tick needs, kept while the tick is integrated: its
+    commands, g [m^2] and g_dot [m^2/s] at the tick, and which cables are taut."""
+    tick: int
+    rotor_speeds: list[np.ndarray]
+    constraint: np.ndarray
+    constraint_rate: np.ndarray
+    taut: np.ndarray
+
+
 class FormationSimulator:
     """Steps the formation DAE from control tick to control tick (seed Algorithm 1)."""
 
@@ -154,6 +165,21 @@ class FormationSimulator:
         tension = self.model.cable_tension(self.t, self.state, rotor_speeds)
         g, g_dot = self.model.constraint_residuals(self.state)
         return np.asarray(tension), np.asarray(g), np.asarray(g_dot)
+
+    def tick_cables(self, rotor_speeds: list[np.ndarray]) -> TickCables:
+        """This tick's cable facts under `rotor_speeds`, before `advance`; the tension follows
+        from `cables_of`."""
+        g, g_dot = self.residuals
+        return TickCables(self.tick, rotor_speeds, g, g_dot, self.taut)
+
+    def cables_of(self, held: TickCables) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(tension [N], g [m^2], g_dot [m^2/s]) at the tick of `held`: the tension from the
+        integration that left it when the simulator has moved on by one tick (no second solve
+        of the DAE), else solved here (the run ended at that tick)."""
+        if self.tick == held.tick + 1 and self.last_step is not None:
+            return self.last_step.cable_tension, held.constraint, held.constraint_rate
+        tension = np.asarray(self.model.cable_tension(self.t, self.state, held.rotor_speeds))
+        return tension, held.constraint, held.constraint_rate
 
     def advance(self, rotor_speeds: list[np.ndarray], saturated: list[np.ndarray]) -> None:
         """Hold `rotor_speeds` over one control period and integrate to the next tick."""

@@ -25,7 +25,7 @@ from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, formation_snapshot
                                      quaternion, uav_frame, vec3)
 from multilift_sim.scenario import Scenario
 from multilift_sim.scene import FormationScene
-from multilift_sim.simulation import FormationSimulator, Snapshot
+from multilift_sim.simulation import FormationSimulator, Snapshot, TickCables
 from multilift_sim.topics import MARKER_DECIMATION, run_topics, uav_topic
 
 TF_TOPIC = '/tf'
@@ -61,7 +61,7 @@ class HeadlessBag:
         self._errors: dict[int, cdr.FloatSequences] = {}
         self._tf = (cdr.TFMessage([uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME])
                     if TF_TOPIC in self._topics else None)
-        self._pending: tuple | None = None  # (tick, snapshot, speeds, (g, g_dot)) of tick t
+        self._pending: tuple[Snapshot, TickCables] | None = None  # of the tick before
 
     def tick(self, sim: FormationSimulator, snap: Snapshot,
              answers: list[ControllerAnswer]) -> None:
@@ -105,24 +105,20 @@ class HeadlessBag:
                         len(errors))
                 write(error_topic, packer.pack(t_ns, answer.formation_error.tolist(),
                                                answer.formation_error_rate.tolist()), t_ns)
-        self._pending = (sim.tick, snap, [a.output.rotor_speeds for a in answers],
-                         sim.residuals, sim.taut)
+        self._pending = (snap, sim.tick_cables([a.output.rotor_speeds for a in answers]))
 
     def finish_pending(self, sim: FormationSimulator) -> None:
         """Write `/formation/state` (and the markers) of the tick before: from the integration
         that left it when the simulator has moved on, else solved here (the last tick)."""
         if self._pending is None:
             return
-        tick, snap, speeds, (g, g_dot), taut = self._pending
+        snap, held = self._pending
         self._pending = None
-        if sim.tick == tick + 1 and sim.last_step is not None:
-            tension = sim.last_step.cable_tension
-        else:  # the run ended at this tick (or its integration stopped the run)
-            tension, g, g_dot = sim.cable_state(speeds)
-        t_ns = snap.t_ns
+        tension, g, g_dot = sim.cables_of(held)
+        t_ns, taut = snap.t_ns, held.taut
         self._write('/formation/state', self._state.pack(t_ns, tension.tolist(), g.tolist(),
                                                          g_dot.tolist(), taut.tolist()), t_ns)
-        if tick % MARKER_DECIMATION == 0:
+        if held.tick % MARKER_DECIMATION == 0:
             self._scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
                                snap.payload_position, tension, taut)
             self._write('/visualization/markers', self._markers.pack(t_ns), t_ns)

@@ -39,7 +39,8 @@ from multilift_sim.ros.common import (PUBLISHER_QOS, RECORDER_NODE, STARTUP_TIME
                                       wait_until, write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import MARKER_DECIMATION, parse_external, uav_topic
-from multilift_sim.simulation import FormationSimulator, SimulationStopped
+from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
+                                      TickCables)
 
 
 class SimNode(Node):
@@ -124,7 +125,8 @@ class SimNode(Node):
                                            *self.odom_pubs])
         return None
 
-    def publish_state(self) -> None:
+    def publish_state(self) -> Snapshot:
+        """The state at this tick, the controllers' snapshot first; returns the snapshot."""
         snap = self.sim.snapshot()
         t_ns = snap.t_ns
         self.clock_pub.publish(messages.clock(t_ns))
@@ -138,6 +140,7 @@ class SimNode(Node):
         gust = self.sim.model.gust_velocity_at_payload(self.sim.t, self.sim.state)
         self.gust_pub.publish(messages.gust(t_ns, gust))
         self.tf_pub.publish(messages.transforms(t_ns, snap))
+        return snap
 
     def wait_for_commands(self) -> None:
         deadline = time.monotonic() + self.scenario.simulation.command_timeout
@@ -154,14 +157,15 @@ class SimNode(Node):
                             f'state at t = {self.sim.t:.3f} s')
             self.executor.spin_once(timeout_sec=0.1)
 
-    def publish_formation(self, speeds: list[np.ndarray]) -> None:
-        tension, g, g_dot = self.sim.cable_state(speeds)
-        taut = self.sim.taut
-        self.formation_pub.publish(messages.formation_state(self.sim.t_ns, tension, g, g_dot,
-                                                            taut))
-        if self.sim.tick % MARKER_DECIMATION == 0:
-            self.marker_pub.publish(formation_markers(self.sim.snapshot(), tension,
-                                                      self.scenario, self.sim.t_ns, taut))
+    def publish_formation(self, snap: Snapshot, held: TickCables) -> None:
+        """/formation/state (and the markers) of the tick of `snap`, once it is integrated:
+        the tension comes from that integration (`FormationSimulator.cables_of`)."""
+        tension, g, g_dot = self.sim.cables_of(held)
+        self.formation_pub.publish(messages.formation_state(snap.t_ns, tension, g, g_dot,
+                                                            held.taut))
+        if held.tick % MARKER_DECIMATION == 0:
+            self.marker_pub.publish(formation_markers(snap, tension, self.scenario, snap.t_ns,
+                                                      held.taut))
 
     def run(self) -> None:
         wait_until(self, self.missing_peers, self.startup_timeout)
@@ -170,14 +174,18 @@ class SimNode(Node):
         try:
             while True:
                 self.commands = [None] * self.sim.n
-                self.publish_state()
+                snap = self.publish_state()
                 self.wait_for_commands()
                 speeds = [np.array(c.angular_velocity, dtype=float) for c in self.commands]
                 flags = [np.array(c.saturated, dtype=bool) for c in self.commands]
-                self.publish_formation(speeds)
+                held = self.sim.tick_cables(speeds)
                 if self.sim.finished:
+                    self.publish_formation(snap, held)
                     break
-                self.sim.advance(speeds, flags)
+                try:
+                    self.sim.advance(speeds, flags)
+                finally:  # a stopped run has its last tick's /formation/state too
+                    self.publish_formation(snap, held)
                 self.applied = speeds
                 wall = time.monotonic() - wall_start
                 if self.realtime and self.sim.t > wall:

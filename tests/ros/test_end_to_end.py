@@ -67,6 +67,16 @@ def test_lockstep_every_command_answers_its_state(single_lift_bag):
     assert clock == odom_stamps
 
 
+def test_the_simulator_s_messages_are_logged_at_their_own_tick(single_lift_bag):
+    """The recorder reads in rounds, yet stamps each message with the /clock sent before it:
+    what the simulator publishes between two /clock messages is logged at its header stamp."""
+    _, _, data = single_lift_bag
+    for topic in ('/uav1/odom', '/payload/odom', '/formation/state', '/formation/snapshot'):
+        logged = [(log_time, stamp_ns(m)) for log_time, m in data[topic]]
+        assert all(log_time == stamp for log_time, stamp in logged), \
+            (topic, [pair for pair in logged if pair[0] != pair[1]][:5])
+
+
 def test_rotor_speeds_within_limits_and_frames(single_lift_bag):
     _, _, data = single_lift_bag
     speeds = np.array([m.angular_velocity for _, m in data['/uav1/rotor_cmd']])

@@ -28,6 +28,7 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Int64, String
 
 from multilift_sim.bag import recover
+from multilift_sim import recording
 from multilift_sim.recording import LogTime, is_recordable, parse_topic_spec
 
 from conftest import ROOT
@@ -313,6 +314,30 @@ def test_log_time_base_is_chosen_once():
     assert LogTime('wall', wall_ns=lambda: 42).stamp(lambda: True) == 42
     with pytest.raises(ValueError, match='time source'):
         LogTime('gps')
+
+
+def test_sim_log_time_is_the_clock_sent_before_the_message():
+    """Messages are stamped by send time, whenever they are read (out-of-order clocks too)."""
+    log_time = LogTime('sim')
+    assert log_time.stamp(lambda: True, 50) == 0  # no /clock yet: ROS time 0
+    for sim_ns, sent_ns in ((0, 100), (10, 200), (20, 300)):
+        log_time.on_clock(sim_ns, sent_ns)
+    clocks = lambda: True  # noqa: E731
+    assert [log_time.stamp(clocks, sent) for sent in (50, 100, 199, 200, 250, 999)] == \
+        [0, 0, 0, 10, 10, 20]
+    assert log_time.stamp(clocks) == 20  # no send time: the latest clock received
+    log_time.on_clock(15, 250)  # a /clock read after a later one
+    assert log_time.stamp(clocks, 260) == 15 and log_time.stamp(clocks, 300) == 20
+
+
+def test_sim_log_time_remembers_the_newest_forgotten_clock():
+    log_time = LogTime('sim')
+    for k in range(3 * recording.CLOCK_MEMORY):
+        log_time.on_clock(10 * k, 1000 + k)
+    assert log_time.stamp(lambda: True, 1000 + 3 * recording.CLOCK_MEMORY - 1) == \
+        10 * (3 * recording.CLOCK_MEMORY - 1)
+    oldest = log_time.stamp(lambda: True, 0)  # sent before every clock still kept
+    assert 0 < oldest < 10 * (3 * recording.CLOCK_MEMORY - recording.CLOCK_MEMORY)
 
 
 def test_topic_specs_and_recordable_topics():

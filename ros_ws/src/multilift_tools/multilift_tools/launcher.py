@@ -68,14 +68,34 @@ class Child:
             except ProcessLookupError:
                 pass
 
-    def warnings(self) -> list[str]:
-        """The child's own `warning:` lines (a node whose teardown had to be cut short says so:
-        multilift_sim.ros.common.TeardownGuard)."""
+    def _log_lines(self) -> list[str]:
         try:
-            text = self.log_path.read_text(errors='replace').splitlines()
+            return self.log_path.read_text(errors='replace').splitlines()
         except OSError:
             return []
-        return [line for line in text if line.startswith('warning:')]
+
+    def teardown_cut_short(self) -> bool:
+        """Whether the node's teardown watchdog ended it holding the GIL (faulthandler's
+        `Timeout (...)!` and exit code 1; multilift_sim.ros.common.TeardownGuard). The watchdog
+        is armed only after the node's loop ended and its publishers were flushed, so unless
+        the node also reported an error, it had done its work."""
+        lines = self._log_lines()
+        return (self.returncode() == 1 and any(line.startswith('Timeout (') for line in lines)
+                and not any(line.startswith('error:') for line in lines))
+
+    def ended_well(self) -> bool:
+        """Exit code 0, or a teardown cut short after the work was done."""
+        return self.returncode() == 0 or self.teardown_cut_short()
+
+    def warnings(self) -> list[str]:
+        """The child's own `warning:` lines (a node whose teardown had to be cut short says so:
+        multilift_sim.ros.common.TeardownGuard), and one for a teardown cut short holding the
+        GIL (its stacks are in the log)."""
+        lines = [line for line in self._log_lines() if line.startswith('warning:')]
+        if self.teardown_cut_short():
+            lines.append('warning: its teardown hung holding the GIL and was cut short by its '
+                         'watchdog after its messages were flushed (stacks in its log)')
+        return lines
 
     def last_error(self, lines: int = 6) -> str:
         """The tail of the child's log: its own words on why it stopped."""
@@ -135,12 +155,12 @@ class Supervisor:
                     code = child.returncode()
                     if code is None:
                         continue
-                    if child.role == 'sim' and code == 0:
+                    if child.role == 'sim' and child.ended_well():
                         self.stop('controller')
                         self.stop('recorder')
                         dead = [c for c in self.children
-                                if c.role != 'sim' and c.returncode() not in (0, None)
-                                and c.returncode() != -signal.SIGINT]
+                                if c.role != 'sim' and c.returncode() is not None
+                                and not c.ended_well() and c.returncode() != -signal.SIGINT]
                         return ('finished', None) if not dead else ('died', dead[0])
                     self.stop_all()
                     return 'died', child

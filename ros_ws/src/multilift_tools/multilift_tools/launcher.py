@@ -99,10 +99,9 @@ class Child:
 
     def last_error(self, lines: int = 6) -> str:
         """The tail of the child's log: its own words on why it stopped."""
-        try:
-            text = self.log_path.read_text(errors='replace').strip().splitlines()
-        except OSError:
-            return ''
+        text = self._log_lines()
+        while text and not text[-1].strip():
+            text.pop()
         errors = [line for line in text if line.startswith('error:')]
         return errors[-1] if errors else '\n'.join(text[-lines:])
 

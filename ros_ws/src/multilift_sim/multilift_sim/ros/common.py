@@ -280,8 +280,11 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
     except (Fatal, StartupError, ScenarioError) as exc:
         print(f'error: {exc}', file=sys.stderr, flush=True)
         code = 1 if not isinstance(exc, ScenarioError) else 2
-    except Exception:  # noqa: BLE001 - a bug: its traceback, exit code 1, the same teardown
+    except Exception as exc:  # noqa: BLE001 - a bug: its traceback, exit code 1, same teardown
         traceback.print_exc()
+        # an `error:` line too, so a teardown cut short afterwards is not taken for a node that
+        # had done its work (multilift_tools.launcher.Child.teardown_cut_short)
+        print(f'error: {type(exc).__name__}: {exc}', file=sys.stderr, flush=True)
         code = 1
     finally:
         # a further SIGINT/SIGTERM would only break the teardown off half-way; the guard bounds it

@@ -6,6 +6,7 @@ World frame z up, body frame FLU, ZYX Euler angles (docs/conventions.md). Pure n
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,22 +44,22 @@ def attitude_from_force(force: np.ndarray, yaw: float,
     c_phi s_theta s_psi - s_phi c_psi, c_phi c_theta) for ZYX angles. The tilt is limited to
     `max_tilt` by shrinking the horizontal part. Returns (roll [rad], pitch [rad], thrust [N]).
     """
-    f = np.asarray(force, dtype=float).copy()
-    f[2] = max(f[2], 1e-6)
-    horizontal = math.hypot(f[0], f[1])
-    limit = f[2] * math.tan(max_tilt)
+    fx, fy, fz = np.asarray(force, dtype=float).tolist()  # plain floats: the per-tick path
+    fz = max(fz, 1e-6)
+    horizontal = math.hypot(fx, fy)
+    limit = fz * math.tan(max_tilt)
     if horizontal > limit:
-        f[:2] *= limit / horizontal
-    thrust = float(np.linalg.norm(f))
+        fx, fy = fx * (limit / horizontal), fy * (limit / horizontal)
+    thrust = math.sqrt(fx * fx + fy * fy + fz * fz)
     s_psi, c_psi = math.sin(yaw), math.cos(yaw)
-    roll = math.asin(max(-1.0, min(1.0, (f[0] * s_psi - f[1] * c_psi) / thrust)))
-    pitch = math.atan2(f[0] * c_psi + f[1] * s_psi, f[2])
+    roll = math.asin(max(-1.0, min(1.0, (fx * s_psi - fy * c_psi) / thrust)))
+    pitch = math.atan2(fx * c_psi + fy * s_psi, fz)
     return roll, pitch, thrust
 
 
 def wrap_angle(angle: np.ndarray | float) -> np.ndarray | float:
-    """Angle wrapped to [-pi, pi)."""
-    return (np.asarray(angle) + math.pi) % (2 * math.pi) - math.pi
+    """Angle wrapped to [-pi, pi) (a float stays a float)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
 class RotorMixer:
@@ -79,18 +80,18 @@ class RotorMixer:
 
     def rotor_speeds(self, thrust: float, torque: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(omega [rad/s], saturated) for collective thrust [N] and body torque [N m]."""
-        request = self.pinv @ np.concatenate(([thrust], torque))
+        request = self.pinv @ np.array((thrust, *torque))
+        high, low = request.max(), request.min()
         saturated = (request > self.square_max) | (request < self.square_min)
         squares = request
-        if saturated.any():
-            spread = request.max() - request.min()
-            if spread <= self.square_max - self.square_min:
+        if high > self.square_max or low < self.square_min:
+            if high - low <= self.square_max - self.square_min:
                 # shift along the collective direction until every rotor fits
-                high = (request.max() - self.square_max) / self.collective[np.argmax(request)]
-                low = (self.square_min - request.min()) / self.collective[np.argmin(request)]
-                shift = -high if high > 0 else (low if low > 0 else 0.0)
+                above = (high - self.square_max) / self.collective[np.argmax(request)]
+                below = (self.square_min - low) / self.collective[np.argmin(request)]
+                shift = -above if above > 0 else (below if below > 0 else 0.0)
                 squares = request + shift * self.collective
-            squares = np.clip(squares, self.square_min, self.square_max)
+            squares = np.minimum(np.maximum(squares, self.square_min), self.square_max)
         return np.sqrt(squares), saturated
 
 
@@ -119,9 +120,11 @@ class CascadeController:
         self._kp = np.asarray(gains.position_kp, dtype=float)
         self._kd = np.asarray(gains.position_kd, dtype=float)
         self._ki = np.asarray(gains.position_ki, dtype=float)
-        self._att_kp = np.asarray(gains.attitude_kp, dtype=float)
-        self._att_kd = np.asarray(gains.attitude_kd, dtype=float)
         self._gravity_vector = gravity * E_Z
+        # the attitude loop's constants as floats (it runs in plain floats)
+        self._inertia = tuple(map(float, vehicle.inertia))
+        self._att_kp = tuple(map(float, gains.attitude_kp))
+        self._att_kd = tuple(map(float, gains.attitude_kd))
 
     def position_force(self, t: float, state: UavState, position_ref: np.ndarray,
                        velocity_ref: np.ndarray, acceleration_ref: np.ndarray) -> np.ndarray:
@@ -129,31 +132,35 @@ class CascadeController:
         dt = 0.0 if self._t_prev is None else max(0.0, t - self._t_prev)
         self._t_prev = t
         error = position_ref - state.position
-        self.integral = np.clip(self.integral + self._ki * error * dt,
-                                -self.integral_limit, self.integral_limit)
+        self.integral = np.minimum(np.maximum(self.integral + self._ki * error * dt,
+                                              -self.integral_limit), self.integral_limit)
         accel = (acceleration_ref + self._kp * error
                  + self._kd * (velocity_ref - state.velocity)
                  + self.integral)
         return self.hover_mass * (accel + self._gravity_vector)
 
-    def attitude_torque(self, state: UavState, setpoint: np.ndarray) -> np.ndarray:
-        """Body torque [N m] driving the Euler angles to `setpoint`."""
-        error = wrap_angle(np.asarray(setpoint) - state.euler)
-        rates = state.body_rates
-        accel = self._att_kp * error - self._att_kd * rates
-        p, q, r = rates.tolist()
-        jp, jq, jr = (self.inertia * rates).tolist()
-        gyro = np.array([q * jr - r * jq, r * jp - p * jr, p * jq - q * jp])  # omega x J omega
-        return self.inertia * accel + gyro
+    def attitude_torque(self, state: UavState, setpoint: Sequence[float]) -> np.ndarray:
+        """Body torque [N m] driving the Euler angles to `setpoint` (roll, pitch, yaw) [rad]."""
+        p, q, r = state.body_rates.tolist()   # plain floats: the per-tick path
+        ix, iy, iz = self._inertia
+        jp, jq, jr = ix * p, iy * q, iz * r
+        gyro = (q * jr - r * jq, r * jp - p * jr, p * jq - q * jp)  # omega x J omega
+        torque = []
+        for axis, (wanted, angle, rate) in enumerate(zip(setpoint, state.euler.tolist(),
+                                                         (p, q, r))):
+            error = wrap_angle(wanted - angle)
+            accel = self._att_kp[axis] * error - self._att_kd[axis] * rate
+            torque.append(self._inertia[axis] * accel + gyro[axis])
+        return np.array(torque)
 
     def command(self, state: UavState, force: np.ndarray, yaw: float) -> ControlOutput:
         """Rotor speeds that produce `force` (world) at heading `yaw`."""
         roll, pitch, thrust = attitude_from_force(force, yaw, self.gains.max_tilt)
-        setpoint = np.array([roll, pitch, yaw])
+        setpoint = (roll, pitch, float(yaw))
         # the thrust acts along the current body z: ask for the part along it
         torque = self.attitude_torque(state, setpoint)
         speeds, saturated = self.mixer.rotor_speeds(thrust, torque)
-        return ControlOutput(speeds, saturated, setpoint, thrust)
+        return ControlOutput(speeds, saturated, np.array(setpoint), thrust)
 
     def update(self, t: float, state: UavState, position_ref: np.ndarray,
                velocity_ref: np.ndarray, acceleration_ref: np.ndarray,

@@ -147,6 +147,9 @@ class VirtualConstraints:
         self.m = len(self.pairs)
         self._constant_jacobian: np.ndarray | None = None   # linear rows: J_vc (Eq. 3.7)
         self._free_motions: dict[float, np.ndarray] = {}    # linear rows: by tol
+        # linear rows read r_f at fixed places: r_f[3 i + axis] - r_f[3 j + axis]
+        self._flat_first = 3 * self.pairs[:, 0] + self.axes if self.linear else None
+        self._flat_second = 3 * self.pairs[:, 1] + self.axes if self.linear else None
         if self.linear:
             jac = np.zeros((self.m, 3 * self.n))
             rows = np.arange(self.m)
@@ -179,10 +182,10 @@ class VirtualConstraints:
     def residual(self, r: np.ndarray) -> np.ndarray:
         """g_vc(r) (m,): [m] for linear rows, [m^2] for distance rows."""
         r = self._check(r)
-        i, j = self.pairs[:, 0], self.pairs[:, 1]
         if self.linear:
-            return r[i, self.axes] - r[j, self.axes] - self.targets
-        diff = r[i] - r[j]
+            flat = r.reshape(-1)
+            return flat[self._flat_first] - flat[self._flat_second] - self.targets
+        diff = r[self.pairs[:, 0]] - r[self.pairs[:, 1]]
         return np.einsum('kd,kd->k', diff, diff) - self.targets ** 2
 
     def jacobian(self, r: np.ndarray) -> np.ndarray:
@@ -363,6 +366,7 @@ class FormationFollower:
         self.beta_vc = beta_vc
         self.yaw = yaw
         self.rows = constraints.rows_of(index)
+        self._row_index = np.array(self.rows, dtype=int)
         self._linear_law = self._linear_law_matrices() if constraints.linear else None
         if altitude_offset is None:  # d_z of a linear geometry, else 0
             nominal = constraints.nominal_positions(np.zeros(3))
@@ -455,8 +459,8 @@ class FormationFollower:
         # (Fig. 4.8)
         error = r[0, 2] + self.altitude_offset - r[i, 2]
         error_rate = -v[i, 2]
-        self.integral = float(np.clip(self.integral + self.gains.position_ki[2] * error * dt,
-                                      -self.integral_limit, self.integral_limit))
+        self.integral = min(max(self.integral + self.gains.position_ki[2] * error * dt,
+                                -self.integral_limit), self.integral_limit)
         force = np.empty(3)
         force[:2] = u[i, :2] + u_vf_i[:2]
         if self.free_mode_gain is not None:  # not in the seed: see the class docstring
@@ -466,7 +470,7 @@ class FormationFollower:
         if residual is None:
             residual = self.constraints.residual(r)
             rates = self.constraints.rate(r, v)[self.rows]
-        return force, residual[self.rows], rates
+        return force, residual[self._row_index], rates
 
     def _free_mode_correction(self, r: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Horizontal force [N] that replaces, in the free follower motions, the followers'

@@ -13,7 +13,8 @@ from typing import Callable
 import numpy as np
 
 from multilift_control.cascade import UavState, balancing_rotor_speed
-from multilift_control.runtime import ControllerAnswer, ControllerRuntime, answer_tick
+from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answer_tick,
+                                       formation_runtimes)
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot
 
@@ -49,7 +50,7 @@ def run_headless(scenario: Scenario, on_tick: TickObserver | None = None,
     as the node would, or with raise_on_stop=False ends the run with `error` set."""
     start = time.monotonic()
     sim = FormationSimulator(scenario)
-    runtimes = [ControllerRuntime(scenario, i) for i in range(scenario.n_uavs)]
+    runtimes = formation_runtimes(scenario)
     run = HeadlessRun(scenario, sim, runtimes)
     try:
         while True:

@@ -1,6 +1,7 @@
 """The leader's mission path (seed §4.2): piecewise-constant velocity segments, world frame."""
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 
@@ -53,6 +54,8 @@ class MissionPath:
         if len(self._ends):  # the stop after the last segment
             self._step_times = np.append(starts, self._ends[-1])
             self._steps = np.vstack((self._steps, -self._velocities[-1]))
+        self._end_list = self._ends.tolist()
+        self._step_list = list(zip(self._step_times.tolist(), self._steps.tolist()))
 
     def __call__(self, t: float) -> Reference:
         """The reference at simulated time t [s]."""
@@ -65,7 +68,7 @@ class MissionPath:
         zero = np.zeros(3)
         if len(self._ends) == 0 or t < 0.0:
             return Reference(self._start.copy(), zero, zero.copy())
-        k = int(np.searchsorted(self._ends, t, side='right'))
+        k = bisect.bisect_right(self._end_list, t)
         if k >= len(self._ends):
             return Reference(self._final.copy(), zero, zero.copy())
         velocity = self._velocities[k]
@@ -73,22 +76,27 @@ class MissionPath:
         return Reference(position, velocity.copy(), zero.copy())
 
     def _filtered(self, t: float) -> Reference:
-        """The reference after the critically damped prefilter (class docstring)."""
+        """The reference after the critically damped prefilter (class docstring); in plain
+        floats per axis (a handful of steps: numpy's per-call cost would dominate)."""
         w = 1.0 / self._tau
-        position = self._start.copy()
-        velocity = np.zeros(3)
-        acceleration = np.zeros(3)
-        for t_k, dv in zip(self._step_times, self._steps):
+        position = self._start.tolist()
+        velocity = [0.0, 0.0, 0.0]
+        acceleration = [0.0, 0.0, 0.0]
+        for t_k, dv in self._step_list:
             x = t - t_k
             if x <= 0.0:
                 break
             decay = math.exp(-w * x)
-            position += dv * (x - (2.0 - (2.0 + w * x) * decay) / w)
-            velocity += dv * (1.0 - (1.0 + w * x) * decay)
-            acceleration += dv * (w * w * x * decay)
+            moved = x - (2.0 - (2.0 + w * x) * decay) / w
+            gained = 1.0 - (1.0 + w * x) * decay
+            pushed = w * w * x * decay
+            for axis in (0, 1):  # horizontal only: see below
+                position[axis] += dv[axis] * moved
+                velocity[axis] += dv[axis] * gained
+                acceleration[axis] += dv[axis] * pushed
         # horizontal only: the vertical steps (the climb of §4.2) need collective thrust, not
         # tilt, and stay raw, so the follower's climb lag of Fig. 4.7 stays the seed's
         raw = self._raw(t)
         position[2], velocity[2], acceleration[2] = (raw.position[2], raw.velocity[2],
                                                       raw.acceleration[2])
-        return Reference(position, velocity, acceleration)
+        return Reference(np.array(position), np.array(velocity), np.array(acceleration))

@@ -52,6 +52,7 @@ class ThrustBook:
         self.thrusts = [(v.mass + share) * gravity for v in self.vehicles]  # [N]
         self.leader: dict[int, float] = {}               # t_ns -> the leader's u_T [N]
         self.pending: dict[int, dict[int, float]] = {}   # t_ns -> {follower: u_T [N]}
+        self._formed: tuple[int, np.ndarray] | None = None  # (t_ns, vectors) last formed
 
     def note(self, index: int, t_ns: int, rotor_speeds: np.ndarray) -> None:
         """UAV `index` (from 0) answered the state at t_ns with these rotor speeds [rad/s]."""
@@ -66,27 +67,35 @@ class ThrustBook:
 
     def vectors(self, t_ns: int, states: list[UavState]) -> np.ndarray:
         """Every UAV's thrust vector R_j(t) e_z u_T,j, world [N], shape (n, 3), for the state
-        at t_ns; needs the leader's answer to it."""
+        at t_ns; needs the leader's answer to it. Formed once per state: followers that share
+        the book (one process, `formation_runtimes`) get the same array (read-only)."""
+        if self._formed is not None and self._formed[0] == t_ns:
+            return self._formed[1]
         for stamp in sorted(k for k in self.pending if k < t_ns):
             for j, thrust in self.pending.pop(stamp).items():
                 self.thrusts[j] = thrust
         for stamp in [k for k in self.leader if k < t_ns]:
             del self.leader[stamp]
         self.thrusts[0] = self.leader.pop(t_ns)
-        return np.array([thrust_axis(*s.euler.tolist()) * u
-                         for s, u in zip(states, self.thrusts)])
+        vectors = np.array([thrust_axis(*s.euler.tolist()) * u
+                            for s, u in zip(states, self.thrusts)])
+        vectors.flags.writeable = False
+        self._formed = (t_ns, vectors)
+        return vectors
 
 
 class ControllerRuntime:
     """UAV `index`'s controller (0: the leader of `control.mode`, else a virtual-constraint
     follower) with its bookkeeping and its run statistics."""
 
-    def __init__(self, scenario: Scenario, index: int):
+    def __init__(self, scenario: Scenario, index: int, thrusts: ThrustBook | None = None):
+        """`thrusts`: a follower's ThrustBook, shared by the followers of one process
+        (`formation_runtimes`); by default its own (a node's)."""
         self.index = index
         self.is_follower = index > 0
         if self.is_follower:
             self.follower = FormationFollower.from_scenario(scenario, index)
-            self.thrusts = ThrustBook(scenario)
+            self.thrusts = ThrustBook(scenario) if thrusts is None else thrusts
             self.statistics = FormationErrorStatistics()
         else:
             self.leader = make_controller(scenario, index)
@@ -125,16 +134,24 @@ class ControllerRuntime:
         return self.statistics.as_dict()
 
 
+def formation_runtimes(scenario: Scenario) -> list[ControllerRuntime]:
+    """Every UAV's controller in one process (the headless loop): the followers share one
+    ThrustBook, as they all see the same answers, so a tick notes each answer once (O(n),
+    where a book per follower would be O(n^2))."""
+    thrusts = ThrustBook(scenario)
+    return [ControllerRuntime(scenario, i, thrusts) for i in range(scenario.n_uavs)]
+
+
 def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
                 states: list[UavState]) -> list[ControllerAnswer]:
     """Every controller's answer to the state at t_ns, in the order the ROS graph gives them:
-    the leader first, then the followers, each of which then notes every answer."""
+    the leader first, then the followers, each of whose books then notes every answer."""
     leader = runtimes[0].answer(t_ns, states)
-    followers = runtimes[1:]
-    for runtime in followers:
-        runtime.note_command(0, t_ns, leader.output.rotor_speeds)
-    answers = [leader] + [runtime.answer(t_ns, states) for runtime in followers]
-    for runtime in followers:
+    books = list({id(r.thrusts): r.thrusts for r in runtimes[1:]}.values())
+    for book in books:
+        book.note(0, t_ns, leader.output.rotor_speeds)
+    answers = [leader] + [runtime.answer(t_ns, states) for runtime in runtimes[1:]]
+    for book in books:
         for answer in answers[1:]:
-            runtime.note_command(answer.index, t_ns, answer.output.rotor_speeds)
+            book.note(answer.index, t_ns, answer.output.rotor_speeds)
     return answers

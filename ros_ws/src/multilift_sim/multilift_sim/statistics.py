@@ -231,10 +231,10 @@ class FormationErrorStatistics:
     samples: int = 0
 
     def add(self, residual: np.ndarray) -> None:
-        residual = np.asarray(residual, dtype=float)
+        residual = np.asarray(residual, dtype=float).ravel()
         if residual.size:
-            self.max_abs = max(self.max_abs, float(np.max(np.abs(residual))))
-            self.norm_sum += float(np.linalg.norm(residual))
+            self.max_abs = max(self.max_abs, float(np.abs(residual).max()))
+            self.norm_sum += math.sqrt(residual @ residual)  # np.linalg.norm's arithmetic
         self.samples += 1
 
     def as_dict(self) -> dict:
@@ -275,7 +275,7 @@ class RunStatistics:
         for i, (peak, flags) in enumerate(zip(peak_speeds, saturated)):
             if peak > self.max_rotor_speed[i]:
                 self.max_rotor_speed[i] = float(peak)
-            if np.any(flags):
+            if any(flags):
                 self.saturated_time[i] += period
 
     def add_tensions(self, tension) -> None:

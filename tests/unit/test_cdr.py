@@ -204,3 +204,26 @@ def test_formation_snapshot(twin, typestore):
         values = msgvalues.formation_snapshot(snap, previous)
         check(packer.pack(snap.t_ns, *values), packer.layout(len(values[-1])),
               messages.formation_snapshot(snap, previous, [4, 4]), typestore)
+
+
+def test_formation_snapshot_unpacks_what_rclpy_serializes(twin):
+    _, snap = twin
+    packer = cdr.FormationSnapshot([4, 4])
+    speeds = [np.array([1500.0, 1490.0, 1500.0, 1510.0]), np.array([1.0, 2.0, 3.0, 4.5])]
+    for previous in (None, speeds):
+        # rclpy's bytes (padding not zeroed) read back to the values packed
+        data = serialize_message(messages.formation_snapshot(snap, previous, [4, 4]))
+        t_ns, *arrays = packer.unpack(data)
+        assert t_ns == snap.t_ns
+        for got, want in zip(arrays, msgvalues.formation_snapshot(snap, previous)):
+            np.testing.assert_array_equal(got, want)
+    # another formation's snapshot is refused, naming what differs
+    three = cdr.FormationSnapshot([4, 4, 4])
+    with pytest.raises(ValueError, match='bytes is not one of 3 UAVs'):
+        three.unpack(data)
+    hexa = cdr.FormationSnapshot([6, 2])
+    with pytest.raises(ValueError, match=r'rotor_count \[4, 4\] where this formation has '
+                                         r'\[6, 2\]'):
+        hexa.unpack(data)
+    with pytest.raises(ValueError, match='encapsulation'):
+        packer.unpack(b'\x00\x00' + data[2:])

@@ -250,6 +250,42 @@ class FormationSnapshot:
                              *flat[4 * r:4 * r + 6], len(self._counts), *self._counts,
                              len(previous), *flat[4 * r + 6:])
 
+    def unpack(self, data: bytes) -> tuple[int, np.ndarray, np.ndarray, np.ndarray,
+                                           np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The inverse of `pack` for this formation: (t_ns, position, velocity, euler,
+        body_rates (3n,) each, payload position, payload velocity (3,), previous rotor
+        speeds (every rotor's, or empty at t = 0)); ValueError when `data` is not such a
+        message (another formation's: other UAV or rotor counts)."""
+        for _, packer in self._structs.values():
+            if len(data) == packer.size:
+                values = packer.unpack(data)
+                break
+        else:
+            raise ValueError(f'a FormationSnapshot of {len(data)} bytes is not one of '
+                             f'{len(self._counts)} UAVs with {self._counts} rotors')
+        if values[0] != ENCAPSULATION:
+            raise ValueError(f'a FormationSnapshot with encapsulation {values[0]!r} '
+                             '(expected CDR little endian)')
+        k, rows, arrays = 5, self._rows, []
+        for name in ('position', 'velocity', 'euler', 'body_rates'):
+            if values[k] != rows:
+                raise ValueError(f'FormationSnapshot.{name} has {values[k]} values where '
+                                 f'{len(self._counts)} UAVs have {rows}')
+            arrays.append(np.array(values[k + 1:k + 1 + rows]))
+            k += 1 + rows
+        arrays += [np.array(values[k:k + 3]), np.array(values[k + 3:k + 6])]
+        k += 6
+        counts = values[k + 1:k + 1 + values[k]]
+        if counts != self._counts:
+            raise ValueError(f'FormationSnapshot.rotor_count {list(counts)} where this '
+                             f'formation has {list(self._counts)}')
+        k += 1 + values[k]
+        if values[k] != len(values) - k - 1:
+            raise ValueError(f'FormationSnapshot.previous_rotor_speeds has {values[k]} values '
+                             f'where this formation has {len(values) - k - 1}')
+        arrays.append(np.array(values[k + 1:]))
+        return (values[1] * 1_000_000_000 + values[2], *arrays)
+
 
 class RotorCommand:
     """multilift_msgs/RotorCommand of `n_rotors` rotors: pack(t_ns, speeds, saturated)."""

@@ -2,17 +2,33 @@
 from __future__ import annotations
 
 import numpy as np
-from multilift_msgs.msg import FormationSnapshot
 
 from multilift_control.cascade import UavState
-from multilift_sim.ros import messages
-from multilift_sim.ros.common import ns_from_stamp
+from multilift_sim import cdr
+from multilift_sim.ros.common import Fatal
+from multilift_sim.scenario import Scenario
 from multilift_sim.topics import FORMATION_SNAPSHOT as SNAPSHOT_TOPIC  # noqa: F401 (nodes)
 
 
-def snapshot_input(msg: FormationSnapshot) -> tuple[int, list[UavState], list[np.ndarray]]:
-    """(t [ns], every UAV's state at t from the leader on, the rotor speeds applied up to t
-    per UAV (empty at t = 0))."""
-    positions, velocities, euler, rates, previous = messages.snapshot_arrays(msg)
-    states = [UavState(*row) for row in zip(positions, velocities, euler, rates)]
-    return ns_from_stamp(msg.header.stamp), states, previous
+class SnapshotReader:
+    """`/formation/snapshot` as it arrives (CDR bytes: the nodes subscribe with raw=True, which
+    spares rclpy's message objects) -> (t [ns], every UAV's state at t from the leader on, the
+    rotor speeds applied up to t per UAV (empty at t = 0)), for the formation of `scenario`."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        counts = [u.vehicle.n_rotors for u in scenario.uavs]
+        self._cdr = cdr.FormationSnapshot(counts)
+        self._edges = np.cumsum(counts)[:-1]
+        self._scenario = scenario.name
+
+    def __call__(self, data: bytes) -> tuple[int, list[UavState], list[np.ndarray]]:
+        try:
+            (t_ns, position, velocity, euler, body_rates, _, _,
+             previous) = self._cdr.unpack(data)
+        except ValueError as error:
+            raise Fatal(f'{SNAPSHOT_TOPIC} is not of scenario {self._scenario}\'s formation '
+                        f'({error}): is another simulator on this ROS domain?') from None
+        states = [UavState(*row) for row in zip(position.reshape(-1, 3),
+                                                 velocity.reshape(-1, 3), euler.reshape(-1, 3),
+                                                 body_rates.reshape(-1, 3))]
+        return t_ns, states, np.split(previous, self._edges) if previous.size else []

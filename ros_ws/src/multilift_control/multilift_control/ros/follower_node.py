@@ -17,11 +17,11 @@ from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorComman
                                 VirtualConstraintError)
 from rclpy.node import Node
 
+from multilift_control.answer_messages import AnswerMessages
 from multilift_control.cascade import UavState
-from multilift_control.ros.common import SNAPSHOT_TOPIC, snapshot_input
+from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
 from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros import messages
 from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
                                       controller_peers_missing, run_node, serve_controller)
 from multilift_sim.topics import uav_topic
@@ -43,9 +43,11 @@ class FollowerNode(Node):
         self.n = n
         self.period_ns = int(round(1e9 / scenario.simulation.control_rate))
         self.runtime = ControllerRuntime(scenario, self.index - 1)
+        self.packer = AnswerMessages(scenario)  # the answer as CDR bytes
         self.states: dict[int, list[UavState]] = {}   # t_ns -> every UAV's state
+        self.read_snapshot = SnapshotReader(scenario)
         self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
-                                 SUBSCRIBER_QOS)
+                                 SUBSCRIBER_QOS, raw=True)
         self.create_subscription(RotorCommand, uav_topic(1, 'rotor_cmd'), self.on_leader,
                                  SUBSCRIBER_QOS)
         i = self.index
@@ -55,6 +57,8 @@ class FollowerNode(Node):
                                                   uav_topic(i, 'attitude_setpoint'), PUBLISHER_QOS)
         self.error_pub = self.create_publisher(VirtualConstraintError,
                                                uav_topic(i, 'formation_error'), PUBLISHER_QOS)
+        self.by_topic = {pub.topic_name: pub
+                         for pub in (self.cmd_pub, self.setpoint_pub, self.error_pub)}
 
     def missing_peers(self) -> str | None:
         return controller_peers_missing(self, self.cmd_pub, self.record)
@@ -64,8 +68,8 @@ class FollowerNode(Node):
         self.runtime.note_command(0, t_ns, np.asarray(msg.angular_velocity, dtype=float))
         self.try_answer(t_ns)
 
-    def on_snapshot(self, msg: FormationSnapshot) -> None:
-        t_ns, states, previous = snapshot_input(msg)
+    def on_snapshot(self, data: bytes) -> None:
+        t_ns, states, previous = self.read_snapshot(data)
         for j, speeds in enumerate(previous[1:], start=1):  # the followers' answers to t - 1
             self.runtime.note_command(j, t_ns - self.period_ns, speeds)
         self.states[t_ns] = states
@@ -77,12 +81,8 @@ class FollowerNode(Node):
         states = self.states.pop(t_ns)
         for stamp in [k for k in self.states if k < t_ns]:
             del self.states[stamp]
-        answer = self.runtime.answer(t_ns, states)
-        i = self.index
-        self.cmd_pub.publish(messages.rotor_command(t_ns, i, answer.output))
-        self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, i, answer.output))
-        self.error_pub.publish(messages.formation_error(t_ns, answer.formation_error,
-                                                        answer.formation_error_rate))
+        for topic, data in self.packer.of(self.runtime.answer(t_ns, states)):
+            self.by_topic[topic].publish(data)
 
 
 def main(args: list[str] | None = None) -> NoReturn:

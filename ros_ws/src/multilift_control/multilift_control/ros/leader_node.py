@@ -14,10 +14,10 @@ from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorComman
                                 TrackingReference)
 from rclpy.node import Node
 
-from multilift_control.ros.common import SNAPSHOT_TOPIC, snapshot_input
+from multilift_control.answer_messages import AnswerMessages
+from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
 from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros import messages
 from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
                                       controller_peers_missing, run_node, serve_controller)
 from multilift_sim.topics import uav_topic
@@ -31,26 +31,28 @@ class LeaderNode(Node):
         self.summary_dir = self.declare_parameter('summary_dir', '').value
         if not name:
             raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
-        self.runtime = ControllerRuntime(scenario_io.load(name), 0)
+        scenario = scenario_io.load(name)
+        self.runtime = ControllerRuntime(scenario, 0)
+        self.packer = AnswerMessages(scenario)  # the answer as CDR bytes
         self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(1, 'rotor_cmd'),
                                              PUBLISHER_QOS)
         self.ref_pub = self.create_publisher(TrackingReference, uav_topic(1, 'reference'),
                                              PUBLISHER_QOS)
         self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
                                                   uav_topic(1, 'attitude_setpoint'), PUBLISHER_QOS)
+        self.by_topic = {pub.topic_name: pub
+                         for pub in (self.cmd_pub, self.ref_pub, self.setpoint_pub)}
+        self.read_snapshot = SnapshotReader(scenario)
         self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
-                                 SUBSCRIBER_QOS)
+                                 SUBSCRIBER_QOS, raw=True)
 
     def missing_peers(self) -> str | None:
         return controller_peers_missing(self, self.cmd_pub, self.record)
 
-    def on_snapshot(self, msg: FormationSnapshot) -> None:
-        t_ns, states, _ = snapshot_input(msg)
-        answer = self.runtime.answer(t_ns, states)
-        self.cmd_pub.publish(messages.rotor_command(t_ns, 1, answer.output))
-        self.setpoint_pub.publish(messages.attitude_setpoint(t_ns, 1, answer.output))
-        if answer.reference is not None:
-            self.ref_pub.publish(messages.tracking_reference(t_ns, answer.reference))
+    def on_snapshot(self, data: bytes) -> None:
+        t_ns, states, _ = self.read_snapshot(data)
+        for topic, data in self.packer.of(self.runtime.answer(t_ns, states)):
+            self.by_topic[topic].publish(data)
 
 
 def main(args: list[str] | None = None) -> NoReturn:

@@ -1,6 +1,7 @@
-"""The multilift messages, built from model values in one place: the nodes publish them and the
-headless runner writes the very same messages to its bag (so a ROS run and a headless run of a
-scenario can be compared message by message). World frame, SI units.
+"""The multilift messages as rclpy objects, built from the same model values
+(multilift_sim.msgvalues) as the CDR bytes the nodes publish (multilift_sim.tick_messages,
+multilift_control.answer_messages): the independent reference tests/unit/test_cdr.py holds
+those bytes to. World frame, SI units.
 """
 from __future__ import annotations
 
@@ -96,20 +97,6 @@ def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | N
     msg.header.stamp = stamp_from_ns(snapshot.t_ns)
     msg.header.frame_id = WORLD_FRAME
     return msg
-
-
-def snapshot_arrays(msg: FormationSnapshot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                     np.ndarray, list[np.ndarray]]:
-    """(positions, velocities, euler, body_rates) each (n, 3), and the previous rotor speeds
-    per UAV (an empty list at t = 0) of a FormationSnapshot."""
-    def rows(values) -> np.ndarray:
-        return np.asarray(values, dtype=float).reshape(-1, 3)
-    previous = np.asarray(msg.previous_rotor_speeds, dtype=float)
-    speeds = []
-    if previous.size:
-        edges = np.cumsum(msg.rotor_count)[:-1]
-        speeds = np.split(previous, edges)
-    return rows(msg.position), rows(msg.velocity), rows(msg.euler), rows(msg.body_rates), speeds
 
 
 def rotor_command(t_ns: int, index: int, output) -> RotorCommand:

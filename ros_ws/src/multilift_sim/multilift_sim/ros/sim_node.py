@@ -31,8 +31,6 @@ from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
-from multilift_sim.ros import messages
-from multilift_sim.ros.markers import formation_markers
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (PUBLISHER_QOS, RECORDER_NODE, STARTUP_TIMEOUT, Fatal,
                                       ns_from_stamp, recorder_hears, recorder_missing, run_node,
@@ -41,6 +39,7 @@ from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import MARKER_DECIMATION, parse_external, uav_topic
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
+from multilift_sim.tick_messages import Message, SimulatorMessages
 
 
 # [s] the graph stays complete this long before t = 0 when a user's node answers (see
@@ -80,7 +79,6 @@ class SimNode(Node):
         self.payload_pub = self.create_publisher(Odometry, '/payload/odom', PUBLISHER_QOS)
         self.snapshot_pub = self.create_publisher(FormationSnapshot, '/formation/snapshot',
                                                   PUBLISHER_QOS)
-        self.rotor_counts = [u.vehicle.n_rotors for u in scenario.uavs]
         self.applied: list[np.ndarray] | None = None  # rotor speeds held up to this tick
         self.formation_pub = self.create_publisher(FormationState, '/formation/state',
                                                    PUBLISHER_QOS)
@@ -88,6 +86,11 @@ class SimNode(Node):
         self.marker_pub = self.create_publisher(MarkerArray, '/visualization/markers',
                                                 PUBLISHER_QOS)
         self.tf_pub = self.create_publisher(TFMessage, '/tf', PUBLISHER_QOS)
+        # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
+        self.packer = SimulatorMessages(scenario)
+        self.by_topic = {pub.topic_name: pub for pub in (
+            self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
+            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub)}
         self.commands: list[RotorCommand | None] = [None] * n
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)
@@ -142,21 +145,17 @@ class SimNode(Node):
                                            *self.odom_pubs])
         return None
 
+    def send(self, message: Message) -> None:
+        topic, data = message
+        self.by_topic[topic].publish(data)
+
     def publish_state(self) -> Snapshot:
-        """The state at this tick, the controllers' snapshot first; returns the snapshot."""
+        """The state at this tick, the controllers' snapshot first (they answer while the rest
+        goes out); returns the snapshot."""
         snap = self.sim.snapshot()
-        t_ns = snap.t_ns
-        self.clock_pub.publish(messages.clock(t_ns))
-        # the controllers' one input message first: they answer while the rest goes out
-        self.snapshot_pub.publish(messages.formation_snapshot(snap, self.applied,
-                                                              self.rotor_counts))
-        for i, uav in enumerate(snap.uavs):
-            self.odom_pubs[i].publish(messages.uav_odometry(t_ns, i + 1, uav))
-        self.payload_pub.publish(messages.payload_odometry(t_ns, snap.payload_position,
-                                                           snap.payload_velocity))
         gust = self.sim.model.gust_velocity_at_payload(self.sim.t, self.sim.state)
-        self.gust_pub.publish(messages.gust(t_ns, gust))
-        self.tf_pub.publish(messages.transforms(t_ns, snap))
+        for message in self.packer.state(snap, gust, self.applied):
+            self.send(message)
         return snap
 
     def wait_for_commands(self) -> None:
@@ -178,11 +177,9 @@ class SimNode(Node):
         """/formation/state (and the markers) of the tick of `snap`, once it is integrated:
         the tension comes from that integration (`FormationSimulator.cables_of`)."""
         tension, g, g_dot = self.sim.cables_of(held)
-        self.formation_pub.publish(messages.formation_state(snap.t_ns, tension, g, g_dot,
-                                                            held.taut))
+        self.send(self.packer.formation(snap.t_ns, tension, g, g_dot, held.taut))
         if held.tick % MARKER_DECIMATION == 0:
-            self.marker_pub.publish(formation_markers(snap, tension, self.scenario, snap.t_ns,
-                                                      held.taut))
+            self.send(self.packer.markers(snap, tension, held.taut))
 
     def run(self) -> None:
         wait_until(self, self.missing_peers, self.startup_timeout)

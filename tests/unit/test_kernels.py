@@ -4,6 +4,10 @@ gusts gives the same numbers (bit for bit here; 1e-12 is what the test demands),
 MULTILIFT_KERNEL=python switches the compiled one off."""
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -57,3 +61,21 @@ def test_cache_dir_is_writable_and_under_the_users_cache():
     from pathlib import Path
     directory = Path(os.environ['NUMBA_CACHE_DIR'])
     assert directory.parts[-2:] == ('multilift', 'numba')
+
+
+def test_loading_the_kernel_leaves_scipy_unimported_and_importable():
+    """numba's BLAS probe is kept from importing scipy (a start-up cost); scipy still imports
+    afterwards, and the kernel still integrates."""
+    code = ('import sys, numpy as np\n'
+            'from multilift_sim import kernels, scenario\n'
+            'from multilift_sim.simulation import FormationSimulator\n'
+            'assert kernels.enabled()\n'
+            'sim = FormationSimulator(scenario.load("twin_lift"))\n'
+            'sim.advance([np.full(4, 1500.0)] * 2, [np.zeros(4, bool)] * 2)\n'
+            'print("scipy" in sys.modules)\n'
+            'import scipy.linalg\n'
+            'print(scipy.linalg.solve(np.eye(2), np.ones(2)).tolist())\n')
+    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                         timeout=120, env={**os.environ, 'MULTILIFT_KERNEL': 'auto'})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split('\n')[:2] == ['False', '[1.0, 1.0]']

@@ -9,11 +9,13 @@ UAV 1 (index 0) is the leader. Pure numpy.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_control.cascade import CascadeController, ControlOutput, UavState
+from multilift_control.cascade import (CascadeController, ControlOutput, FormationStates,
+                                       UavState)
 from multilift_sim import formation_geometry  # start places and the V offsets v_1i, world
 from multilift_sim.kinematics import thrust_axis
 from multilift_sim.multirotor import MultirotorParams
@@ -427,7 +429,7 @@ class FormationFollower:
         weights = (self.masses[:, None] * self.gravity * E_Z).reshape(-1)
         return p, p @ jac, inv_m, weights, jac[self.rows]
 
-    def desired_force(self, t: float, states: list[UavState], thrust_vectors: np.ndarray
+    def desired_force(self, t: float, states: Sequence[UavState], thrust_vectors: np.ndarray
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(F world [N], errors g_vc[rows_of(i)], error rates J r_dot[rows_of(i)]).
 
@@ -435,8 +437,8 @@ class FormationFollower:
         advances the altitude integral to t [s]. `update` calls it once per tick.
         """
         i = self.index
-        r = np.array([s.position for s in states], dtype=float)
-        v = np.array([s.velocity for s in states], dtype=float)
+        states = FormationStates.of(states)
+        r, v = states.positions, states.velocities
         u = np.array(thrust_vectors, dtype=float)
         if self.own_thrust == 'commanded' and self.lift is not None:
             u[i] = self.lift
@@ -484,7 +486,7 @@ class FormationFollower:
         correction = basis @ (basis.T @ (target - u[1:, :2]).reshape(-1))
         return correction[2 * (self.index - 1):2 * self.index]
 
-    def update(self, t: float, states: list[UavState], thrust_vectors: np.ndarray
+    def update(self, t: float, states: Sequence[UavState], thrust_vectors: np.ndarray
                ) -> tuple[ControlOutput, np.ndarray, np.ndarray]:
         """One control tick at simulated time t [s].
 

@@ -12,7 +12,7 @@ from typing import Callable
 
 import numpy as np
 
-from multilift_control.cascade import UavState, balancing_rotor_speed
+from multilift_control.cascade import FormationStates, UavState, balancing_rotor_speed
 from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answer_tick,
                                        formation_runtimes)
 from multilift_sim.scenario import Scenario
@@ -22,8 +22,10 @@ from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snap
 TickObserver = Callable[[FormationSimulator, Snapshot, list[ControllerAnswer]], None]
 
 
-def uav_states(snapshot: Snapshot) -> list[UavState]:
-    return [UavState(u.position, u.velocity, u.euler, u.body_rates) for u in snapshot.uavs]
+def uav_states(snapshot: Snapshot) -> FormationStates:
+    """What the controllers measure of the formation at the snapshot's tick."""
+    return FormationStates(UavState(u.position, u.velocity, u.euler, u.body_rates)
+                           for u in snapshot.uavs)
 
 
 @dataclass

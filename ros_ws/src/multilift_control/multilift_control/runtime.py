@@ -11,6 +11,7 @@ compares their bags to 1e-9 m).
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,7 +66,7 @@ class ThrustBook:
     def has_leader(self, t_ns: int) -> bool:
         return t_ns in self.leader
 
-    def vectors(self, t_ns: int, states: list[UavState]) -> np.ndarray:
+    def vectors(self, t_ns: int, states: Sequence[UavState]) -> np.ndarray:
         """Every UAV's thrust vector R_j(t) e_z u_T,j, world [N], shape (n, 3), for the state
         at t_ns; needs the leader's answer to it. Formed once per state: followers that share
         the book (one process, `formation_runtimes`) get the same array (read-only)."""
@@ -115,7 +116,7 @@ class ControllerRuntime:
         """Whether this controller can answer the state at t_ns (given every UAV's state)."""
         return not self.is_follower or self.thrusts.has_leader(t_ns)
 
-    def answer(self, t_ns: int, states: list[UavState]) -> ControllerAnswer:
+    def answer(self, t_ns: int, states: Sequence[UavState]) -> ControllerAnswer:
         """The answer to the formation state at t_ns (`states`: every UAV, from the leader)."""
         t = t_ns * 1e-9
         if not self.is_follower:
@@ -143,7 +144,7 @@ def formation_runtimes(scenario: Scenario) -> list[ControllerRuntime]:
 
 
 def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
-                states: list[UavState]) -> list[ControllerAnswer]:
+                states: Sequence[UavState]) -> list[ControllerAnswer]:
     """Every controller's answer to the state at t_ns, in the order the ROS graph gives them:
     the leader first, then the followers, each of whose books then notes every answer."""
     leader = runtimes[0].answer(t_ns, states)

@@ -11,6 +11,7 @@ equal); this one is used when numba imports and MULTILIFT_KERNEL is not `python`
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -31,12 +32,29 @@ def _load():
     global _integrate, _unavailable
     if _integrate is None and not _unavailable:
         try:
+            _import_numba_quietly()
             from multilift_sim._numba_kernel import integrate_period
         except ImportError:
             _unavailable = True
             return None
         _integrate = integrate_period
     return _integrate
+
+
+def _import_numba_quietly() -> None:
+    """Import numba's array implementations without scipy. Loading even a cached kernel
+    imports numba.np.arraymath, whose import imports scipy.linalg only to learn whether BLAS
+    is there for np.dot of vectors (0.1-0.4 s of every process's start here; our kernels call
+    no BLAS). Hidden from that probe, numba takes its plain loop for such products; scipy
+    imports normally afterwards."""
+    hide = 'scipy' not in sys.modules
+    if hide:
+        sys.modules['scipy'] = None  # an import of scipy now raises ImportError
+    try:
+        import numba.np.arraymath  # noqa: F401 - the import is the point
+    finally:
+        if hide and sys.modules.get('scipy', False) is None:
+            del sys.modules['scipy']
 
 
 def model_constants(model) -> tuple:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from multilift_control.cascade import UavState
+from multilift_control.cascade import FormationStates, UavState
 from multilift_sim import cdr
 from multilift_sim.ros.common import Fatal
 from multilift_sim.scenario import Scenario
@@ -21,14 +21,14 @@ class SnapshotReader:
         self._edges = np.cumsum(counts)[:-1]
         self._scenario = scenario.name
 
-    def __call__(self, data: bytes) -> tuple[int, list[UavState], list[np.ndarray]]:
+    def __call__(self, data: bytes) -> tuple[int, FormationStates, list[np.ndarray]]:
         try:
             (t_ns, position, velocity, euler, body_rates, _, _,
              previous) = self._cdr.unpack(data)
         except ValueError as error:
             raise Fatal(f'{SNAPSHOT_TOPIC} is not of scenario {self._scenario}\'s formation '
                         f'({error}): is another simulator on this ROS domain?') from None
-        states = [UavState(*row) for row in zip(position.reshape(-1, 3),
-                                                 velocity.reshape(-1, 3), euler.reshape(-1, 3),
-                                                 body_rates.reshape(-1, 3))]
+        states = FormationStates(UavState(*row) for row in zip(
+            position.reshape(-1, 3), velocity.reshape(-1, 3), euler.reshape(-1, 3),
+            body_rates.reshape(-1, 3)))
         return t_ns, states, np.split(previous, self._edges) if previous.size else []

@@ -10,6 +10,7 @@ shared with the headless loop. Parameters: scenario, uav_index, record, summary_
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import NoReturn
 
 import numpy as np
@@ -44,7 +45,7 @@ class FollowerNode(Node):
         self.period_ns = int(round(1e9 / scenario.simulation.control_rate))
         self.runtime = ControllerRuntime(scenario, self.index - 1)
         self.packer = AnswerMessages(scenario)  # the answer as CDR bytes
-        self.states: dict[int, list[UavState]] = {}   # t_ns -> every UAV's state
+        self.states: dict[int, Sequence[UavState]] = {}   # t_ns -> every UAV's state
         self.read_snapshot = SnapshotReader(scenario)
         self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
                                  SUBSCRIBER_QOS, raw=True)

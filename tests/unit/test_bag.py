@@ -238,3 +238,35 @@ def test_recover_a_torn_file(tmp_path):
         qos = reader.connections[0].ext.offered_qos_profiles
     assert values == [list(_rotor(i).angular_velocity) for i in range(readable)]
     assert qos[0].durability == QosDurability.TRANSIENT_LOCAL
+
+
+@pytest.mark.parametrize('compression', ['zstd', 'lz4', 'none'])
+def test_messages_are_written_as_the_mcap_library_writes_them(tmp_path, compression):
+    """BagWriter packs each Message record itself (bag._MessageAppender): the file is the one
+    the library's Writer.add_message gives, byte for byte, across several chunks, topics and
+    log times out of order."""
+    def fill(bag: BagWriter) -> None:
+        bag.add_topic('/uav1/odom', 'nav_msgs/msg/Odometry', ROSBAG2_QOS)
+        bag.add_topic('/uav1/rotor_cmd', 'multilift_msgs/msg/RotorCommand', ROSBAG2_QOS)
+        for i in range(300):
+            bag.write('/uav1/odom', serialize_message(_odometry(i)), 10_000 * i)
+            bag.write('/uav1/rotor_cmd', serialize_message(_rotor(i)), 10_000 * i + 3,
+                      publish_time_ns=7 * i)
+            if i % 50 == 7:
+                bag.write('/uav1/odom', serialize_message(_odometry(i)), 500 * i)  # earlier
+        bag.close()
+
+    fast = BagWriter(tmp_path / 'fast' / 'bag', compression=compression, chunk_size=4096)
+    fill(fast)
+    library = BagWriter(tmp_path / 'library' / 'bag', compression=compression, chunk_size=4096)
+    writer = library._writer
+
+    def add(channel_id, sequence, log_time, publish_time, data):
+        writer.add_message(channel_id, log_time, bytes(data), publish_time, sequence=sequence)
+    library._messages.add = add
+    fill(library)
+    data = _mcap(tmp_path / 'fast' / 'bag').read_bytes()
+    chunks = [r for r in make_reader(open(_mcap(tmp_path / 'fast' / 'bag'), 'rb'))
+              .get_summary().chunk_indexes]
+    assert len(chunks) > 5
+    assert data == _mcap(tmp_path / 'library' / 'bag').read_bytes()

@@ -63,3 +63,12 @@ def test_euler_from_quaternion_inverts_quaternion_from_euler():
     stack = Rotation.from_euler('ZYX', angles[:6, ::-1]).as_quat().reshape(2, 3, 4)
     np.testing.assert_allclose(euler_from_quaternion(stack), angles[:6].reshape(2, 3, 3),
                                atol=1e-9)
+
+
+def test_message_quaternion_is_quaternion_from_euler():
+    """msgvalues.quaternion (plain floats, one attitude per message) against the array form."""
+    from multilift_sim.msgvalues import quaternion
+    rng = np.random.default_rng(11)
+    for eta in rng.uniform(-np.pi, np.pi, (200, 3)):
+        np.testing.assert_allclose(quaternion(eta), quaternion_from_euler(eta), rtol=0,
+                                   atol=1e-15)

@@ -6,11 +6,11 @@ World frame, SI units.
 """
 from __future__ import annotations
 
+import math
 from typing import Sequence
 
 import numpy as np
 
-from multilift_sim.kinematics import quaternion_from_euler
 
 WORLD_FRAME = 'world'
 PAYLOAD_FRAME = 'payload'
@@ -31,9 +31,14 @@ def stamp(t_ns: int) -> tuple[int, int]:
 
 
 def quaternion(euler: Sequence[float]) -> Quat:
-    """(x, y, z, w) of ZYX Euler angles (kinematics.quaternion_from_euler) as floats."""
-    q = quaternion_from_euler(euler).tolist()
-    return q[0], q[1], q[2], q[3]
+    """(x, y, z, w) of ZYX Euler angles [rad]: kinematics.quaternion_from_euler's arithmetic in
+    plain floats (one attitude per message: numpy's per-call cost would be most of it)."""
+    roll, pitch, yaw = (0.5 * float(a) for a in euler)
+    sr, cr = math.sin(roll), math.cos(roll)
+    sp, cp = math.sin(pitch), math.cos(pitch)
+    sy, cy = math.sin(yaw), math.cos(yaw)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
 
 
 def vec3(values: Sequence[float]) -> Vec3:

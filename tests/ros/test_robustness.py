@@ -531,3 +531,30 @@ def test_a_teardown_that_ends_leaves_no_warning():
               'import time; time.sleep(1.5)\n')
     out = subprocess.run(['python', '-c', script], capture_output=True, text=True, timeout=30)
     assert out.returncode == 0 and 'warning' not in out.stderr and not out.stderr, out.stderr
+
+
+# -- our nodes' Fast DDS profile (run_node's use_fastdds_profile) -------------------------------
+def test_the_fastdds_profile_is_written_and_parsed_and_a_users_own_wins(tmp_path, monkeypatch):
+    from multilift_sim.ros.common import FASTDDS_HEARTBEAT_PROFILE, use_fastdds_profile
+    for name in ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE'):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
+    path = use_fastdds_profile()
+    assert path == tmp_path / 'cache' / 'multilift' / 'fastdds_profiles.xml'
+    assert path.read_text() == FASTDDS_HEARTBEAT_PROFILE
+    assert os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] == str(path)
+    # Fast DDS reads it without complaint: a node with a publisher, under the profile
+    probe = ('import rclpy; from std_msgs.msg import String\n'
+             'rclpy.init(); node = rclpy.create_node("profile_probe")\n'
+             'pub = node.create_publisher(String, "/profile_probe", 10)\n'
+             'pub.publish(String(data="x")); node.destroy_node(); rclpy.shutdown()\n'
+             'print("ok")\n')
+    out = subprocess.run(['python', '-c', probe], capture_output=True, text=True, timeout=60,
+                         env=dict(os.environ))
+    assert out.returncode == 0 and out.stdout.strip() == 'ok', out.stderr
+    assert 'error' not in out.stderr.lower(), out.stderr
+    # a profile the user names is left alone
+    monkeypatch.setenv('FASTDDS_DEFAULT_PROFILES_FILE', str(tmp_path / 'theirs.xml'))
+    monkeypatch.delenv('FASTRTPS_DEFAULT_PROFILES_FILE')
+    assert use_fastdds_profile() is None
+    assert 'FASTRTPS_DEFAULT_PROFILES_FILE' not in os.environ

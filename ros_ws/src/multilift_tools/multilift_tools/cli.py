@@ -127,7 +127,8 @@ def _summary(name: str, data: dict, bag: Path | None, scenario) -> None:
     for i in range(2, scenario.n_uavs + 1):
         follower = data.get(f'follower{i}')
         if follower and follower.get('answered_states'):
-            lines.append(f'  uav{i} formation  max |g_vc| '
+            # the largest row and the mean norm of its rows: the mean can exceed the max
+            lines.append(f'  uav{i} formation  largest |g_vc| row '
                          f'{follower["max_abs_formation_error"]:.3f}, mean |g_vc| '
                          f'{follower["mean_formation_error_norm"]:.3f} (m)')
     if bag is not None:

@@ -1,4 +1,4 @@
-"""CDR (XCDR1, little endian) of the messages a run records, packed without rclpy.
+"""CDR (XCDR1, little endian) of the messages a run publishes and records, packed without rclpy.
 
 Each packer compiles one `struct.Struct` for its message layout once (the frame names and the
 sequence lengths of a run are fixed), then packs a message in one call from plain numbers: the

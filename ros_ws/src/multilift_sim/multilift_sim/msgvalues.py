@@ -1,8 +1,8 @@
 """The numbers our messages carry, computed once from model values (no rclpy, no message types).
 
-multilift_sim.ros.messages fills rclpy messages from these functions and multilift_sim.cdr packs
-CDR straight from them, so a node's message and a headless bag's record hold the same values.
-World frame, SI units.
+multilift_sim.cdr packs CDR straight from these functions (the bytes the nodes publish and the
+headless bag writes), and multilift_sim.ros.messages fills rclpy messages from them, the
+reference the packed bytes are tested against. World frame, SI units.
 """
 from __future__ import annotations
 

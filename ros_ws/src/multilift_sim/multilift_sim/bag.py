@@ -99,11 +99,10 @@ class _MessageAppender:
     file's statistics, the chunk's time range and message index, the chunk finished past
     `chunk_size`; tests/unit/test_bag.py holds the file byte-equal to the library's."""
 
-    def __init__(self, writer: Writer, chunk_size: int) -> None:
+    def __init__(self, writer: Writer) -> None:
         self._statistics = writer._Writer__statistics          # noqa: SLF001 - see above
         self._chunk = writer._Writer__chunk_builder            # noqa: SLF001
-        self._finish_chunk = writer._Writer__maybe_finalize_chunk  # noqa: SLF001
-        self._chunk_size = chunk_size
+        self._maybe_finish_chunk = writer._Writer__maybe_finalize_chunk  # noqa: SLF001
 
     def add(self, channel_id: int, sequence: int, log_time: int, publish_time: int,
             data: bytes) -> None:
@@ -130,8 +129,7 @@ class _MessageAppender:
         records.write(_MESSAGE_RECORD.pack(0x05, _MESSAGE_FIELDS + len(data), channel_id,
                                            sequence, log_time, publish_time))
         records.write(data)
-        if records.count > self._chunk_size:
-            self._finish_chunk()
+        self._maybe_finish_chunk()  # past the Writer's chunk_size
 
 
 @dataclass
@@ -188,7 +186,7 @@ class BagWriter:
         self._writer = Writer(self._file, chunk_size=chunk_size,
                               compression=_COMPRESSION[compression], enable_crcs=True)
         self._writer.start(profile='ros2', library=LIBRARY)
-        self._messages = _MessageAppender(self._writer, chunk_size)
+        self._messages = _MessageAppender(self._writer)
         self._topics: dict[str, _Topic] = {}
         self._schema_ids: dict[str, int] = {}
         self._start_ns = _NO_TIME

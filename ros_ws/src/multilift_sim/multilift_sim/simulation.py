@@ -98,6 +98,8 @@ class FormationSimulator:
         # and (g, g_dot) at the current state, for whoever reports them (the headless bag)
         self.last_step: Integration | None = None
         self.residuals: tuple[np.ndarray, np.ndarray] | None = None
+        # the air velocity at the payload in the current state [m/s], world (/payload/gust)
+        self.payload_gust: np.ndarray = np.zeros(3)
         # how far each cable reaches for the swing's equilibrium place: l_i widened by the
         # constraint tolerance, so cables held within it always meet [m]
         self._reach = [math.sqrt(u.cable_length ** 2 + sim.constraint_tolerance)
@@ -244,8 +246,8 @@ class FormationSimulator:
             n, x = self.n, self.state
             stats.swing.add(payload_swing_at(x[:6 * n].reshape(n, 6)[:, :3],
                                              x[6 * n:6 * n + 3], self._reach))
+        gust = self.payload_gust = self.model.gust_velocity_at_payload(t, self.state)
         if self.scenario.gusts:
-            gust = self.model.gust_velocity_at_payload(t, self.state)
             stats.max_gust_speed = max(stats.max_gust_speed,
                                        math.sqrt(gust @ gust))  # np.linalg.norm's arithmetic
         sim = self.scenario.simulation

@@ -45,8 +45,7 @@ class HeadlessBag:
         """Write the state at tick t and every controller's answer to it."""
         self.finish_pending(sim)
         t_ns, write = snap.t_ns, self._write
-        gust = sim.model.gust_velocity_at_payload(sim.t, sim.state)
-        for topic, data in self._simulator.state(snap, gust, self._applied):
+        for topic, data in self._simulator.state(snap, sim.payload_gust, self._applied):
             write(topic, data, t_ns)
         self._applied = [a.output.rotor_speeds for a in answers]
         for answer in answers:

@@ -23,8 +23,9 @@ from multilift_control.cascade import UavState
 from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
 from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, ns_from_stamp,
-                                      controller_peers_missing, run_node, serve_controller)
+from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, RawPublishers,
+                                      controller_peers_missing, ns_from_stamp, run_node,
+                                      serve_controller)
 from multilift_sim.topics import uav_topic
 
 
@@ -58,8 +59,7 @@ class FollowerNode(Node):
                                                   uav_topic(i, 'attitude_setpoint'), PUBLISHER_QOS)
         self.error_pub = self.create_publisher(VirtualConstraintError,
                                                uav_topic(i, 'formation_error'), PUBLISHER_QOS)
-        self.by_topic = {pub.topic_name: pub
-                         for pub in (self.cmd_pub, self.setpoint_pub, self.error_pub)}
+        self.outputs = RawPublishers(self.cmd_pub, self.setpoint_pub, self.error_pub)
 
     def missing_peers(self) -> str | None:
         return controller_peers_missing(self, self.cmd_pub, self.record)
@@ -82,8 +82,7 @@ class FollowerNode(Node):
         states = self.states.pop(t_ns)
         for stamp in [k for k in self.states if k < t_ns]:
             del self.states[stamp]
-        for topic, data in self.packer.of(self.runtime.answer(t_ns, states)):
-            self.by_topic[topic].publish(data)
+        self.outputs.send(self.packer.of(self.runtime.answer(t_ns, states)))
 
 
 def main(args: list[str] | None = None) -> NoReturn:

@@ -18,7 +18,7 @@ from multilift_control.answer_messages import AnswerMessages
 from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
 from multilift_control.runtime import ControllerRuntime
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
+from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, RawPublishers,
                                       controller_peers_missing, run_node, serve_controller)
 from multilift_sim.topics import uav_topic
 
@@ -40,8 +40,7 @@ class LeaderNode(Node):
                                              PUBLISHER_QOS)
         self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
                                                   uav_topic(1, 'attitude_setpoint'), PUBLISHER_QOS)
-        self.by_topic = {pub.topic_name: pub
-                         for pub in (self.cmd_pub, self.ref_pub, self.setpoint_pub)}
+        self.outputs = RawPublishers(self.cmd_pub, self.ref_pub, self.setpoint_pub)
         self.read_snapshot = SnapshotReader(scenario)
         self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
                                  SUBSCRIBER_QOS, raw=True)
@@ -51,8 +50,7 @@ class LeaderNode(Node):
 
     def on_snapshot(self, data: bytes) -> None:
         t_ns, states, _ = self.read_snapshot(data)
-        for topic, data in self.packer.of(self.runtime.answer(t_ns, states)):
-            self.by_topic[topic].publish(data)
+        self.outputs.send(self.packer.of(self.runtime.answer(t_ns, states)))
 
 
 def main(args: list[str] | None = None) -> NoReturn:

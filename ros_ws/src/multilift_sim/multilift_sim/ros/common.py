@@ -13,7 +13,7 @@ import threading
 import time
 import traceback
 from pathlib import Path
-from typing import Callable, NoReturn
+from typing import Callable, Iterable, NoReturn
 
 import numpy as np
 import rclpy
@@ -218,6 +218,19 @@ def use_fastdds_profile() -> Path | None:
         return None
     os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(path)
     return path
+
+
+class RawPublishers:
+    """A node's publishers by topic, for messages that are already CDR bytes
+    (`multilift_sim.tick_messages.Message`: (topic, bytes)): sent as they are."""
+
+    def __init__(self, *publishers) -> None:
+        self._by_topic = {pub.topic_name: pub for pub in publishers}
+
+    def send(self, messages: Iterable[tuple[str, bytes]]) -> None:
+        """Publish each (topic, bytes) of `messages`, in order."""
+        for topic, data in messages:
+            self._by_topic[topic].publish(data)
 
 
 def flush_publishers(node: Node, timeout: float = FLUSH_TIMEOUT) -> None:

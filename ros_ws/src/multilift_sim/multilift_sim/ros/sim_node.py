@@ -33,13 +33,13 @@ from visualization_msgs.msg import MarkerArray
 
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (PUBLISHER_QOS, RECORDER_NODE, STARTUP_TIMEOUT, Fatal,
-                                      ns_from_stamp, recorder_hears, recorder_missing, run_node,
-                                      wait_until, write_summary)
+                                      RawPublishers, ns_from_stamp, recorder_hears,
+                                      recorder_missing, run_node, wait_until, write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import MARKER_DECIMATION, parse_external, uav_topic
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
-from multilift_sim.tick_messages import Message, SimulatorMessages
+from multilift_sim.tick_messages import SimulatorMessages
 
 
 # [s] the graph stays complete this long before t = 0 when a user's node answers (see
@@ -88,9 +88,9 @@ class SimNode(Node):
         self.tf_pub = self.create_publisher(TFMessage, '/tf', PUBLISHER_QOS)
         # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
         self.packer = SimulatorMessages(scenario)
-        self.by_topic = {pub.topic_name: pub for pub in (
+        self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
-            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub)}
+            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub)
         self.commands: list[RotorCommand | None] = [None] * n
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)
@@ -145,17 +145,11 @@ class SimNode(Node):
                                            *self.odom_pubs])
         return None
 
-    def send(self, message: Message) -> None:
-        topic, data = message
-        self.by_topic[topic].publish(data)
-
     def publish_state(self) -> Snapshot:
         """The state at this tick, the controllers' snapshot first (they answer while the rest
         goes out); returns the snapshot."""
         snap = self.sim.snapshot()
-        gust = self.sim.model.gust_velocity_at_payload(self.sim.t, self.sim.state)
-        for message in self.packer.state(snap, gust, self.applied):
-            self.send(message)
+        self.outputs.send(self.packer.state(snap, self.sim.payload_gust, self.applied))
         return snap
 
     def wait_for_commands(self) -> None:
@@ -177,9 +171,9 @@ class SimNode(Node):
         """/formation/state (and the markers) of the tick of `snap`, once it is integrated:
         the tension comes from that integration (`FormationSimulator.cables_of`)."""
         tension, g, g_dot = self.sim.cables_of(held)
-        self.send(self.packer.formation(snap.t_ns, tension, g, g_dot, held.taut))
+        self.outputs.send([self.packer.formation(snap.t_ns, tension, g, g_dot, held.taut)])
         if held.tick % MARKER_DECIMATION == 0:
-            self.send(self.packer.markers(snap, tension, held.taut))
+            self.outputs.send([self.packer.markers(snap, tension, held.taut)])
 
     def run(self) -> None:
         wait_until(self, self.missing_peers, self.startup_timeout)

@@ -1,7 +1,9 @@
 """Cascade multirotor control (seed Ch. 3): position -> attitude setpoint and thrust -> torques
 -> rotor speeds, saturated to the vehicle's [omega_min, omega_max].
 
-World frame z up, body frame FLU, ZYX Euler angles (docs/conventions.md). Pure numpy.
+World frame z up, body frame FLU, ZYX Euler angles (docs/conventions.md). The methods here
+are the reference; when the compiled kernels are on (`multilift_sim.kernels`) a tick runs the
+same arithmetic compiled (`multilift_control._numba_laws`, tests/unit/test_compiled_laws.py).
 """
 from __future__ import annotations
 
@@ -12,11 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from multilift_sim import kernels
 from multilift_sim.allocation import allocation_matrix
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario import ControlConfig
 
 E_Z = np.array([0.0, 0.0, 1.0])
+COMPILED_LAWS = 'multilift_control._numba_laws'  # the compiled per-tick arithmetic
 
 
 @dataclass(frozen=True)
@@ -139,9 +143,10 @@ class CascadeController:
         self.gravity = gravity
         self.inertia = np.asarray(vehicle.inertia, dtype=float)
         self.mixer = RotorMixer(vehicle)
-        self.integral = np.zeros(3)
         self.integral_limit = 0.5 * gravity  # [m/s^2] of integral authority
-        self._t_prev: float | None = None
+        # what the loop remembers: the integral (x, y, z) [m/s^2] and the time of the last
+        # tick [s] (NaN: none yet), in one array both the methods and the compiled code update
+        self._memory = np.array([0.0, 0.0, 0.0, math.nan])
         # the gains as arrays once (not per tick)
         self._kp = np.asarray(gains.position_kp, dtype=float)
         self._kd = np.asarray(gains.position_kd, dtype=float)
@@ -151,18 +156,32 @@ class CascadeController:
         self._inertia = tuple(map(float, vehicle.inertia))
         self._att_kp = tuple(map(float, gains.attitude_kp))
         self._att_kd = tuple(map(float, gains.attitude_kd))
+        self._laws = kernels.compiled_module(COMPILED_LAWS)  # None: the methods below
+        # the compiled code's constants (the _numba_laws.CASCADE_* layout)
+        self.compiled_constants = (
+            np.array([*self._kp, *self._kd, *self._ki, self.integral_limit, hover_mass, gravity,
+                      gains.max_tilt, *self._inertia, *self._att_kp, *self._att_kd,
+                      self.mixer.square_min, self.mixer.square_max], dtype=float),
+            np.ascontiguousarray(self.mixer.pinv), np.ascontiguousarray(self.mixer.collective))
+
+    @property
+    def integral(self) -> np.ndarray:
+        """The position loop's integral term [m/s^2], world (x, y, z)."""
+        return self._memory[:3]
 
     def position_force(self, t: float, state: UavState, position_ref: np.ndarray,
                        velocity_ref: np.ndarray, acceleration_ref: np.ndarray) -> np.ndarray:
         """Force the thrust should produce, world frame [N]."""
-        dt = 0.0 if self._t_prev is None else max(0.0, t - self._t_prev)
-        self._t_prev = t
+        t_prev = float(self._memory[3])
+        dt = 0.0 if math.isnan(t_prev) else max(0.0, t - t_prev)
+        self._memory[3] = t
         error = position_ref - state.position
-        self.integral = np.minimum(np.maximum(self.integral + self._ki * error * dt,
-                                              -self.integral_limit), self.integral_limit)
+        integral = np.minimum(np.maximum(self.integral + self._ki * error * dt,
+                                         -self.integral_limit), self.integral_limit)
+        self._memory[:3] = integral
         accel = (acceleration_ref + self._kp * error
                  + self._kd * (velocity_ref - state.velocity)
-                 + self.integral)
+                 + integral)
         return self.hover_mass * (accel + self._gravity_vector)
 
     def attitude_torque(self, state: UavState, setpoint: Sequence[float]) -> np.ndarray:
@@ -181,6 +200,10 @@ class CascadeController:
 
     def command(self, state: UavState, force: np.ndarray, yaw: float) -> ControlOutput:
         """Rotor speeds that produce `force` (world) at heading `yaw`."""
+        if self._laws is not None:
+            return ControlOutput(*self._laws.cascade_command(
+                *self.compiled_constants, state.euler, state.body_rates,
+                np.asarray(force, dtype=float), float(yaw)))
         roll, pitch, thrust = attitude_from_force(force, yaw, self.gains.max_tilt)
         setpoint = (roll, pitch, float(yaw))
         # the thrust acts along the current body z: ask for the part along it
@@ -192,6 +215,11 @@ class CascadeController:
                velocity_ref: np.ndarray, acceleration_ref: np.ndarray,
                yaw_ref: float = 0.0) -> ControlOutput:
         """One control tick at simulated time t [s]."""
+        if self._laws is not None:
+            return ControlOutput(*self._laws.cascade_update(
+                *self.compiled_constants, self._memory, t, state.position, state.velocity,
+                state.euler, state.body_rates, position_ref, velocity_ref, acceleration_ref,
+                float(yaw_ref)))
         force = self.position_force(t, state, position_ref, velocity_ref, acceleration_ref)
         return self.command(state, force, yaw_ref)
 

@@ -4,7 +4,9 @@ The followers keep the formation geometry by producing, with their thrust, the c
 that would hold the UAVs on the hypersurface g_vc(r_f) = 0 (Eq. 3.5). Everything is in the world
 frame (z up) of docs/conventions.md; the seed writes its equations in a z-down frame, so its
 "V" offsets v_1i go through `multilift_sim.frames` (`formation_geometry.v_offset`).
-UAV 1 (index 0) is the leader. Pure numpy.
+UAV 1 (index 0) is the leader. Pure numpy; with the compiled kernels on, a follower of linear
+(and V) rows runs its tick compiled (`multilift_control._numba_laws`), these methods the
+reference.
 """
 from __future__ import annotations
 
@@ -14,8 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_control.cascade import (CascadeController, ControlOutput, FormationStates,
-                                       UavState)
+from multilift_control.cascade import (COMPILED_LAWS, CascadeController, ControlOutput,
+                                       FormationStates, UavState)
+from multilift_sim import kernels
 from multilift_sim import formation_geometry  # start places and the V offsets v_1i, world
 from multilift_sim.kinematics import thrust_axis
 from multilift_sim.multirotor import MultirotorParams
@@ -374,11 +377,33 @@ class FormationFollower:
             nominal = constraints.nominal_positions(np.zeros(3))
             altitude_offset = nominal[index, 2] - nominal[0, 2]
         self.altitude_offset = float(altitude_offset)  # z_d,i - z_1 [m]
-        self.lift: np.ndarray | None = None  # last lift asked, R(eta_d) e_z u_T, world [N]
         self.cascade = CascadeController(vehicle, gains, hover_mass, gravity)
-        self.integral = 0.0  # [m/s^2]
         self.integral_limit = 0.5 * gravity
-        self._t_prev: float | None = None
+        # what the law remembers, in one array the methods and the compiled code update: the
+        # altitude integral [m/s^2], the time of the last tick [s] and the last lift asked
+        # R(eta_d) e_z u_T, world [N] (NaN: none yet)
+        self._memory = np.array([0.0, math.nan, math.nan, math.nan, math.nan])
+        laws = kernels.compiled_module(COMPILED_LAWS) if constraints.linear else None
+        self._compiled_update = None if laws is None else laws.linear_follower_update
+        p, q, inv_m, weights, own_rows = self._linear_law or (None,) * 5
+        self._compiled_law = None if laws is None else (  # the _numba_laws.FOLLOWER_* layout
+            np.array([2.0 * alpha_vc, beta_vc ** 2, self.altitude_offset, hover_mass, gravity,
+                      gains.position_kp[2], gains.position_kd[2], gains.position_ki[2],
+                      self.integral_limit, vehicle.thrust_coefficient,
+                      float(own_thrust == 'commanded')], dtype=float),
+            index, p, q, inv_m, weights, np.ascontiguousarray(own_rows),
+            constraints._flat_first, constraints._flat_second, constraints.targets,
+            self._row_index)
+
+    @property
+    def lift(self) -> np.ndarray | None:
+        """The lift asked at the last tick, R(eta_d) e_z u_T, world [N] (None before it)."""
+        return None if math.isnan(self._memory[2]) else self._memory[2:5].copy()
+
+    @property
+    def integral(self) -> float:
+        """The altitude loop's integral term [m/s^2]."""
+        return float(self._memory[0])
 
     @classmethod
     def from_scenario(cls, scenario, index: int, **options) -> FormationFollower:
@@ -440,8 +465,8 @@ class FormationFollower:
         states = FormationStates.of(states)
         r, v = states.positions, states.velocities
         u = np.array(thrust_vectors, dtype=float)
-        if self.own_thrust == 'commanded' and self.lift is not None:
-            u[i] = self.lift
+        if self.own_thrust == 'commanded' and not math.isnan(self._memory[2]):
+            u[i] = self._memory[2:5]
         if self._linear_law is not None:  # the same law, O(n): see _linear_law_matrices
             p, q, inv_m, weights, own_rows = self._linear_law
             residual = self.constraints.residual(r)
@@ -453,16 +478,17 @@ class FormationFollower:
                                      self.alpha_vc, self.beta_vc)
             u_vf_i = u_vf[i]
             residual = rates = None
-        dt = 0.0 if self._t_prev is None else max(0.0, t - self._t_prev)
-        self._t_prev = t
+        t_prev = float(self._memory[1])
+        dt = 0.0 if math.isnan(t_prev) else max(0.0, t - t_prev)
+        self._memory[1] = t
         # z_d,i = z_1 (seed §3.2, after Eq. 3.13), a reference the outer loop updates each tick:
         # the damping acts on the follower's own climb rate, not on z_1_dot - z_i_dot, hence
         # the follower's lag in the climb (§4.3, Fig. 4.7) and the leader's larger thrust
         # (Fig. 4.8)
         error = r[0, 2] + self.altitude_offset - r[i, 2]
         error_rate = -v[i, 2]
-        self.integral = min(max(self.integral + self.gains.position_ki[2] * error * dt,
-                                -self.integral_limit), self.integral_limit)
+        self._memory[0] = min(max(self.integral + self.gains.position_ki[2] * error * dt,
+                                  -self.integral_limit), self.integral_limit)
         force = np.empty(3)
         force[:2] = u[i, :2] + u_vf_i[:2]
         if self.free_mode_gain is not None:  # not in the seed: see the class docstring
@@ -494,12 +520,19 @@ class FormationFollower:
         R_i e_z u_T,i, world [N]. Returns (ControlOutput, the follower's rows of g_vc [m or
         m^2], their rates [m/s or m^2/s]).
         """
-        force, errors, rates = self.desired_force(t, states, thrust_vectors)
         state = states[self.index]
         if self.yaw is None:
             self.yaw = float(state.euler[2])  # hold the initial heading
+        if self._compiled_update is not None:  # this method's arithmetic, compiled
+            states = FormationStates.of(states)
+            speeds, saturated, setpoint, thrust, errors, rates = self._compiled_update(
+                *self._compiled_law, self._memory, t, states.positions, states.velocities,
+                np.asarray(thrust_vectors, dtype=float), *self.cascade.compiled_constants,
+                state.euler, state.body_rates, self.yaw)
+            return ControlOutput(speeds, saturated, setpoint, thrust), errors, rates
+        force, errors, rates = self.desired_force(t, states, thrust_vectors)
         out = self.cascade.command(state, force, self.yaw)  # Eq. 3.13, attitude loop, mixer
         # what the rotors will give after saturation, along the thrust axis asked for
         thrust = self.vehicle.collective_thrust(out.rotor_speeds)
-        self.lift = thrust_axis(*out.attitude_setpoint.tolist()) * thrust
+        self._memory[2:5] = thrust_axis(*out.attitude_setpoint.tolist()) * thrust
         return out, errors, rates

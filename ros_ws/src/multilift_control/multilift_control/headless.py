@@ -12,20 +12,14 @@ from typing import Callable
 
 import numpy as np
 
-from multilift_control.cascade import FormationStates, UavState, balancing_rotor_speed
+from multilift_control.cascade import balancing_rotor_speed
 from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answer_tick,
-                                       formation_runtimes)
+                                       formation_runtimes, uav_states)
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot
 
 # on_tick(simulator, snapshot at t, every controller's answer to it)
 TickObserver = Callable[[FormationSimulator, Snapshot, list[ControllerAnswer]], None]
-
-
-def uav_states(snapshot: Snapshot) -> FormationStates:
-    """What the controllers measure of the formation at the snapshot's tick."""
-    return FormationStates(UavState(u.position, u.velocity, u.euler, u.body_rates)
-                           for u in snapshot.uavs)
 
 
 @dataclass

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from multilift_control.cascade import COMPILED_LAWS
+from multilift_sim import kernels
 from multilift_sim.scenario import MissionConfig
 
 
@@ -56,10 +58,20 @@ class MissionPath:
             self._steps = np.vstack((self._steps, -self._velocities[-1]))
         self._end_list = self._ends.tolist()
         self._step_list = list(zip(self._step_times.tolist(), self._steps.tolist()))
+        # _filtered compiled when the kernels are on (multilift_control._numba_laws)
+        laws = kernels.compiled_module(COMPILED_LAWS)
+        self._compiled_filtered = None if laws is None else laws.filtered_reference
+        self._compiled_path = tuple(np.ascontiguousarray(a, dtype=float) for a in (
+            self._start, self._step_times, self._steps.reshape(-1, 3), self._ends,
+            self._velocities, self._origins.reshape(-1, 3), self._starts,
+            np.asarray(self._final, dtype=float)))
 
     def __call__(self, t: float) -> Reference:
         """The reference at simulated time t [s]."""
         if self._tau > 0.0:
+            if self._compiled_filtered is not None:  # _filtered's arithmetic, compiled
+                out = self._compiled_filtered(float(t), 1.0 / self._tau, *self._compiled_path)
+                return Reference(out[:3], out[3:6], out[6:])
             return self._filtered(t)
         return self._raw(t)
 

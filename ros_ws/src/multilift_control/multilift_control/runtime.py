@@ -16,12 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_control.cascade import ControlOutput, UavState
+from multilift_control.cascade import ControlOutput, FormationStates, UavState
 from multilift_control.controllers import make_controller
 from multilift_control.formation import FormationFollower
 from multilift_control.mission import Reference
 from multilift_sim.kinematics import thrust_axis
 from multilift_sim.scenario import Scenario
+from multilift_sim.simulation import FormationSimulator, Snapshot
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
 
 
@@ -156,3 +157,20 @@ def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
         for answer in answers[1:]:
             book.note(answer.index, t_ns, answer.output.rotor_speeds)
     return answers
+
+
+def uav_states(snapshot: Snapshot) -> FormationStates:
+    """What the controllers measure of the formation at the snapshot's tick."""
+    return FormationStates(UavState(u.position, u.velocity, u.euler, u.body_rates)
+                           for u in snapshot.uavs)
+
+
+def warm_up(scenario: Scenario, index: int) -> None:
+    """Answer the scenario's start once with a throwaway controller of UAV `index` (from 0),
+    so that its compiled laws are loaded from numba's cache, or compiled when the cache is
+    empty (seconds), before a node joins the lockstep, where the simulator's
+    `command_timeout` counts."""
+    runtime = ControllerRuntime(scenario, index)
+    if runtime.is_follower:
+        runtime.note_command(0, 0, np.zeros(scenario.uavs[0].vehicle.n_rotors))
+    runtime.answer(0, uav_states(FormationSimulator(scenario).snapshot()))

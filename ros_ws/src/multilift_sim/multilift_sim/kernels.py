@@ -6,39 +6,42 @@ equal); this one is used when numba imports and MULTILIFT_KERNEL is not `python`
 (`MULTILIFT_KERNEL=python` forces the pure kernel). Compiled code is cached on disk
 (`cache=True`) under NUMBA_CACHE_DIR, by default `$XDG_CACHE_HOME/multilift/numba`
 (`~/.cache/multilift/numba`), set before numba is imported: the first process compiles
-(about 1-2 s), later ones load the cache.
+(about 1-2 s), later ones load the cache. `compiled_module` loads the control laws' compiled
+functions (multilift_control._numba_laws) the same way, under the same switch.
 """
 from __future__ import annotations
 
+import importlib
 import os
 import sys
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
 _cache_home = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
 os.environ.setdefault('NUMBA_CACHE_DIR', str(Path(_cache_home) / 'multilift' / 'numba'))
 
-_integrate = None  # the compiled function, once built
-_unavailable = False
+_modules: dict[str, ModuleType | None] = {}  # compiled modules by name (None: no numba)
 
 
 def enabled() -> bool:
     """Whether the compiled kernel is to be used (numba importable, not switched off)."""
-    return os.environ.get('MULTILIFT_KERNEL', 'auto') != 'python' and _load() is not None
+    return compiled_module('multilift_sim._numba_kernel') is not None
 
 
-def _load():
-    global _integrate, _unavailable
-    if _integrate is None and not _unavailable:
+def compiled_module(name: str) -> ModuleType | None:
+    """The module of compiled functions `name` (imported once), or None when the pure-Python
+    reference is to be used: numba does not import, or MULTILIFT_KERNEL=python."""
+    if os.environ.get('MULTILIFT_KERNEL', 'auto') == 'python':
+        return None
+    if name not in _modules:
         try:
             _import_numba_quietly()
-            from multilift_sim._numba_kernel import integrate_period
+            _modules[name] = importlib.import_module(name)
         except ImportError:
-            _unavailable = True
-            return None
-        _integrate = integrate_period
-    return _integrate
+            _modules[name] = None
+    return _modules[name]
 
 
 def _import_numba_quietly() -> None:
@@ -71,5 +74,6 @@ def model_constants(model) -> tuple:
 def integrate(constants: tuple, x: np.ndarray, wrenches: np.ndarray, dt: float,
               steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """`steps` RK4 steps of dt [s] from x: (state, multipliers at x, g, g_dot at the end)."""
-    return _load()(*constants, np.ascontiguousarray(x, dtype=np.float64),
-                   np.ascontiguousarray(wrenches, dtype=np.float64), float(dt), int(steps))
+    kernel = compiled_module('multilift_sim._numba_kernel').integrate_period
+    return kernel(*constants, np.ascontiguousarray(x, dtype=np.float64),
+                  np.ascontiguousarray(wrenches, dtype=np.float64), float(dt), int(steps))

@@ -274,3 +274,46 @@ def test_messages_are_written_as_the_mcap_library_writes_them(tmp_path, compress
               .get_summary().chunk_indexes]
     assert len(chunks) > 5
     assert data == _mcap(tmp_path / 'library' / 'bag').read_bytes()
+
+
+@pytest.mark.parametrize('chunk_size', [1 << 20, 4096])
+def test_write_many_writes_what_write_writes(tmp_path, chunk_size):
+    """A tick's messages written together (`write_many`) are the records, sequences, times and
+    metadata that a `write` of each gives: in one chunk the same file byte for byte; across
+    chunks the same messages (a chunk is finished after a batch, not inside it)."""
+    payloads = [(serialize_message(_odometry(i)), serialize_message(_rotor(i)))
+                for i in range(300)]
+    topics = [('/uav1/odom', 'nav_msgs/msg/Odometry'),
+              ('/uav1/rotor_cmd', 'multilift_msgs/msg/RotorCommand')]
+
+    def bag(name: str) -> BagWriter:
+        writer = BagWriter(tmp_path / name / 'bag', chunk_size=chunk_size)
+        for topic, kind in topics:
+            writer.add_topic(topic, kind, ROSBAG2_QOS)
+        return writer
+
+    one_by_one, together = bag('one'), bag('together')
+    for i, (odometry, rotor) in enumerate(payloads):
+        tick = [('/uav1/odom', odometry), ('/uav1/rotor_cmd', rotor), ('/uav1/odom', rotor)]
+        for topic, data in tick:
+            one_by_one.write(topic, data, 10_000 * i)
+        together.write_many(tick, 10_000 * i)
+    together.write_many([], 5)  # nothing to write
+    with pytest.raises(BagError, match='/nowhere was not added'):
+        together.write_many([('/uav1/odom', b'x'), ('/nowhere', b'y')], 1)
+    one_by_one.close()
+    together.close()
+    first, second = _mcap(tmp_path / 'one' / 'bag'), _mcap(tmp_path / 'together' / 'bag')
+
+    def messages(path: Path) -> list:
+        with open(path, 'rb') as stream:
+            return [(channel.topic, message.sequence, message.log_time, message.publish_time,
+                     message.data)
+                    for _, channel, message in make_reader(stream).iter_messages()]
+    assert len(messages(second)) == 900
+    assert messages(first) == messages(second)
+    assert ((tmp_path / 'one' / 'bag' / 'metadata.yaml').read_text()
+            == (tmp_path / 'together' / 'bag' / 'metadata.yaml').read_text().replace(
+                'together', 'one'))
+    if chunk_size > 900 * 400:
+        assert first.read_bytes() == second.read_bytes()

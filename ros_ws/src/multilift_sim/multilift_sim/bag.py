@@ -24,7 +24,7 @@ import os
 import struct
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 from mcap.exceptions import McapError
 from mcap.records import Channel, Message, MessageIndex, Schema
@@ -106,29 +106,40 @@ class _MessageAppender:
 
     def add(self, channel_id: int, sequence: int, log_time: int, publish_time: int,
             data: bytes) -> None:
+        self.add_many([(channel_id, sequence, data)], log_time, publish_time)
+
+    def add_many(self, messages: list[tuple[int, int, bytes]], log_time: int,
+                 publish_time: int) -> None:
+        """`add` of each (channel id, sequence, data), all logged at `log_time`, in one write
+        to the chunk and one chunk-size check after them (a chunk may pass `chunk_size` by
+        these messages; `add` alone checks after each message, as the library)."""
         stats, chunk = self._statistics, self._chunk
         if stats.message_count == 0:
             stats.message_start_time = log_time
         else:
             stats.message_start_time = min(log_time, stats.message_start_time)
         stats.message_end_time = max(log_time, stats.message_end_time)
-        stats.channel_message_counts[channel_id] += 1
-        stats.message_count += 1
+        stats.message_count += len(messages)
         if chunk.num_messages == 0:
             chunk.message_start_time = log_time
         else:
             chunk.message_start_time = min(chunk.message_start_time, log_time)
         chunk.message_end_time = max(chunk.message_end_time, log_time)
-        index = chunk.message_indices.get(channel_id)
-        if index is None:
-            index = chunk.message_indices[channel_id] = MessageIndex(channel_id=channel_id,
-                                                                     records=[])
+        chunk.num_messages += len(messages)
+        counts, indices = stats.channel_message_counts, chunk.message_indices
         records = chunk.record_writer
-        index.records.append((log_time, records.count))
-        chunk.num_messages += 1
-        records.write(_MESSAGE_RECORD.pack(0x05, _MESSAGE_FIELDS + len(data), channel_id,
-                                           sequence, log_time, publish_time))
-        records.write(data)
+        offset, parts = records.count, []
+        for channel_id, sequence, data in messages:
+            counts[channel_id] += 1
+            index = indices.get(channel_id)
+            if index is None:
+                index = indices[channel_id] = MessageIndex(channel_id=channel_id, records=[])
+            index.records.append((log_time, offset))
+            parts.append(_MESSAGE_RECORD.pack(0x05, _MESSAGE_FIELDS + len(data), channel_id,
+                                              sequence, log_time, publish_time))
+            parts.append(data)
+            offset += _MESSAGE_RECORD.size + len(data)
+        records.write(b''.join(parts))
         self._maybe_finish_chunk()  # past the Writer's chunk_size
 
 
@@ -247,6 +258,33 @@ class BagWriter:
         self._start_ns = min(self._start_ns, log_time_ns)
         self._end_ns = max(self._end_ns, log_time_ns)
         self._unflushed = 0 if self._file.writes != writes_before else self._unflushed + 1
+
+    def write_many(self, messages: Sequence[tuple[str, bytes]], log_time_ns: int) -> None:
+        """`write` of each (topic, CDR bytes), all received at `log_time_ns` [ns], in order,
+        packed together (a headless tick's messages: about a fifth of the cost of a write
+        each); a chunk is finished after them, not between them."""
+        self._check_open()
+        if log_time_ns < 0:
+            raise BagError(f'negative log time {log_time_ns} ns for a message of '
+                           f'{messages[0][0] if messages else "no topic"}')
+        entries = [self._topics.get(topic) for topic, _ in messages]
+        if None in entries:
+            topic = messages[entries.index(None)][0]
+            raise BagError(f'topic {topic} was not added to bag {self.directory}; '
+                           'call add_topic first')
+        if not entries:
+            return
+        records = []
+        for entry, (_, data) in zip(entries, messages):
+            records.append((entry.channel_id, entry.message_count, data))
+            entry.message_count += 1
+        writes_before = self._file.writes
+        self._messages.add_many(records, log_time_ns, log_time_ns)
+        self._message_count += len(records)
+        self._start_ns = min(self._start_ns, log_time_ns)
+        self._end_ns = max(self._end_ns, log_time_ns)
+        self._unflushed = (0 if self._file.writes != writes_before
+                           else self._unflushed + len(records))
 
     def flush(self) -> None:
         """Finish the chunk in progress so every message written so far is on disk."""

@@ -34,7 +34,7 @@ class HeadlessBag:
         qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
         for topic, kind in run_topics(scenario.n_uavs):
             writer.add_topic(topic, kind, qos)
-        self._write = writer.write
+        self._write = writer.write_many  # a tick's messages, all stamped with its time
         self._simulator = SimulatorMessages(scenario)
         self._answers = AnswerMessages(scenario)
         self._applied = None  # the rotor speeds held up to this tick (None at t = 0)
@@ -44,13 +44,11 @@ class HeadlessBag:
              answers: list[ControllerAnswer]) -> None:
         """Write the state at tick t and every controller's answer to it."""
         self.finish_pending(sim)
-        t_ns, write = snap.t_ns, self._write
-        for topic, data in self._simulator.state(snap, sim.payload_gust, self._applied):
-            write(topic, data, t_ns)
+        messages = self._simulator.state(snap, sim.payload_gust, self._applied)
         self._applied = [a.output.rotor_speeds for a in answers]
         for answer in answers:
-            for topic, data in self._answers.of(answer):
-                write(topic, data, t_ns)
+            messages += self._answers.of(answer)
+        self._write(messages, snap.t_ns)
         self._pending = (snap, sim.tick_cables(self._applied))
 
     def finish_pending(self, sim: FormationSimulator) -> None:
@@ -61,10 +59,10 @@ class HeadlessBag:
         snap, held = self._pending
         self._pending = None
         tension, g, g_dot = sim.cables_of(held)
-        self._write(*self._simulator.formation(snap.t_ns, tension, g, g_dot, held.taut),
-                    snap.t_ns)
+        messages = [self._simulator.formation(snap.t_ns, tension, g, g_dot, held.taut)]
         if held.tick % MARKER_DECIMATION == 0:
-            self._write(*self._simulator.markers(snap, tension, held.taut), snap.t_ns)
+            messages.append(self._simulator.markers(snap, tension, held.taut))
+        self._write(messages, snap.t_ns)
 
 
 def record_headless(scenario: Scenario, bag_dir: Path,

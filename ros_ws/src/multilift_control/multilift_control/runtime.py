@@ -20,7 +20,7 @@ from multilift_control.cascade import ControlOutput, FormationStates, UavState
 from multilift_control.controllers import make_controller
 from multilift_control.formation import FormationFollower
 from multilift_control.mission import Reference
-from multilift_sim.kinematics import thrust_axis
+from multilift_sim.kinematics import thrust_axis_floats
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
@@ -79,7 +79,7 @@ class ThrustBook:
         for stamp in [k for k in self.leader if k < t_ns]:
             del self.leader[stamp]
         self.thrusts[0] = self.leader.pop(t_ns)
-        vectors = np.array([thrust_axis(*s.euler.tolist()) * u
+        vectors = np.array([[axis * u for axis in thrust_axis_floats(*s.euler.tolist())]
                             for s, u in zip(states, self.thrusts)])
         vectors.flags.writeable = False
         self._formed = (t_ns, vectors)

@@ -73,7 +73,8 @@ def model_constants(model) -> tuple:
 
 def integrate(constants: tuple, x: np.ndarray, wrenches: np.ndarray, dt: float,
               steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """`steps` RK4 steps of dt [s] from x: (state, multipliers at x, g, g_dot at the end)."""
-    kernel = compiled_module('multilift_sim._numba_kernel').integrate_period
+    """`steps` RK4 steps of dt [s] from x: (state, multipliers at x, g, g_dot at the end);
+    after `enabled()` said yes."""
+    kernel = _modules['multilift_sim._numba_kernel'].integrate_period
     return kernel(*constants, np.ascontiguousarray(x, dtype=np.float64),
                   np.ascontiguousarray(wrenches, dtype=np.float64), float(dt), int(steps))

@@ -45,11 +45,16 @@ def rotation_matrix(eta: ArrayLike) -> np.ndarray:
 def thrust_axis(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """R(eta) e_z [unit, world], the body z axis along which the rotors push: the third column
     of `rotation_matrix` for one attitude [rad], in plain floats (the per-tick path)."""
+    return np.array(thrust_axis_floats(roll, pitch, yaw))
+
+
+def thrust_axis_floats(roll: float, pitch: float, yaw: float) -> tuple[float, float, float]:
+    """`thrust_axis` as three floats."""
     s_phi, c_phi = math.sin(roll), math.cos(roll)
     s_theta, c_theta = math.sin(pitch), math.cos(pitch)
     s_psi, c_psi = math.sin(yaw), math.cos(yaw)
-    return np.array([c_psi * s_theta * c_phi + s_psi * s_phi,
-                     s_psi * s_theta * c_phi - c_psi * s_phi, c_theta * c_phi])
+    return (c_psi * s_theta * c_phi + s_psi * s_phi, s_psi * s_theta * c_phi - c_psi * s_phi,
+            c_theta * c_phi)
 
 
 def euler_rate_matrix(eta: ArrayLike) -> np.ndarray:

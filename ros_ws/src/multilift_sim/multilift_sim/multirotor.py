@@ -69,7 +69,8 @@ class MultirotorParams:
         """u_T = k_T sum_k omega_k^2 [N] of rotor speeds [rad/s] (seed Eq. 2.9, along body +z:
         docs/conventions.md); rotor_speeds (..., n_r) gives shape (...)."""
         speeds = np.asarray(rotor_speeds, dtype=float)
-        total = self.thrust_coefficient * np.sum(speeds * speeds, axis=-1)
+        # np.sum's reduction without its Python wrapper (a per-tick call)
+        total = self.thrust_coefficient * np.add.reduce(speeds * speeds, axis=-1)
         return float(total) if total.ndim == 0 else total
 
     @property

@@ -234,12 +234,14 @@ class FormationSimulator:
         g, g_dot = residuals if residuals is not None else \
             self.model.constraint_residuals(self.state)
         self.residuals = (g, g_dot)
-        abs_g, abs_g_dot = np.abs(g), np.abs(g_dot)
+        # per cable in plain floats (a few cables: numpy's per-call cost would dominate)
+        abs_g, abs_g_dot = [abs(v) for v in g.tolist()], [abs(v) for v in g_dot.tolist()]
         taut = getattr(self.model, 'taut', None)
         if taut is not None:  # the tolerances hold for taut cables only (cable_model: slack)
-            abs_g, abs_g_dot = np.where(taut, abs_g, 0.0), np.where(taut, abs_g_dot, 0.0)
-        worst, worst_rate = int(abs_g.argmax()), int(abs_g_dot.argmax())
-        peak, peak_rate = float(abs_g[worst]), float(abs_g_dot[worst_rate])
+            abs_g = [v if held else 0.0 for v, held in zip(abs_g, taut.tolist())]
+            abs_g_dot = [v if held else 0.0 for v, held in zip(abs_g_dot, taut.tolist())]
+        peak, peak_rate = max(abs_g), max(abs_g_dot)
+        worst, worst_rate = abs_g.index(peak), abs_g_dot.index(peak_rate)  # the first, as argmax
         stats = self.stats
         stats.add_constraints(peak, peak_rate)
         if self.tick % self._swing_every == 0:

@@ -215,8 +215,9 @@ class TrackingStatistics:
     error: PeakRms = field(default_factory=PeakRms)
 
     def add(self, reference_position: np.ndarray, position: np.ndarray) -> None:
-        delta = np.asarray(reference_position, float) - np.asarray(position, float)
-        self.error.add(float(math.sqrt(float(delta @ delta))))
+        dx, dy, dz = (np.asarray(reference_position, float)
+                      - np.asarray(position, float)).tolist()
+        self.error.add(math.sqrt(dx * dx + dy * dy + dz * dz))  # in floats: once a tick
 
     def as_dict(self) -> dict:
         return {'max_tracking_error': self.error.max, 'rms_tracking_error': self.error.rms,
@@ -231,10 +232,10 @@ class FormationErrorStatistics:
     samples: int = 0
 
     def add(self, residual: np.ndarray) -> None:
-        residual = np.asarray(residual, dtype=float).ravel()
-        if residual.size:
-            self.max_abs = max(self.max_abs, float(np.abs(residual).max()))
-            self.norm_sum += math.sqrt(residual @ residual)  # np.linalg.norm's arithmetic
+        rows = np.asarray(residual, dtype=float).ravel().tolist()  # in floats: once a tick
+        if rows:
+            self.max_abs = max(self.max_abs, max(abs(v) for v in rows))
+            self.norm_sum += math.sqrt(sum(v * v for v in rows))
         self.samples += 1
 
     def as_dict(self) -> dict:

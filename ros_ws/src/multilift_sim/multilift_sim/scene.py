@@ -123,10 +123,11 @@ def _cable_points(start: tuple[float, float, float], end: tuple[float, float, fl
     """The LINE_LIST points of a cable from `start` to `end`: CABLE_SEGMENTS segments end to
     end when taut, each half its length (a dashed line) when slack."""
     fill = 1.0 if taut else 0.5
+    (x, y, z), (dx, dy, dz) = start, (end[0] - start[0], end[1] - start[1], end[2] - start[2])
     points = []
     for k in range(CABLE_SEGMENTS):
         for s in (k / CABLE_SEGMENTS, (k + fill) / CABLE_SEGMENTS):
-            points.append(tuple(a + s * (b - a) for a, b in zip(start, end)))
+            points.append((x + s * dx, y + s * dy, z + s * dz))
     return points
 
 

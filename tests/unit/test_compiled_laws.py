@@ -6,6 +6,9 @@ headless run flies the same trajectory."""
 from __future__ import annotations
 
 import dataclasses
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -122,3 +125,26 @@ def test_headless_run_compiled_equals_pure(monkeypatch):
     for key in ('leader', 'follower2'):
         for figure, value in a[key].items():
             assert value == pytest.approx(b[key][figure], rel=1e-9, abs=1e-12), (key, figure)
+
+
+@pytest.mark.parametrize('setting', [None, 'auto'])
+def test_controller_nodes_run_the_pure_laws_unless_told(setting):
+    """A controller node (`prepare_node_laws`) leaves numba unimported unless
+    MULTILIFT_KERNEL is set; with it set to auto it loads the compiled laws before it answers."""
+    code = ('import os, sys\n'
+            'from multilift_control.runtime import ControllerRuntime, prepare_node_laws\n'
+            'from multilift_sim import scenario\n'
+            's = scenario.load("twin_lift")\n'
+            'prepare_node_laws(s, 1)\n'
+            'follower = ControllerRuntime(s, 1).follower\n'
+            'print(os.environ["MULTILIFT_KERNEL"], "numba" in sys.modules,\n'
+            '      follower._compiled_update is not None and\n'
+            '      len(follower._compiled_update.signatures) > 0)\n')
+    env = {k: v for k, v in os.environ.items() if k != 'MULTILIFT_KERNEL'}
+    if setting is not None:
+        env['MULTILIFT_KERNEL'] = setting
+    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                         timeout=300, env=env)
+    assert out.returncode == 0, out.stderr
+    expected = 'python False False' if setting is None else 'auto True True'
+    assert out.stdout.split() == expected.split()

@@ -11,15 +11,17 @@ compares their bags to 1e-9 m).
 """
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_control.cascade import ControlOutput, FormationStates, UavState
+from multilift_control.cascade import COMPILED_LAWS, ControlOutput, FormationStates, UavState
 from multilift_control.controllers import make_controller
 from multilift_control.formation import FormationFollower
 from multilift_control.mission import Reference
+from multilift_sim import kernels
 from multilift_sim.kinematics import thrust_axis_floats
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
@@ -165,11 +167,19 @@ def uav_states(snapshot: Snapshot) -> FormationStates:
                            for u in snapshot.uavs)
 
 
-def warm_up(scenario: Scenario, index: int) -> None:
-    """Answer the scenario's start once with a throwaway controller of UAV `index` (from 0),
-    so that its compiled laws are loaded from numba's cache, or compiled when the cache is
-    empty (seconds), before a node joins the lockstep, where the simulator's
-    `command_timeout` counts."""
+def prepare_node_laws(scenario: Scenario, index: int) -> None:
+    """Choose and load the control laws of a controller node of UAV `index` (from 0), before
+    its topics appear (the simulator's `command_timeout` counts from the first state).
+
+    A node runs the laws' pure methods unless MULTILIFT_KERNEL is set: importing numba costs
+    every process about 0.5 s of CPU plus 0.2 s to load the cached laws, more than the
+    compiled laws save where a node's time goes to rclpy, and the start-up of many nodes
+    shares two cores (a V of 30 started in 44 s against 19 s pure; `benchmarks/results.md`).
+    With MULTILIFT_KERNEL=auto the laws are compiled here: one throwaway answer to the
+    scenario's start loads them from numba's cache, or compiles them (seconds)."""
+    os.environ.setdefault(kernels.VARIABLE, 'python')
+    if kernels.compiled_module(COMPILED_LAWS) is None:
+        return
     runtime = ControllerRuntime(scenario, index)
     if runtime.is_follower:
         runtime.note_command(0, 0, np.zeros(scenario.uavs[0].vehicle.n_rotors))

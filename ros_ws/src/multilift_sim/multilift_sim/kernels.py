@@ -7,7 +7,8 @@ equal); this one is used when numba imports and MULTILIFT_KERNEL is not `python`
 (`cache=True`) under NUMBA_CACHE_DIR, by default `$XDG_CACHE_HOME/multilift/numba`
 (`~/.cache/multilift/numba`), set before numba is imported: the first process compiles
 (about 1-2 s), later ones load the cache. `compiled_module` loads the control laws' compiled
-functions (multilift_control._numba_laws) the same way, under the same switch.
+functions (multilift_control._numba_laws) the same way, under the same switch; controller
+nodes default it to `python` (multilift_control.runtime.prepare_node_laws).
 """
 from __future__ import annotations
 
@@ -22,6 +23,7 @@ import numpy as np
 _cache_home = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
 os.environ.setdefault('NUMBA_CACHE_DIR', str(Path(_cache_home) / 'multilift' / 'numba'))
 
+VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset): compiled where numba imports; python: pure
 _modules: dict[str, ModuleType | None] = {}  # compiled modules by name (None: no numba)
 
 
@@ -33,7 +35,7 @@ def enabled() -> bool:
 def compiled_module(name: str) -> ModuleType | None:
     """The module of compiled functions `name` (imported once), or None when the pure-Python
     reference is to be used: numba does not import, or MULTILIFT_KERNEL=python."""
-    if os.environ.get('MULTILIFT_KERNEL', 'auto') == 'python':
+    if os.environ.get(VARIABLE, 'auto') == 'python':
         return None
     if name not in _modules:
         try:

@@ -21,7 +21,7 @@ from rclpy.node import Node
 from multilift_control.answer_messages import AnswerMessages
 from multilift_control.cascade import UavState
 from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
-from multilift_control.runtime import ControllerRuntime, warm_up
+from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, RawPublishers,
                                       controller_peers_missing, ns_from_stamp, run_node,
@@ -44,7 +44,7 @@ class FollowerNode(Node):
             raise Fatal(f'uav_index {self.index} must be a follower: 2..{n}')
         self.n = n
         self.period_ns = int(round(1e9 / scenario.simulation.control_rate))
-        warm_up(scenario, self.index - 1)  # compiled laws loaded before our topics appear
+        prepare_node_laws(scenario, self.index - 1)  # before our topics appear
         self.runtime = ControllerRuntime(scenario, self.index - 1)
         self.packer = AnswerMessages(scenario)  # the answer as CDR bytes
         self.states: dict[int, Sequence[UavState]] = {}   # t_ns -> every UAV's state

@@ -16,7 +16,7 @@ from rclpy.node import Node
 
 from multilift_control.answer_messages import AnswerMessages
 from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
-from multilift_control.runtime import ControllerRuntime, warm_up
+from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, RawPublishers,
                                       controller_peers_missing, run_node, serve_controller)
@@ -32,7 +32,7 @@ class LeaderNode(Node):
         if not name:
             raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
         scenario = scenario_io.load(name)
-        warm_up(scenario, 0)  # compiled laws loaded before our topics appear
+        prepare_node_laws(scenario, 0)  # before our topics appear
         self.runtime = ControllerRuntime(scenario, 0)
         self.packer = AnswerMessages(scenario)  # the answer as CDR bytes
         self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(1, 'rotor_cmd'),

@@ -63,19 +63,21 @@ def test_cache_dir_is_writable_and_under_the_users_cache():
     assert directory.parts[-2:] == ('multilift', 'numba')
 
 
-def test_loading_the_kernel_leaves_scipy_unimported_and_importable():
-    """numba's BLAS probe is kept from importing scipy (a start-up cost); scipy still imports
-    afterwards, and the kernel still integrates."""
+def test_loading_the_kernel_leaves_scipy_and_coverage_unimported_and_importable():
+    """numba's BLAS probe is kept from importing scipy and its coverage hook from importing
+    coverage (start-up costs); both still import afterwards, and the kernel still
+    integrates."""
     code = ('import sys, numpy as np\n'
             'from multilift_sim import kernels, scenario\n'
             'from multilift_sim.simulation import FormationSimulator\n'
             'assert kernels.enabled()\n'
             'sim = FormationSimulator(scenario.load("twin_lift"))\n'
             'sim.advance([np.full(4, 1500.0)] * 2, [np.zeros(4, bool)] * 2)\n'
-            'print("scipy" in sys.modules)\n'
-            'import scipy.linalg\n'
-            'print(scipy.linalg.solve(np.eye(2), np.ones(2)).tolist())\n')
+            'print("scipy" in sys.modules, "coverage" in sys.modules)\n'
+            'import scipy.linalg, coverage\n'
+            'print(scipy.linalg.solve(np.eye(2), np.ones(2)).tolist(),\n'
+            '      callable(coverage.Coverage))\n')
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                          timeout=120, env={**os.environ, 'MULTILIFT_KERNEL': 'auto'})
     assert out.returncode == 0, out.stderr
-    assert out.stdout.split('\n')[:2] == ['False', '[1.0, 1.0]']
+    assert out.stdout.split('\n')[:2] == ['False False', '[1.0, 1.0] True']

@@ -47,19 +47,21 @@ def compiled_module(name: str) -> ModuleType | None:
 
 
 def _import_numba_quietly() -> None:
-    """Import numba's array implementations without scipy. Loading even a cached kernel
-    imports numba.np.arraymath, whose import imports scipy.linalg only to learn whether BLAS
-    is there for np.dot of vectors (0.1-0.4 s of every process's start here; our kernels call
-    no BLAS). Hidden from that probe, numba takes its plain loop for such products; scipy
-    imports normally afterwards."""
-    hide = 'scipy' not in sys.modules
-    if hide:
-        sys.modules['scipy'] = None  # an import of scipy now raises ImportError
+    """Import numba's array implementations without scipy or coverage. Loading even a cached
+    kernel imports numba.np.arraymath, whose import imports scipy.linalg only to learn whether
+    BLAS is there for np.dot of vectors (0.1-0.4 s of every process's start here; our kernels
+    call no BLAS), and numba imports `coverage` (installed for the tests) to extend it to
+    compiled lines (70 ms, `python -X importtime`). Hidden from those imports, numba takes its
+    plain loop for such products and no coverage hook; both import normally afterwards."""
+    hidden = [name for name in ('scipy', 'coverage') if name not in sys.modules]
+    for name in hidden:
+        sys.modules[name] = None  # an import of it now raises ImportError
     try:
         import numba.np.arraymath  # noqa: F401 - the import is the point
     finally:
-        if hide and sys.modules.get('scipy', False) is None:
-            del sys.modules['scipy']
+        for name in hidden:
+            if sys.modules.get(name, False) is None:
+                del sys.modules[name]
 
 
 def model_constants(model) -> tuple:

@@ -71,7 +71,7 @@ def messages_table() -> None:
                                                       uav.rotation, uav.body_rates))),
         ('FormationState (n=2)',
          lambda: serialize_message(messages.formation_state(t_ns, tension, g, g_dot)),
-         lambda: state.pack(t_ns, tension.tolist(), g.tolist(), g_dot.tolist())),
+         lambda: state.pack(t_ns, tension.tolist(), g.tolist(), g_dot.tolist(), [True] * 2)),
         ('FormationSnapshot (n=2)',
          lambda: serialize_message(messages.formation_snapshot(snap, speeds, [4, 4])),
          lambda: snapshot.pack(t_ns, *msgvalues.formation_snapshot(snap, speeds))),
@@ -131,7 +131,8 @@ def run_table(seconds: float) -> None:
     scenario = dataclasses.replace(scenario, simulation=dataclasses.replace(
         scenario.simulation, duration=seconds))
     ticks = scenario.simulation.tick_count + 1
-    print(f'headless twin_lift, {seconds:g} s simulated ({ticks} ticks) [us per tick, CPU]')
+    print(f'headless twin_lift, {seconds:g} s simulated ({ticks} ticks) [us per tick, CPU]; '
+          'the kernel is the physics and the control laws')
     for kernel in ('python', 'auto'):
         os.environ['MULTILIFT_KERNEL'] = kernel
         start = time.process_time()

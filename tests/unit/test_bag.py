@@ -265,9 +265,11 @@ def test_messages_are_written_as_the_mcap_library_writes_them(tmp_path, compress
     library = BagWriter(tmp_path / 'library' / 'bag', compression=compression, chunk_size=4096)
     writer = library._writer
 
-    def add(channel_id, sequence, log_time, publish_time, data):
-        writer.add_message(channel_id, log_time, bytes(data), publish_time, sequence=sequence)
-    library._messages.add = add
+    def add_many(messages, log_time, publish_time):
+        for channel_id, sequence, data in messages:
+            writer.add_message(channel_id, log_time, bytes(data), publish_time,
+                               sequence=sequence)
+    library._messages.add_many = add_many
     fill(library)
     data = _mcap(tmp_path / 'fast' / 'bag').read_bytes()
     chunks = [r for r in make_reader(open(_mcap(tmp_path / 'fast' / 'bag'), 'rb'))

@@ -104,15 +104,11 @@ class _MessageAppender:
         self._chunk = writer._Writer__chunk_builder            # noqa: SLF001
         self._maybe_finish_chunk = writer._Writer__maybe_finalize_chunk  # noqa: SLF001
 
-    def add(self, channel_id: int, sequence: int, log_time: int, publish_time: int,
-            data: bytes) -> None:
-        self.add_many([(channel_id, sequence, data)], log_time, publish_time)
-
     def add_many(self, messages: list[tuple[int, int, bytes]], log_time: int,
                  publish_time: int) -> None:
-        """`add` of each (channel id, sequence, data), all logged at `log_time`, in one write
-        to the chunk and one chunk-size check after them (a chunk may pass `chunk_size` by
-        these messages; `add` alone checks after each message, as the library)."""
+        """`Writer.add_message` of each (channel id, sequence, data), all logged at
+        `log_time`, in one write to the chunk and one chunk-size check after them (a chunk
+        may pass `chunk_size` by these messages; one message at a time is the library's)."""
         stats, chunk = self._statistics, self._chunk
         if stats.message_count == 0:
             stats.message_start_time = log_time
@@ -243,30 +239,14 @@ class BagWriter:
     def write(self, topic: str, data: bytes, log_time_ns: int,
               publish_time_ns: int | None = None) -> None:
         """Append one CDR-serialized message of `topic`, received at `log_time_ns` [ns]."""
-        self._check_open()
-        entry = self._topics.get(topic)
-        if entry is None:
-            raise BagError(f'topic {topic} was not added to bag {self.directory}; '
-                           'call add_topic first')
-        if log_time_ns < 0:
-            raise BagError(f'negative log time {log_time_ns} ns for a message of {topic}')
-        writes_before = self._file.writes
-        self._messages.add(entry.channel_id, entry.message_count, log_time_ns,
-                           log_time_ns if publish_time_ns is None else publish_time_ns, data)
-        entry.message_count += 1
-        self._message_count += 1
-        self._start_ns = min(self._start_ns, log_time_ns)
-        self._end_ns = max(self._end_ns, log_time_ns)
-        self._unflushed = 0 if self._file.writes != writes_before else self._unflushed + 1
+        self.write_many([(topic, data)], log_time_ns, publish_time_ns)
 
-    def write_many(self, messages: Sequence[tuple[str, bytes]], log_time_ns: int) -> None:
+    def write_many(self, messages: Sequence[tuple[str, bytes]], log_time_ns: int,
+                   publish_time_ns: int | None = None) -> None:
         """`write` of each (topic, CDR bytes), all received at `log_time_ns` [ns], in order,
         packed together (a headless tick's messages: about a fifth of the cost of a write
         each); a chunk is finished after them, not between them."""
         self._check_open()
-        if log_time_ns < 0:
-            raise BagError(f'negative log time {log_time_ns} ns for a message of '
-                           f'{messages[0][0] if messages else "no topic"}')
         entries = [self._topics.get(topic) for topic, _ in messages]
         if None in entries:
             topic = messages[entries.index(None)][0]
@@ -274,12 +254,16 @@ class BagWriter:
                            'call add_topic first')
         if not entries:
             return
+        if log_time_ns < 0:
+            raise BagError(f'negative log time {log_time_ns} ns for a message of '
+                           f'{messages[0][0]}')
         records = []
         for entry, (_, data) in zip(entries, messages):
             records.append((entry.channel_id, entry.message_count, data))
             entry.message_count += 1
         writes_before = self._file.writes
-        self._messages.add_many(records, log_time_ns, log_time_ns)
+        self._messages.add_many(records, log_time_ns,
+                                log_time_ns if publish_time_ns is None else publish_time_ns)
         self._message_count += len(records)
         self._start_ns = min(self._start_ns, log_time_ns)
         self._end_ns = max(self._end_ns, log_time_ns)

@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -26,6 +28,22 @@ SETTLE = 0.5  # [s] without graph change, once another node is seen, that ends t
 HZ_WINDOW = 10000  # messages `topic hz` averages over by default (ros2 topic hz's default)
 HZ_DEPTH = 100  # keep_last depth of `topic hz`'s subscription
 ADAPT_PERIOD = 0.2  # [s] how often `topic echo` compares its QoS with the publishers' offers
+# Ctrl-C (SIGINT) or SIGTERM asked the topic tool to stop: a flag its loops read. Raising
+# KeyboardInterrupt from the signal, or letting rclpy's handler shut the context down, could
+# land inside rclpy's taking of a message, which then failed as a RuntimeError ("Unable to
+# convert call argument") and the tool exited 1 (seen in `topic hz` under a full test run).
+_STOP = threading.Event()
+
+
+def _running() -> bool:
+    import rclpy
+    return rclpy.ok() and not _STOP.is_set()
+
+
+def _stop_if_asked() -> None:
+    """Out of rclpy's calls, turn a stop request into KeyboardInterrupt (`topic_main`: exit 0)."""
+    if _STOP.is_set():
+        raise KeyboardInterrupt
 
 
 def _spin_graph(node, until=None, timeout: float = DISCOVERY_WAIT) -> None:
@@ -35,6 +53,7 @@ def _spin_graph(node, until=None, timeout: float = DISCOVERY_WAIT) -> None:
     start = last_change = time.monotonic()
     seen = None
     while time.monotonic() - start < timeout:
+        _stop_if_asked()
         rclpy.spin_once(node, timeout_sec=0.05)
         if until is not None:
             if until():
@@ -105,7 +124,7 @@ def _topic_echo(node, args: argparse.Namespace) -> int:
     subscription = introspection.AdaptiveSubscription(node, msg_type, args.topic, on_message,
                                                       depth=10)
     next_check = time.monotonic() + ADAPT_PERIOD
-    while rclpy.ok() and not (args.once and received):
+    while _running() and not (args.once and received):
         rclpy.spin_once(node, timeout_sec=0.1)
         if time.monotonic() >= next_check:
             next_check = time.monotonic() + ADAPT_PERIOD
@@ -179,6 +198,7 @@ def _topic_hz(node, args: argparse.Namespace) -> int:
         print(f'WARNING: topic [{args.topic}] does not appear to be published yet',
               file=sys.stderr, flush=True)
         while rclpy.ok() and args.topic not in dict(node.get_topic_names_and_types()):
+            _stop_if_asked()
             rclpy.spin_once(node, timeout_sec=0.1)
     type_name = dict(node.get_topic_names_and_types())[args.topic][0]
     try:
@@ -193,7 +213,7 @@ def _topic_hz(node, args: argparse.Namespace) -> int:
     stats = RateWindow(args.window)
     node.create_subscription(msg_type, args.topic,
                              lambda data: stats.add(clock.now().nanoseconds), qos, raw=True)
-    while rclpy.ok():
+    while _running():
         rclpy.spin_once(node, timeout_sec=0.1)
         result = stats.report()
         if result is not None:
@@ -234,7 +254,10 @@ def topic_main(argv: list[str]) -> int:
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.parameter import Parameter
-    rclpy.init()
+    from rclpy.signals import SignalHandlerOptions
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: _STOP.set())
     overrides = ([Parameter('use_sim_time', Parameter.Type.BOOL, True)]
                  if getattr(args, 'use_sim_time', False) else [])
     node = rclpy.create_node(f'_multilift_topic_{os.getpid()}', start_parameter_services=False,

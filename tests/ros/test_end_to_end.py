@@ -178,6 +178,31 @@ def test_a_dead_controller_stops_the_run_and_is_named(tmp_path, ros_env, scenari
     assert len(read_bag(bag)['/uav1/odom']) > 10
 
 
+def test_a_killed_recorder_stops_the_run_and_its_bag_is_rebuilt(tmp_path, ros_env,
+                                                               private_scenario):
+    """The recorder dies without closing the bag (here SIGKILL, as a crash in the DDS library
+    would): the run stops, names it, and rebuilds the bag from its complete chunks."""
+    bag = tmp_path / 'bag'
+    proc = _run([str(private_scenario), '--bag', str(bag)], ros_env)
+    pids = _wait_for_processes(f'recorder_node.*{bag}', 1)
+    wait_until_simulated(proc, 1.0)
+    size = sum(f.stat().st_size for f in bag.glob('*.mcap'))
+    # a flush after t = 1 s: the file grew by a chunk of messages
+    wait_for(lambda: sum(f.stat().st_size for f in bag.glob('*.mcap')) > size, 60,
+             'a chunk written after t = 1 s')
+    os.kill(pids[0], signal.SIGKILL)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 1, err
+    assert 'error: recorder_node stopped (killed by SIGKILL)' in err
+    assert 'warning: recorder_node ended (killed by SIGKILL) without closing the bag' in err
+    assert f'bag rebuilt at {bag} from its complete chunks' in err
+    assert _children_of(private_scenario.name) == []
+    assert (bag / 'metadata.yaml').is_file()
+    odom = read_bag(bag)['/uav1/odom']
+    assert len(odom) > 0
+    assert [stamp_ns(m) for _, m in odom] == sorted(stamp_ns(m) for _, m in odom)
+
+
 def test_a_silent_controller_hits_the_lockstep_timeout(tmp_path, ros_env, private_scenario):
     text = private_scenario.read_text().replace('command_timeout: 5.0', 'command_timeout: 1.0')
     private_scenario.write_text(text)

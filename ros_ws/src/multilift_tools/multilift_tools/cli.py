@@ -199,6 +199,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                     '-r', f'__node:=follower{i}']
             children.append(Child(f'follower_node (uav{i})', argv,
                                   work / f'follower{i}_node.log', 'controller'))
+    recorder: Child | None = None
     if record:
         _fresh_bag_dir(bag)
         # an external controller's topics are recorded as they appear (the recorder records
@@ -208,8 +209,9 @@ def cmd_run(args: argparse.Namespace) -> int:
                 for leaf in ('rotor_cmd', 'reference', 'attitude_setpoint', 'formation_error')}
         topics = [f'{name}|{kind}' for name, kind in run_topics(scenario.n_uavs)
                   if name not in ours]
-        children.append(Child('recorder_node', [str(recorder_exe), *_ros_args(
-            {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder'))
+        recorder = Child('recorder_node', [str(recorder_exe), *_ros_args(
+            {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder')
+        children.append(recorder)
     progress = Progress(work / 'progress', sys.stdout.isatty())
     print(f'multilift run {scenario.name}: {scenario.n_uavs} UAV(s), '
           f'{args.duration or scenario.simulation.duration:g} s, logs in {work}', flush=True)
@@ -221,26 +223,47 @@ def cmd_run(args: argparse.Namespace) -> int:
     outcome, dead = Supervisor(children).run(on_tick=progress)
     progress()
     progress.close()
-    if outcome == 'interrupted':
-        print('interrupted: every process stopped' + (f'; bag closed at {bag}' if bag else ''),
-              file=sys.stderr)
-        return 130
-    if outcome == 'died':
-        print(f'error: {dead.name} stopped (exit code {dead.returncode()}): '
-              f'{dead.last_error()}', file=sys.stderr)
-        if bag:
-            print(f'the other processes were stopped; bag closed at {bag}', file=sys.stderr)
-        print(f'logs: {work}', file=sys.stderr)
-        return 1
+    bag_state = _bag_state(bag, recorder) if bag else ''
     warnings = [f'{child.name}: {line}' for child in children for line in child.warnings()]
     for line in warnings:
         print(line, file=sys.stderr)
+    if outcome == 'interrupted':
+        print('interrupted: every process stopped' + (f'; {bag_state}' if bag else ''),
+              file=sys.stderr)
+        if warnings or (bag and not recorder.ended_well()):
+            print(f'logs: {work}', file=sys.stderr)
+        return 130
+    if outcome == 'died':
+        print(f'error: {dead.name} stopped ({dead.exit_text()}): {dead.last_error()}',
+              file=sys.stderr)
+        print('the other processes were stopped' + (f'; {bag_state}' if bag else ''),
+              file=sys.stderr)
+        print(f'logs: {work}', file=sys.stderr)
+        return 1
     _summary(scenario.name, _read_summaries(summary_dir, scenario), bag, scenario)
     if warnings:
         print(f'logs: {work}', file=sys.stderr)
     else:
         shutil.rmtree(work, ignore_errors=True)
     return 0
+
+
+def _bag_state(bag: Path, recorder: Child) -> str:
+    """Where the run's bag stands once every process has stopped, in words: closed by the
+    recorder, or, when the recorder ended without closing it (killed, crashed), rebuilt from its
+    complete chunks as `multilift bag reindex` does, with a warning naming how it ended (what it
+    received after its last flush, `flush_period` 1 s at most, is lost)."""
+    if (bag / 'metadata.yaml').is_file():
+        return f'bag closed at {bag}'
+    from multilift_tools.bag_tools import BagToolError, reindex
+    print(f'warning: {recorder.name} ended ({recorder.exit_text()}) without closing the bag '
+          f'(its log: {recorder.log_path})', file=sys.stderr)
+    try:
+        rebuilt = reindex(bag)
+    except BagToolError as exc:
+        return f'the bag could not be rebuilt: {exc}'
+    return (f'bag rebuilt at {bag} from its complete chunks ({rebuilt.messages} messages, '
+            f'{rebuilt.duration_ns * 1e-9:.2f} s)')
 
 
 def _run_headless(scenario, bag: Path | None) -> int:

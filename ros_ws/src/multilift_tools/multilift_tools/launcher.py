@@ -53,13 +53,28 @@ class Child:
 
     def start(self) -> None:
         log = open(self.log_path, 'wb')
+        # PYTHONFAULTHANDLER: a child that dies of a fatal signal (SIGSEGV, SIGABRT in the DDS
+        # library) leaves its Python stacks in its log instead of nothing
         self.process = subprocess.Popen(self.argv, stdout=log, stderr=subprocess.STDOUT,
                                         stdin=subprocess.DEVNULL, start_new_session=True,
-                                        preexec_fn=_die_with_parent)
+                                        preexec_fn=_die_with_parent,
+                                        env=dict(os.environ, PYTHONFAULTHANDLER='1'))
         log.close()
 
     def returncode(self) -> int | None:
         return None if self.process is None else self.process.poll()
+
+    def exit_text(self) -> str:
+        """'exit code 1', 'killed by SIGSEGV' or 'still running'."""
+        code = self.returncode()
+        if code is None:
+            return 'still running'
+        if code < 0:
+            try:
+                return f'killed by {signal.Signals(-code).name}'
+            except ValueError:
+                return f'killed by signal {-code}'
+        return f'exit code {code}'
 
     def signal(self, sig: int) -> None:
         if self.process is not None and self.process.poll() is None:

@@ -36,11 +36,15 @@
   (and what waits for its log time to settle: a round, HOLD_MAX s at most);
   `bag.recover()` turns what a killed recorder left into a complete bag.
 - SIGINT or SIGTERM: keep receiving until 0.3 s pass without a message (3 s at most; a second
-  signal stops at once), close the bag (`metadata.yaml` written) and exit 0.
+  signal stops at once), close the bag (`metadata.yaml` written) and exit 0. A drain or close
+  still running HANG_REPORT s after the signal writes its stacks to stderr (the log). A recorder
+  that dies without closing the bag leaves its complete chunks: `multilift run` rebuilds the bag
+  from them and says so (`multilift_tools.cli._bag_state`).
 """
 
 from __future__ import annotations
 
+import faulthandler
 import functools
 import signal
 import sys
@@ -70,6 +74,7 @@ TAKE_BATCH = 256
 ROUND_PERIOD = 0.02  # [s] between reading rounds (a round takes every message waiting)
 CLOCK_DEPTH = 1000  # /clock messages a round can find waiting
 HOLD_MAX = 1.0  # [s] longest a message waits for the /clock after it (its log time settled)
+HANG_REPORT = 7.0  # [s] after a stop signal: the stacks of a drain or close still running
 
 
 class RecorderNode(Node):
@@ -100,6 +105,9 @@ class RecorderNode(Node):
         self._recorded: dict[str, Subscription] = {}
         self._skipped: set[str] = set()
         self._in_bag: set[str] = set()
+        # topic -> (publishers seen in the graph, of them matched by our reader) at a graph poll
+        # where the topic had publishers: a topic that ends with no message is reported with it
+        self._publishers_seen: dict[str, tuple[int, int]] = {}
         # messages whose sim log time may still change: (topic, data, sent [ns], taken at [s])
         self._held: list[tuple[str, bytes, int, float]] = []
         # the time source: reliable where /clock's publisher offers it, so no /clock is lost
@@ -137,6 +145,7 @@ class RecorderNode(Node):
         for topic, types in self.get_topic_names_and_types():
             if topic in self._recorded:
                 self._recorded[topic].adapt()
+                self._note_publishers(topic)
                 continue
             if (not self._record_all or topic in self._skipped
                     or not recording.is_recordable(topic)
@@ -145,6 +154,14 @@ class RecorderNode(Node):
             if len(types) > 1:
                 self.get_logger().warn(f'{topic} has several types {types}; recording {types[0]}')
             self._subscribe(topic, types[0])
+
+    def _note_publishers(self, topic: str) -> None:
+        if topic in self._in_bag:
+            return
+        known = self.count_publishers(topic)
+        if known:
+            matched = self._recorded[topic].subscription.get_publisher_count()
+            self._publishers_seen[topic] = (known, matched)
 
     def _add_to_bag(self, topic: str) -> None:
         offers = introspection.offered_qos(self.get_publishers_info_by_topic(topic))
@@ -242,6 +259,12 @@ class RecorderNode(Node):
         for topic in self._types:
             if topic not in self._in_bag:
                 self._add_to_bag(topic)
+                if topic in self._publishers_seen:
+                    known, matched = self._publishers_seen[topic]
+                    # to stderr with the launcher's prefix: `multilift run` repeats it
+                    print(f'warning: recorder: {topic} had {known} publisher(s) ({matched} '
+                          'matched by the recorder) but no message of it arrived; the bag has '
+                          'the topic without messages', file=sys.stderr, flush=True)
         self.bag.close()
         self.get_logger().info(f'closed {self.bag.directory}: {self.bag.message_count} messages '
                                f'on {len(self.bag.topics)} topics')
@@ -253,6 +276,10 @@ def main(args: list[str] | None = None) -> int:
     stop, abort = threading.Event(), threading.Event()
 
     def on_signal(signum: int, frame: object) -> None:
+        if not stop.is_set():
+            # if the drain or the close hangs (in DDS code, maybe holding the GIL), its stacks
+            # reach the log before the launcher's SIGKILL (10 s after its SIGINT)
+            faulthandler.dump_traceback_later(HANG_REPORT, file=sys.stderr)
         (abort if stop.is_set() else stop).set()
 
     signal.signal(signal.SIGINT, on_signal)
@@ -274,6 +301,7 @@ def main(args: list[str] | None = None) -> int:
     finally:
         if node is not None:
             node.close()
+            faulthandler.cancel_dump_traceback_later()
             node.destroy_node()
         rclpy.try_shutdown()
     return 0

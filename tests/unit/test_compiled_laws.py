@@ -127,24 +127,27 @@ def test_headless_run_compiled_equals_pure(monkeypatch):
             assert value == pytest.approx(b[key][figure], rel=1e-9, abs=1e-12), (key, figure)
 
 
-@pytest.mark.parametrize('setting', [None, 'auto'])
-def test_controller_nodes_run_the_pure_laws_unless_told(setting):
-    """A controller node (`prepare_node_laws`) leaves numba unimported unless
-    MULTILIFT_KERNEL is set; with it set to auto it loads the compiled laws before it answers."""
+@pytest.mark.parametrize('setting,expected', [(None, 'aot False ahead-of-time'),
+                                              ('jit', 'jit True just-in-time'),
+                                              ('python', 'python False pure')])
+def test_controller_nodes_run_the_laws_built_ahead_of_time_unless_told(setting, expected):
+    """A controller node (`prepare_node_laws`) runs the laws scripts/setup compiled ahead of
+    time, numba unimported, unless MULTILIFT_KERNEL says otherwise: with jit it loads the laws
+    compiled just in time before it answers, with python the pure methods."""
     code = ('import os, sys\n'
             'from multilift_control.runtime import ControllerRuntime, prepare_node_laws\n'
-            'from multilift_sim import scenario\n'
+            'from multilift_sim import kernels, scenario\n'
             's = scenario.load("twin_lift")\n'
             'prepare_node_laws(s, 1)\n'
-            'follower = ControllerRuntime(s, 1).follower\n'
-            'print(os.environ["MULTILIFT_KERNEL"], "numba" in sys.modules,\n'
-            '      follower._compiled_update is not None and\n'
-            '      len(follower._compiled_update.signatures) > 0)\n')
+            'law = ControllerRuntime(s, 1).follower._compiled_update\n'
+            'kind = ("pure" if law is None else "ahead-of-time"\n'
+            '        if isinstance(law, kernels._Checked) else\n'
+            '        "just-in-time" if len(law.signatures) > 0 else "not loaded")\n'
+            'print(os.environ["MULTILIFT_KERNEL"], "numba" in sys.modules, kind)\n')
     env = {k: v for k, v in os.environ.items() if k != 'MULTILIFT_KERNEL'}
     if setting is not None:
         env['MULTILIFT_KERNEL'] = setting
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                          timeout=300, env=env)
     assert out.returncode == 0, out.stderr
-    expected = 'python False False' if setting is None else 'auto True True'
     assert out.stdout.split() == expected.split()

@@ -1,9 +1,12 @@
 """The compiled float kernel (multilift_sim.kernels, numba) against the pure-Python float kernel
 of FormationModel, the reference: a control period from a swinging, tilted state through the
 gusts gives the same numbers (bit for bit here; 1e-12 is what the test demands), and
-MULTILIFT_KERNEL=python switches the compiled one off."""
+MULTILIFT_KERNEL=python switches the compiled one off. Compiled ahead of time (scripts/setup)
+and just in time, the kernel and the control laws give the same bits; the ahead-of-time build
+loads without numba and refuses arguments of the wrong type."""
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -64,9 +67,9 @@ def test_cache_dir_is_writable_and_under_the_users_cache():
 
 
 def test_loading_the_kernel_leaves_scipy_and_coverage_unimported_and_importable():
-    """numba's BLAS probe is kept from importing scipy and its coverage hook from importing
-    coverage (start-up costs); both still import afterwards, and the kernel still
-    integrates."""
+    """Just in time: numba's BLAS probe is kept from importing scipy and its coverage hook
+    from importing coverage (start-up costs); both still import afterwards, and the kernel
+    still integrates."""
     code = ('import sys, numpy as np\n'
             'from multilift_sim import kernels, scenario\n'
             'from multilift_sim.simulation import FormationSimulator\n'
@@ -78,6 +81,83 @@ def test_loading_the_kernel_leaves_scipy_and_coverage_unimported_and_importable(
             'print(scipy.linalg.solve(np.eye(2), np.ones(2)).tolist(),\n'
             '      callable(coverage.Coverage))\n')
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
-                         timeout=120, env={**os.environ, 'MULTILIFT_KERNEL': 'auto'})
+                         timeout=120, env={**os.environ, 'MULTILIFT_KERNEL': 'jit'})
     assert out.returncode == 0, out.stderr
     assert out.stdout.split('\n')[:2] == ['False False', '[1.0, 1.0] True']
+
+
+AHEAD_OF_TIME = ('multilift_sim._numba_kernel', 'multilift_control._numba_laws')
+
+
+def test_setup_built_the_kernels_ahead_of_time_and_they_load_without_numba():
+    for name in AHEAD_OF_TIME:
+        assert all(path.is_file() for path in kernels.ahead_of_time_files(name)), name
+    code = ('import sys, numpy as np\n'
+            'from multilift_sim import kernels, scenario\n'
+            'from multilift_sim.simulation import FormationSimulator\n'
+            'sim = FormationSimulator(scenario.load("twin_lift"))\n'
+            'sim.advance([np.full(4, 1500.0)] * 2, [np.zeros(4, bool)] * 2)\n'
+            'law = kernels.compiled_module("multilift_control._numba_laws").cascade_update\n'
+            'print(kernels.enabled(), isinstance(law, kernels._Checked), sim.t > 0,\n'
+            '      "numba" in sys.modules)\n')
+    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                         timeout=120, env={**os.environ, 'MULTILIFT_KERNEL': 'auto'})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ['True', 'True', 'True', 'False']
+
+
+@pytest.mark.parametrize('name', ['twin_lift', 'circle3', 'v5'])
+def test_ahead_of_time_equals_just_in_time_bit_for_bit(name, monkeypatch):
+    """The physics over a control period, and a headless run (physics and control laws)."""
+    from multilift_control.headless import run_headless
+    import dataclasses
+    simulator = _swinging(name, ticks=5)
+    speeds = [np.full(u.vehicle.n_rotors, 1520.0) for u in simulator.scenario.uavs]
+    scenario = simulator.scenario
+    short = dataclasses.replace(scenario, simulation=dataclasses.replace(
+        scenario.simulation, duration=3.0))
+    results = {}
+    for mode in ('aot', 'jit'):
+        monkeypatch.setenv('MULTILIFT_KERNEL', mode)
+        assert kernels.enabled()
+        period = simulator.model.integrate(simulator.state, speeds, simulator.dt, 10)
+        run = run_headless(short)
+        summary = run.summary()
+        summary['sim'].pop('wall_time', None)
+        results[mode] = (period.state, period.cable_tension, run.simulator.state,
+                         json.dumps(summary, sort_keys=True, default=str))
+    aot, jit = results['aot'], results['jit']
+    for a, b in zip(aot[:3], jit[:3]):
+        assert np.array_equal(a, b)
+    assert aot[3] == jit[3]
+    assert np.any(results['aot'][2] != simulator.state)  # the run moved
+
+
+def test_an_argument_of_the_wrong_type_is_a_type_error_not_a_crash():
+    compiled = kernels.load_ahead_of_time('multilift_sim._numba_kernel')
+    assert compiled is not None
+    simulator = FormationSimulator(scenario_io.load('twin_lift'))
+    constants = kernels.model_constants(simulator.model)
+    x = np.ascontiguousarray(simulator.state, dtype=np.float64)
+    wrenches = np.zeros((2, 6))
+    state, *_ = compiled.integrate_period(*constants, x, wrenches, 0.001, 2)
+    assert state.shape == x.shape and np.all(np.isfinite(state))
+    wide = np.repeat(x, 2)
+    for bad, words in ((x.astype(np.float32), 'float32'), (wide[::2], 'strided'),
+                       (x.tolist(), 'list')):
+        with pytest.raises(TypeError, match=f'argument 9 must be a C-contiguous 1-d float64 '
+                                            f'array, got .*{words}'):
+            compiled.integrate_period(*constants, bad, wrenches, 0.001, 2)
+
+
+def test_the_ahead_of_time_build_is_named_by_its_source(tmp_path, monkeypatch):
+    """A changed source is never served the old build: the files' names hash the source."""
+    module = tmp_path / 'aot_naming_probe.py'
+    module.write_text('A = 1\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    first = kernels.ahead_of_time_files('aot_naming_probe')
+    assert first == kernels.ahead_of_time_files('aot_naming_probe')
+    module.write_text('A = 2\n')
+    second = kernels.ahead_of_time_files('aot_naming_probe')
+    assert first[0] != second[0] and first[1] != second[1]
+    assert first[0].parent == kernels.AHEAD_OF_TIME_DIR

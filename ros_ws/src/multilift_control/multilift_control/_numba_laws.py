@@ -252,3 +252,24 @@ def filtered_reference(t, omega, start, step_times, steps, ends, velocities, ori
     out[2] = origins[k, 2] + velocities[k, 2] * (t - starts[k])
     out[5] = velocities[k, 2]
     return out
+
+
+# What every caller passes (CascadeController, FormationFollower, MissionPath): the signatures
+# compiled ahead of time (multilift_sim.kernels.build_ahead_of_time). A linear follower's law
+# rows arrive read-only (views of the law's frozen arrays).
+_ARRAY, _MATRIX = numba.float64[::1], numba.float64[:, ::1]
+_FROZEN = numba.types.Array(numba.float64, 2, 'C', readonly=True)
+_INDICES, _FLAGS = numba.int64[::1], numba.boolean[::1]
+_F8 = numba.float64
+_COMMAND = numba.types.Tuple((_ARRAY, _FLAGS, _ARRAY, _F8))
+AHEAD_OF_TIME = {
+    'cascade_command': _COMMAND(_ARRAY, _MATRIX, _ARRAY, _ARRAY, _ARRAY, _ARRAY, _F8),
+    'cascade_update': _COMMAND(_ARRAY, _MATRIX, _ARRAY, _ARRAY, _F8, _ARRAY, _ARRAY, _ARRAY,
+                               _ARRAY, _ARRAY, _ARRAY, _ARRAY, _F8),
+    'linear_follower_update': numba.types.Tuple((_ARRAY, _FLAGS, _ARRAY, _F8, _ARRAY, _ARRAY))(
+        _ARRAY, numba.int64, _MATRIX, _MATRIX, _ARRAY, _ARRAY, _MATRIX, _INDICES, _INDICES,
+        _ARRAY, _INDICES, _ARRAY, _F8, _FROZEN, _FROZEN, _FROZEN, _ARRAY, _MATRIX, _ARRAY,
+        _ARRAY, _ARRAY, _F8),
+    'filtered_reference': _ARRAY(_F8, _F8, _ARRAY, _ARRAY, _MATRIX, _ARRAY, _MATRIX, _MATRIX,
+                                 _ARRAY, _ARRAY),
+}

@@ -171,13 +171,15 @@ def prepare_node_laws(scenario: Scenario, index: int) -> None:
     """Choose and load the control laws of a controller node of UAV `index` (from 0), before
     its topics appear (the simulator's `command_timeout` counts from the first state).
 
-    A node runs the laws' pure methods unless MULTILIFT_KERNEL is set: importing numba costs
-    every process about 0.5 s of CPU plus 0.2 s to load the cached laws, more than the
-    compiled laws save where a node's time goes to rclpy, and the start-up of many nodes
-    shares two cores (a V of 30 started in 44 s against 19 s pure; `benchmarks/results.md`).
-    With MULTILIFT_KERNEL=auto the laws are compiled here: one throwaway answer to the
-    scenario's start loads them from numba's cache, or compiles them (seconds)."""
-    os.environ.setdefault(kernels.VARIABLE, 'python')
+    A node runs the laws compiled ahead of time where scripts/setup built them (they load in
+    a millisecond), else their pure methods: MULTILIFT_KERNEL defaults to `aot` here, because
+    importing numba for the just-in-time laws costs every process about 0.5 s of CPU plus
+    0.2 s to load the cached laws, more than they save where a node's time goes to rclpy, and
+    the start-up of many nodes shares two cores (a V of 30 started in 44 s against 19 s pure;
+    `benchmarks/results.md`). With MULTILIFT_KERNEL=auto or jit the laws may be compiled just
+    in time: one throwaway answer to the scenario's start loads them here (or compiles them,
+    seconds)."""
+    os.environ.setdefault(kernels.VARIABLE, 'aot')
     if kernels.compiled_module(COMPILED_LAWS) is None:
         return
     runtime = ControllerRuntime(scenario, index)

@@ -189,3 +189,14 @@ def integrate_period(uavs, gusts, payload_mass, inv_payload_mass, gravity, two_a
         g[i] = dx * dx + dy * dy + dz * dz - uavs[i, 1]
         g_dot[i] = 2.0 * (dx * dvx + dy * dvy + dz * dvz)
     return state, first, g, g_dot
+
+
+# What every caller passes (multilift_sim.kernels.integrate): the signatures compiled ahead of
+# time (multilift_sim.kernels.build_ahead_of_time)
+_ARRAY, _MATRIX = numba.float64[::1], numba.float64[:, ::1]
+_F8 = numba.float64
+AHEAD_OF_TIME = {
+    'integrate_period': numba.types.UniTuple(_ARRAY, 4)(
+        _MATRIX, _MATRIX, _F8, _F8, _F8, _F8, _F8, numba.boolean, _F8, _ARRAY, _MATRIX, _F8,
+        numba.int64),
+}

@@ -2,48 +2,169 @@
 compiled with numba: the same arithmetic in the same order, one control period per call.
 
 The pure-Python kernel in dynamics.py stays the reference (tests/test_kernels.py holds them
-equal); this one is used when numba imports and MULTILIFT_KERNEL is not `python`
-(`MULTILIFT_KERNEL=python` forces the pure kernel). Compiled code is cached on disk
-(`cache=True`) under NUMBA_CACHE_DIR, by default `$XDG_CACHE_HOME/multilift/numba`
-(`~/.cache/multilift/numba`), set before numba is imported: the first process compiles
-(about 1-2 s), later ones load the cache. `compiled_module` loads the control laws' compiled
-functions (multilift_control._numba_laws) the same way, under the same switch; controller
-nodes default it to `python` (multilift_control.runtime.prepare_node_laws).
+equal). `compiled_module` loads a module of compiled functions (this kernel,
+multilift_sim._numba_kernel, and the control laws', multilift_control._numba_laws) in one of
+two forms, under MULTILIFT_KERNEL:
+
+- ahead of time (`build_ahead_of_time`, run by scripts/setup): numba's pycc compiles the
+  module's `AHEAD_OF_TIME` functions into a plain extension module under
+  `$XDG_CACHE_HOME/multilift/aot` (`~/.cache/multilift/aot`), its file named by a hash of the
+  module's source, Python and numpy, so a changed source is never served stale code. It loads
+  in about a millisecond without numba (whose import costs every process about 0.5 s). Its
+  functions trust their argument types (a wrong one reads wrong memory), so each call is
+  checked first (`_Checked`): a TypeError, never a crash.
+- just in time: `numba.njit(cache=True)`, the cache under NUMBA_CACHE_DIR, by default
+  `~/.cache/multilift/numba`; the first process compiles (1-2 s), later ones load the cache.
+
+MULTILIFT_KERNEL: `auto` (or unset) ahead of time where built, else just in time where numba
+imports, else the pure reference; `aot` ahead of time or the pure reference (controller
+nodes' default: multilift_control.runtime.prepare_node_laws); `jit` just in time or the
+pure reference; `python` the pure reference.
 """
 from __future__ import annotations
 
+import hashlib
 import importlib
+import importlib.machinery
+import importlib.util
+import json
 import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
-from types import ModuleType
+from types import SimpleNamespace
+from typing import Any, Callable
 
 import numpy as np
 
 _cache_home = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
 os.environ.setdefault('NUMBA_CACHE_DIR', str(Path(_cache_home) / 'multilift' / 'numba'))
 
-VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset): compiled where numba imports; python: pure
-_modules: dict[str, ModuleType | None] = {}  # compiled modules by name (None: no numba)
+VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), aot, jit or python: see the docstring
+MODES = ('auto', 'aot', 'jit', 'python')
+AHEAD_OF_TIME_DIR = Path(_cache_home) / 'multilift' / 'aot'
+# compiled modules by (name, mode); None: the pure reference
+_modules: dict[tuple[str, str], Any] = {}
+
+
+def mode() -> str:
+    """MULTILIFT_KERNEL, checked: one of MODES."""
+    value = os.environ.get(VARIABLE) or 'auto'
+    if value not in MODES:
+        raise ValueError(f'{VARIABLE}={value!r}: expected one of {", ".join(MODES)}')
+    return value
 
 
 def enabled() -> bool:
-    """Whether the compiled kernel is to be used (numba importable, not switched off)."""
+    """Whether the compiled kernel is to be used (built or numba importable, not switched
+    off)."""
     return compiled_module('multilift_sim._numba_kernel') is not None
 
 
-def compiled_module(name: str) -> ModuleType | None:
-    """The module of compiled functions `name` (imported once), or None when the pure-Python
-    reference is to be used: numba does not import, or MULTILIFT_KERNEL=python."""
-    if os.environ.get(VARIABLE, 'auto') == 'python':
+def compiled_module(name: str) -> Any:
+    """The compiled functions of module `name` (loaded once per mode): ahead of time or just in
+    time as MULTILIFT_KERNEL says, or None when the pure-Python reference is to be used."""
+    key = (name, mode())
+    if key not in _modules:
+        compiled = None
+        if key[1] in ('auto', 'aot'):
+            compiled = load_ahead_of_time(name)
+        if compiled is None and key[1] in ('auto', 'jit'):
+            try:
+                _import_numba_quietly()
+                compiled = importlib.import_module(name)
+            except ImportError:
+                compiled = None
+        _modules[key] = compiled
+    return _modules[key]
+
+
+def ahead_of_time_files(name: str) -> tuple[Path, Path]:
+    """(extension module, its argument checks) built from module `name` as it is now."""
+    source = Path(importlib.util.find_spec(name).origin).read_bytes()
+    digest = hashlib.sha256(source + f'|{sys.version}|{np.__version__}'.encode()).hexdigest()
+    stem = f'{name}-{digest[:16]}'
+    return (AHEAD_OF_TIME_DIR / f'{stem}{importlib.machinery.EXTENSION_SUFFIXES[0]}',
+            AHEAD_OF_TIME_DIR / f'{stem}.json')
+
+
+def _extension_name(name: str) -> str:
+    return 'aot_' + name.replace('.', '_')
+
+
+class _Checked:
+    """A function compiled ahead of time behind a check of its array arguments: numba's
+    ahead-of-time wrappers do not check them (a float32 or strided array reads wrong memory,
+    or crashes), the just-in-time dispatcher compiles for what it gets."""
+
+    def __init__(self, function: Callable, arrays: list[tuple[int, str, int]]) -> None:
+        self.function = function
+        self.__name__ = function.__name__
+        self.arrays = [(index, np.dtype(dtype), ndim) for index, dtype, ndim in arrays]
+
+    def __call__(self, *args):
+        for index, dtype, ndim in self.arrays:
+            value = args[index]
+            if (type(value) is not np.ndarray or value.dtype != dtype or value.ndim != ndim
+                    or not value.flags.c_contiguous):
+                raise TypeError(f'{self.__name__}: argument {index} must be a C-contiguous '
+                                f'{ndim}-d {dtype} array, got {_describe(value)}')
+        return self.function(*args)
+
+
+def _describe(value: object) -> str:
+    if isinstance(value, np.ndarray):
+        layout = 'C-contiguous' if value.flags.c_contiguous else 'strided'
+        return f'a {layout} {value.ndim}-d {value.dtype} array'
+    return type(value).__name__
+
+
+def load_ahead_of_time(name: str) -> Any:
+    """Module `name`'s functions compiled ahead of time for its current source (checked:
+    `_Checked`), or None when they were not built."""
+    extension_path, checks_path = ahead_of_time_files(name)
+    if not (extension_path.is_file() and checks_path.is_file()):
         return None
-    if name not in _modules:
-        try:
-            _import_numba_quietly()
-            _modules[name] = importlib.import_module(name)
-        except ImportError:
-            _modules[name] = None
-    return _modules[name]
+    extension_name = _extension_name(name)
+    loader = importlib.machinery.ExtensionFileLoader(extension_name, str(extension_path))
+    spec = importlib.util.spec_from_file_location(extension_name, extension_path,
+                                                  loader=loader)
+    extension = importlib.util.module_from_spec(spec)
+    loader.exec_module(extension)
+    checks = json.loads(checks_path.read_text())
+    return SimpleNamespace(**{function: _Checked(getattr(extension, function), arrays)
+                              for function, arrays in checks.items()})
+
+
+def build_ahead_of_time(name: str) -> Path:
+    """Compile module `name`'s `AHEAD_OF_TIME` functions ({name: numba signature}) into an
+    extension module under AHEAD_OF_TIME_DIR (numba's pycc; a C compiler is needed). Returns
+    its path; the files appear whole (written aside, then renamed)."""
+    from numba.np.numpy_support import as_dtype
+    from numba.pycc import CC
+    from numba.core import types
+    module = importlib.import_module(name)
+    extension_path, checks_path = ahead_of_time_files(name)
+    AHEAD_OF_TIME_DIR.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix='.build-', dir=AHEAD_OF_TIME_DIR))
+    try:
+        compiler = CC(_extension_name(name))
+        compiler.output_dir = str(work)
+        checks = {}
+        for function, signature in module.AHEAD_OF_TIME.items():
+            compiler.export(function, signature)(getattr(module, function).py_func)
+            checks[function] = [(index, as_dtype(arg.dtype).str, arg.ndim)
+                                for index, arg in enumerate(signature.args)
+                                if isinstance(arg, types.Array)]
+        compiler.compile()
+        built = next(work.glob(f'{_extension_name(name)}*'))
+        (work / 'checks.json').write_text(json.dumps(checks))
+        os.replace(work / 'checks.json', checks_path)
+        os.replace(built, extension_path)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return extension_path
 
 
 def _import_numba_quietly() -> None:
@@ -79,6 +200,6 @@ def integrate(constants: tuple, x: np.ndarray, wrenches: np.ndarray, dt: float,
               steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """`steps` RK4 steps of dt [s] from x: (state, multipliers at x, g, g_dot at the end);
     after `enabled()` said yes."""
-    kernel = _modules['multilift_sim._numba_kernel'].integrate_period
+    kernel = compiled_module('multilift_sim._numba_kernel').integrate_period
     return kernel(*constants, np.ascontiguousarray(x, dtype=np.float64),
                   np.ascontiguousarray(wrenches, dtype=np.float64), float(dt), int(steps))

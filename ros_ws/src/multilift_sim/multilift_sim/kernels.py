@@ -96,20 +96,29 @@ def _extension_name(name: str) -> str:
 class _Checked:
     """A function compiled ahead of time behind a check of its array arguments: numba's
     ahead-of-time wrappers do not check them (a float32 or strided array reads wrong memory,
-    or crashes), the just-in-time dispatcher compiles for what it gets."""
+    or crashes), the just-in-time dispatcher compiles for what it gets.
+
+    An array object that passed is remembered by position and not checked again (a
+    controller's constants and memory come back every tick; numpy arrays keep their dtype,
+    shape and layout), which keeps the check at about 1 us a call."""
 
     def __init__(self, function: Callable, arrays: list[tuple[int, str, int]]) -> None:
         self.function = function
         self.__name__ = function.__name__
         self.arrays = [(index, np.dtype(dtype), ndim) for index, dtype, ndim in arrays]
+        self._passed: dict[int, np.ndarray] = {}
 
     def __call__(self, *args):
+        passed = self._passed
         for index, dtype, ndim in self.arrays:
             value = args[index]
+            if value is passed.get(index):
+                continue
             if (type(value) is not np.ndarray or value.dtype != dtype or value.ndim != ndim
                     or not value.flags.c_contiguous):
                 raise TypeError(f'{self.__name__}: argument {index} must be a C-contiguous '
                                 f'{ndim}-d {dtype} array, got {_describe(value)}')
+            passed[index] = value
         return self.function(*args)
 
 

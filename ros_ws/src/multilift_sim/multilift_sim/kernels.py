@@ -33,7 +33,7 @@ import shutil
 import sys
 import tempfile
 from pathlib import Path
-from types import SimpleNamespace
+from types import ModuleType
 from typing import Any, Callable
 
 import numpy as np
@@ -100,7 +100,8 @@ class _Checked:
 
     An array object that passed is remembered by position and not checked again (a
     controller's constants and memory come back every tick; numpy arrays keep their dtype,
-    shape and layout), which keeps the check at about 1 us a call."""
+    shape and layout). Each caller gets a checker of its own (`_AheadOfTimeModule`), so what
+    it remembers is that caller's arrays."""
 
     def __init__(self, function: Callable, arrays: list[tuple[int, str, int]]) -> None:
         self.function = function
@@ -141,9 +142,21 @@ def load_ahead_of_time(name: str) -> Any:
                                                   loader=loader)
     extension = importlib.util.module_from_spec(spec)
     loader.exec_module(extension)
-    checks = json.loads(checks_path.read_text())
-    return SimpleNamespace(**{function: _Checked(getattr(extension, function), arrays)
-                              for function, arrays in checks.items()})
+    return _AheadOfTimeModule(extension, json.loads(checks_path.read_text()))
+
+
+class _AheadOfTimeModule:
+    """An extension module built ahead of time, seen through its checks: each attribute
+    access gives a fresh `_Checked` function (a controller keeps the one it took)."""
+
+    def __init__(self, extension: ModuleType, checks: dict[str, list]) -> None:
+        self._extension = extension
+        self._checks = checks
+
+    def __getattr__(self, function: str) -> _Checked:
+        if function.startswith('_') or function not in self._checks:
+            raise AttributeError(function)
+        return _Checked(getattr(self._extension, function), self._checks[function])
 
 
 def build_ahead_of_time(name: str) -> Path:

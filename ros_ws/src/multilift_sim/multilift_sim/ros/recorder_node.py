@@ -256,6 +256,8 @@ class RecorderNode(Node):
         if self.bag.closed:
             return
         self.release(everything=True)
+        for topic in self._recorded:
+            self._note_publishers(topic)
         for topic in self._types:
             if topic not in self._in_bag:
                 self._add_to_bag(topic)

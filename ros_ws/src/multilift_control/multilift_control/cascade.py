@@ -156,7 +156,9 @@ class CascadeController:
         self._inertia = tuple(map(float, vehicle.inertia))
         self._att_kp = tuple(map(float, gains.attitude_kp))
         self._att_kd = tuple(map(float, gains.attitude_kd))
-        self._laws = kernels.compiled_module(COMPILED_LAWS)  # None: the methods below
+        laws = kernels.compiled_module(COMPILED_LAWS)  # None: the methods below
+        self._compiled_command = None if laws is None else laws.cascade_command
+        self._compiled_update = None if laws is None else laws.cascade_update
         # the compiled code's constants (the _numba_laws.CASCADE_* layout)
         self.compiled_constants = (
             np.array([*self._kp, *self._kd, *self._ki, self.integral_limit, hover_mass, gravity,
@@ -200,8 +202,8 @@ class CascadeController:
 
     def command(self, state: UavState, force: np.ndarray, yaw: float) -> ControlOutput:
         """Rotor speeds that produce `force` (world) at heading `yaw`."""
-        if self._laws is not None:
-            return ControlOutput(*self._laws.cascade_command(
+        if self._compiled_command is not None:
+            return ControlOutput(*self._compiled_command(
                 *self.compiled_constants, state.euler, state.body_rates,
                 np.asarray(force, dtype=float), float(yaw)))
         roll, pitch, thrust = attitude_from_force(force, yaw, self.gains.max_tilt)
@@ -215,8 +217,8 @@ class CascadeController:
                velocity_ref: np.ndarray, acceleration_ref: np.ndarray,
                yaw_ref: float = 0.0) -> ControlOutput:
         """One control tick at simulated time t [s]."""
-        if self._laws is not None:
-            return ControlOutput(*self._laws.cascade_update(
+        if self._compiled_update is not None:
+            return ControlOutput(*self._compiled_update(
                 *self.compiled_constants, self._memory, t, state.position, state.velocity,
                 state.euler, state.body_rates, position_ref, velocity_ref, acceleration_ref,
                 float(yaw_ref)))

@@ -237,7 +237,8 @@ class FormationModel:
             (float(self.uav_masses[i]), float(self._lengths_sq[i]),
              *self._inv_inertia[:, i].tolist(), *self._gyro_coefficients[:, i].tolist())
             for i in range(n)]
-        self._compiled: tuple | None = None  # kernels.model_constants, made on first use
+        # (MULTILIFT_KERNEL, kernels.integrator(), kernels.model_constants), made on first use
+        self._compiled: tuple | None = None
 
     # ----------------------------------------------------------------------------- inputs
     def wrenches(self, rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
@@ -304,10 +305,11 @@ class FormationModel:
         the tension is that of the first stage of the first step (the multipliers at x)."""
         wrenches = self.wrenches(rotor_speeds)
         if self.uses_float_kernel and kernels.enabled():  # the same kernel, compiled
-            if self._compiled is None:
-                self._compiled = kernels.model_constants(self)
-            state, multipliers, g, g_dot = kernels.integrate(self._compiled, x, wrenches, dt,
-                                                             steps)
+            mode = kernels.mode()
+            if self._compiled is None or self._compiled[0] != mode:
+                self._compiled = (mode, kernels.integrator(), kernels.model_constants(self))
+            state, multipliers, g, g_dot = kernels.integrate(*self._compiled[1:], x, wrenches,
+                                                             dt, steps)
             return Integration(state, 2.0 * self.cable_lengths * multipliers, g, g_dot)
         if self.uses_float_kernel:
             w = wrenches.tolist()

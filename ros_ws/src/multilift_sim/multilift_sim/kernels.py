@@ -218,10 +218,15 @@ def model_constants(model) -> tuple:
             bool(model._has_drag), float(params.payload_drag_coefficient))
 
 
-def integrate(constants: tuple, x: np.ndarray, wrenches: np.ndarray, dt: float,
-              steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """`steps` RK4 steps of dt [s] from x: (state, multipliers at x, g, g_dot at the end);
-    after `enabled()` said yes."""
-    kernel = compiled_module('multilift_sim._numba_kernel').integrate_period
+def integrator() -> Callable:
+    """The compiled `integrate_period`, for one caller to keep (each keeps its own checked
+    function: `_AheadOfTimeModule`); after `enabled()` said yes."""
+    return compiled_module('multilift_sim._numba_kernel').integrate_period
+
+
+def integrate(kernel: Callable, constants: tuple, x: np.ndarray, wrenches: np.ndarray,
+              dt: float, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """`steps` RK4 steps of dt [s] from x with `kernel` (`integrator()`) and the model's
+    `constants` (`model_constants`): (state, multipliers at x, g, g_dot at the end)."""
     return kernel(*constants, np.ascontiguousarray(x, dtype=np.float64),
                   np.ascontiguousarray(wrenches, dtype=np.float64), float(dt), int(steps))

@@ -23,9 +23,9 @@ from multilift_control.cascade import UavState
 from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
 from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, RawPublishers,
-                                      controller_peers_missing, ns_from_stamp, run_node,
-                                      serve_controller)
+from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
+                                      RawPublishers, controller_peers_missing, ns_from_stamp,
+                                      run_node, serve_controller)
 from multilift_sim.topics import uav_topic
 
 
@@ -60,7 +60,8 @@ class FollowerNode(Node):
                                                   uav_topic(i, 'attitude_setpoint'), PUBLISHER_QOS)
         self.error_pub = self.create_publisher(VirtualConstraintError,
                                                uav_topic(i, 'formation_error'), PUBLISHER_QOS)
-        self.outputs = RawPublishers(self.cmd_pub, self.setpoint_pub, self.error_pub)
+        self.outputs = RawPublishers(self.cmd_pub, self.setpoint_pub, self.error_pub,
+                                     confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
 
     def missing_peers(self) -> str | None:
         return controller_peers_missing(self, self.cmd_pub, self.record)

@@ -18,8 +18,9 @@ from multilift_control.answer_messages import AnswerMessages
 from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
 from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal, RawPublishers,
-                                      controller_peers_missing, run_node, serve_controller)
+from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
+                                      RawPublishers, controller_peers_missing, run_node,
+                                      serve_controller)
 from multilift_sim.topics import uav_topic
 
 
@@ -41,7 +42,8 @@ class LeaderNode(Node):
                                              PUBLISHER_QOS)
         self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
                                                   uav_topic(1, 'attitude_setpoint'), PUBLISHER_QOS)
-        self.outputs = RawPublishers(self.cmd_pub, self.ref_pub, self.setpoint_pub)
+        self.outputs = RawPublishers(self.cmd_pub, self.ref_pub, self.setpoint_pub,
+                                     confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.read_snapshot = SnapshotReader(scenario)
         self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
                                  SUBSCRIBER_QOS, raw=True)

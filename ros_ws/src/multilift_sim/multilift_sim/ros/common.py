@@ -220,17 +220,50 @@ def use_fastdds_profile() -> Path | None:
     return path
 
 
+# Discovery runs on each side of a writer-reader pair on its own: a reliable writer that has
+# matched a reader sends to it, but a reader that has not yet matched the writer drops what it
+# hears and asks again (from the writer's history) only once it has. A run that ends first
+# loses the topic from the bag: seen once here, a 1 s run whose bag had none of the leader's
+# rotor commands. When recording, a node therefore waits after its first messages until every
+# subscriber acknowledged them (this long at most, then a warning names the topics).
+FIRST_ACK_TIMEOUT = 2.0  # [s]
+
+
 class RawPublishers:
     """A node's publishers by topic, for messages that are already CDR bytes
-    (`multilift_sim.tick_messages.Message`: (topic, bytes)): sent as they are."""
+    (`multilift_sim.tick_messages.Message`: (topic, bytes)): sent as they are.
 
-    def __init__(self, *publishers) -> None:
+    `confirm_first` [s]: after the first `send`, wait up to this long until every subscriber of
+    every topic acknowledged it (FIRST_ACK_TIMEOUT when recording; 0: no wait)."""
+
+    def __init__(self, *publishers, confirm_first: float = 0.0) -> None:
         self._by_topic = {pub.topic_name: pub for pub in publishers}
+        self._confirm_within = confirm_first
 
     def send(self, messages: Iterable[tuple[str, bytes]]) -> None:
         """Publish each (topic, bytes) of `messages`, in order."""
         for topic, data in messages:
             self._by_topic[topic].publish(data)
+        if self._confirm_within > 0.0:
+            self._confirm()
+
+    def _confirm(self) -> None:
+        within, self._confirm_within = self._confirm_within, 0.0
+        deadline = time.monotonic() + within
+        unconfirmed = []
+        for topic, pub in self._by_topic.items():
+            try:
+                acked = pub.wait_for_all_acked(
+                    Duration(seconds=max(0.0, deadline - time.monotonic())))
+            except Exception:  # noqa: BLE001 - a context shut down: the run is ending anyway
+                return
+            if not acked:
+                unconfirmed.append(topic)
+        if unconfirmed:
+            print(f'warning: {", ".join(unconfirmed)}: not acknowledged by every subscriber '
+                  f'{within:g} s after the first message (a reader that has not discovered '
+                  'this node yet, such as the recorder, may miss the start of the run)',
+                  file=sys.stderr, flush=True)
 
 
 def flush_publishers(node: Node, timeout: float = FLUSH_TIMEOUT) -> None:

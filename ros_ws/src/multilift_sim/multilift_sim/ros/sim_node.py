@@ -32,9 +32,10 @@ from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (PUBLISHER_QOS, RECORDER_NODE, STARTUP_TIMEOUT, Fatal,
-                                      RawPublishers, ns_from_stamp, recorder_hears,
-                                      recorder_missing, run_node, wait_until, write_summary)
+from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, RECORDER_NODE,
+                                      STARTUP_TIMEOUT, Fatal, RawPublishers, ns_from_stamp,
+                                      recorder_hears, recorder_missing, run_node, wait_until,
+                                      write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import MARKER_DECIMATION, parse_external, uav_topic
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
@@ -90,7 +91,8 @@ class SimNode(Node):
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
-            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub)
+            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub,
+            confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.commands: list[RotorCommand | None] = [None] * n
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)

@@ -193,7 +193,8 @@ class FormationModel:
     Two kernels compute the same accelerations: a numpy one vectorised over the UAVs that forms
     the n x n matrix G M^-1 G^T, and a plain-float one that loops over the UAVs and applies
     the Woodbury identity (a 3 x 3 solve, below). Small arrays make numpy's per-call overhead
-    dominate, so ``kernel='auto'`` picks the float kernel for up to FLOAT_KERNEL_MAX_UAVS UAVs;
+    dominate, so ``kernel='auto'`` picks the float kernel for up to FLOAT_KERNEL_MAX_UAVS UAVs
+    (for any number where it runs compiled: `kernels.enabled()`);
     ``'float'`` or ``'numpy'`` force one. They agree to rounding
     (tests/test_dynamics_formation.py).
     """
@@ -230,8 +231,9 @@ class FormationModel:
                                             (moments[0] - moments[2]) / moments[1],
                                             (moments[1] - moments[0]) / moments[2]])
         self._has_drag = params.payload_drag_coefficient > 0
-        self.uses_float_kernel = (kernel == 'float'
-                                  or (kernel == 'auto' and n <= FLOAT_KERNEL_MAX_UAVS))
+        # compiled, the float kernel's O(n) loop beats numpy's n x n solve at every n
+        self.uses_float_kernel = (kernel == 'float' or (kernel == 'auto' and (
+            n <= FLOAT_KERNEL_MAX_UAVS or kernels.enabled())))
         # Per-UAV constants of the float kernel: (m_i, l_i^2, 1/I (3), gyro coefficients (3)).
         self._uav_constants = [
             (float(self.uav_masses[i]), float(self._lengths_sq[i]),

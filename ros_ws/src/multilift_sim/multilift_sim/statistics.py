@@ -28,48 +28,57 @@ _FEASIBILITY = 1e-9
 _WORKING_SET = 6
 
 
-def _sphere_pair_lowest(c1: np.ndarray, r1: float, c2: np.ndarray,
-                        r2: float) -> np.ndarray | None:
-    """Lowest point of the circle where the spheres (c1, r1) and (c2, r2) meet, or None."""
-    axis = c2 - c1
-    d = float(np.linalg.norm(axis))
+Point = tuple[float, float, float]
+
+
+def _sphere_pair_lowest(c1: Point, r1: float, c2: Point, r2: float) -> Point | None:
+    """Lowest point of the circle where the spheres (c1, r1) and (c2, r2) meet, or None
+    (plain floats: the payload-swing statistic runs it for every pair of its working set)."""
+    (x1, y1, z1), (x2, y2, z2) = c1, c2
+    ax, ay, az = x2 - x1, y2 - y1, z2 - z1
+    d = math.sqrt(ax * ax + ay * ay + az * az)
     if d < 1e-12 or d > r1 + r2 or d < abs(r1 - r2):
         return None
-    axis = axis / d
+    ax, ay, az = ax / d, ay / d, az / d
     a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
     radius = math.sqrt(max(r1 * r1 - a * a, 0.0))
-    centre = c1 + a * axis
-    down = np.array([0.0, 0.0, -1.0]) - axis * (-axis[2])      # -e_z without its axis part
-    norm = float(np.linalg.norm(down))
+    # -e_z without its part along the axis
+    dx, dy, dz = ax * az, ay * az, -1.0 + az * az
+    norm = math.sqrt(dx * dx + dy * dy + dz * dz)
     if norm < 1e-12:                                            # vertical axis: any point
-        down = np.cross(axis, [1.0, 0.0, 0.0])
-        norm = float(np.linalg.norm(down))
-    return centre + radius * down / norm
+        dx, dy, dz = 0.0, az, -ay                               # axis x e_x
+        norm = math.sqrt(dy * dy + dz * dz)
+    k = radius / norm
+    return (x1 + a * ax + k * dx, y1 + a * ay + k * dy, z1 + a * az + k * dz)
 
 
-def _sphere_triple_lowest(c1: np.ndarray, r1: float, c2: np.ndarray, r2: float,
-                          c3: np.ndarray, r3: float) -> np.ndarray | None:
-    """The lower of the (at most two) points where three spheres meet, or None."""
-    ex = c2 - c1
-    d = float(np.linalg.norm(ex))
+def _sphere_triple_lowest(c1: Point, r1: float, c2: Point, r2: float, c3: Point,
+                          r3: float) -> Point | None:
+    """The lower of the (at most two) points where three spheres meet, or None (plain
+    floats, as `_sphere_pair_lowest`)."""
+    (x1, y1, z1), (x2, y2, z2), (x3, y3, z3) = c1, c2, c3
+    ex, ey_, ez_ = x2 - x1, y2 - y1, z2 - z1
+    d = math.sqrt(ex * ex + ey_ * ey_ + ez_ * ez_)
     if d < 1e-12:
         return None
-    ex = ex / d
-    i = float(ex @ (c3 - c1))
-    ey = c3 - c1 - i * ex
-    j = float(np.linalg.norm(ey))
+    ex, ey_, ez_ = ex / d, ey_ / d, ez_ / d                     # e_x, the unit axis 1 -> 2
+    wx, wy, wz = x3 - x1, y3 - y1, z3 - z1
+    i = ex * wx + ey_ * wy + ez_ * wz
+    fx, fy, fz = wx - i * ex, wy - i * ey_, wz - i * ez_        # e_y before its norm
+    j = math.sqrt(fx * fx + fy * fy + fz * fz)
     if j < 1e-12:
         return None
-    ey = ey / j
-    ez = np.cross(ex, ey)
+    fx, fy, fz = fx / j, fy / j, fz / j
+    gx, gy, gz = ey_ * fz - ez_ * fy, ez_ * fx - ex * fz, ex * fy - ey_ * fx  # e_z = e_x x e_y
     x = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
     y = (r1 * r1 - r3 * r3 + i * i + j * j) / (2.0 * j) - i * x / j
     z_sq = r1 * r1 - x * x - y * y
     if z_sq < 0.0:
         return None
-    base = c1 + x * ex + y * ey
+    bx, by, bz = x1 + x * ex + y * fx, y1 + x * ey_ + y * fy, z1 + x * ez_ + y * fz
     z = math.sqrt(z_sq)
-    first, second = base + z * ez, base - z * ez
+    first = (bx + z * gx, by + z * gy, bz + z * gz)
+    second = (bx - z * gx, by - z * gy, bz - z * gz)
     return first if first[2] <= second[2] else second
 
 
@@ -106,27 +115,31 @@ def _lowest_in(uavs: np.ndarray, lengths: np.ndarray, members: list[int]) -> np.
     meet. The optimum of `min z` over an intersection of balls lies on at most three spheres,
     so it is the lowest feasible one of: a ball's bottom, a pair's lowest circle point, a
     triple's lower meeting point."""
-    best = None
+    centres = [tuple(row) for row in uavs[members].tolist()]
+    radii = lengths[members].tolist()
+    slack = [_FEASIBILITY * (1.0 + r) for r in radii]
+    best: Point | None = None
 
-    def consider(point: np.ndarray | None) -> None:
+    def consider(point: Point | None) -> None:
         nonlocal best
         if point is None or (best is not None and point[2] >= best[2]):
             return
-        gaps = np.linalg.norm(uavs[members] - point, axis=1) - lengths[members]
-        if np.all(gaps <= _FEASIBILITY * (1.0 + lengths[members])):
-            best = point
+        px, py, pz = point
+        for (cx, cy, cz), radius, allowed in zip(centres, radii, slack):
+            dx, dy, dz = cx - px, cy - py, cz - pz
+            if not math.sqrt(dx * dx + dy * dy + dz * dz) - radius <= allowed:  # NaN too
+                return
+        best = point
 
-    down = np.array([0.0, 0.0, -1.0])
-    for i in members:
-        consider(uavs[i] + lengths[i] * down)
-    if best is not None:
-        return best
-    for i, j in combinations(members, 2):
-        consider(_sphere_pair_lowest(uavs[i], lengths[i], uavs[j], lengths[j]))
-    for i, j, k in combinations(members, 3):
-        consider(_sphere_triple_lowest(uavs[i], lengths[i], uavs[j], lengths[j],
-                                       uavs[k], lengths[k]))
-    return best
+    for (cx, cy, cz), radius in zip(centres, radii):
+        consider((cx, cy, cz - radius))
+    if best is None:
+        pairs = list(zip(centres, radii))
+        for (c1, r1), (c2, r2) in combinations(pairs, 2):
+            consider(_sphere_pair_lowest(c1, r1, c2, r2))
+        for (c1, r1), (c2, r2), (c3, r3) in combinations(pairs, 3):
+            consider(_sphere_triple_lowest(c1, r1, c2, r2, c3, r3))
+    return None if best is None else np.array(best)
 
 
 def equilibrium_payload_position(uav_positions: ArrayLike, cable_lengths: ArrayLike

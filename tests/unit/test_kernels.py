@@ -148,6 +148,14 @@ def test_an_argument_of_the_wrong_type_is_a_type_error_not_a_crash():
         with pytest.raises(TypeError, match=f'argument 9 must be a C-contiguous 1-d float64 '
                                             f'array, got .*{words}'):
             compiled.integrate_period(*constants, bad, wrenches, 0.001, 2)
+    # the laws write their memory: a read-only one is refused
+    laws = kernels.load_ahead_of_time('multilift_control._numba_laws')
+    frozen = np.zeros(4)
+    frozen.flags.writeable = False
+    with pytest.raises(TypeError, match='argument 3 must be a C-contiguous writable 1-d '
+                                        'float64 array, got a C-contiguous read-only'):
+        laws.cascade_update(np.zeros(24), np.zeros((4, 4)), np.zeros(4), frozen, 0.0,
+                            *[np.zeros(3)] * 7, 0.0)
 
 
 def test_the_ahead_of_time_build_is_named_by_its_source(tmp_path, monkeypatch):

@@ -255,21 +255,25 @@ def filtered_reference(t, omega, start, step_times, steps, ends, velocities, ori
 
 
 # What every caller passes (CascadeController, FormationFollower, MissionPath): the signatures
-# compiled ahead of time (multilift_sim.kernels.build_ahead_of_time). A linear follower's law
-# rows arrive read-only (views of the law's frozen arrays).
-_ARRAY, _MATRIX = numba.float64[::1], numba.float64[:, ::1]
-_FROZEN = numba.types.Array(numba.float64, 2, 'C', readonly=True)
-_INDICES, _FLAGS = numba.int64[::1], numba.boolean[::1]
+# compiled ahead of time (multilift_sim.kernels.build_ahead_of_time). Arrays are read only but a
+# controller's memory, which the code updates: the build fails should it write another, and
+# callers may pass read-only arrays (a linear follower's law rows and the formation's states
+# are views of frozen arrays).
+_ARRAY = numba.types.Array(numba.float64, 1, 'C', readonly=True)
+_MATRIX = numba.types.Array(numba.float64, 2, 'C', readonly=True)
+_INDICES = numba.types.Array(numba.int64, 1, 'C', readonly=True)
+_MEMORY, _OUT = numba.float64[::1], numba.float64[::1]
 _F8 = numba.float64
-_COMMAND = numba.types.Tuple((_ARRAY, _FLAGS, _ARRAY, _F8))
+_COMMAND = numba.types.Tuple((_OUT, numba.boolean[::1], _OUT, _F8))
 AHEAD_OF_TIME = {
     'cascade_command': _COMMAND(_ARRAY, _MATRIX, _ARRAY, _ARRAY, _ARRAY, _ARRAY, _F8),
-    'cascade_update': _COMMAND(_ARRAY, _MATRIX, _ARRAY, _ARRAY, _F8, _ARRAY, _ARRAY, _ARRAY,
+    'cascade_update': _COMMAND(_ARRAY, _MATRIX, _ARRAY, _MEMORY, _F8, _ARRAY, _ARRAY, _ARRAY,
                                _ARRAY, _ARRAY, _ARRAY, _ARRAY, _F8),
-    'linear_follower_update': numba.types.Tuple((_ARRAY, _FLAGS, _ARRAY, _F8, _ARRAY, _ARRAY))(
+    'linear_follower_update': numba.types.Tuple(
+        (_OUT, numba.boolean[::1], _OUT, _F8, _OUT, _OUT))(
         _ARRAY, numba.int64, _MATRIX, _MATRIX, _ARRAY, _ARRAY, _MATRIX, _INDICES, _INDICES,
-        _ARRAY, _INDICES, _ARRAY, _F8, _FROZEN, _FROZEN, _FROZEN, _ARRAY, _MATRIX, _ARRAY,
+        _ARRAY, _INDICES, _MEMORY, _F8, _MATRIX, _MATRIX, _MATRIX, _ARRAY, _MATRIX, _ARRAY,
         _ARRAY, _ARRAY, _F8),
-    'filtered_reference': _ARRAY(_F8, _F8, _ARRAY, _ARRAY, _MATRIX, _ARRAY, _MATRIX, _MATRIX,
-                                 _ARRAY, _ARRAY),
+    'filtered_reference': _OUT(_F8, _F8, _ARRAY, _ARRAY, _MATRIX, _ARRAY, _MATRIX, _MATRIX,
+                               _ARRAY, _ARRAY),
 }

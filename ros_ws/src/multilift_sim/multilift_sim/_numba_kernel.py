@@ -192,11 +192,13 @@ def integrate_period(uavs, gusts, payload_mass, inv_payload_mass, gravity, two_a
 
 
 # What every caller passes (multilift_sim.kernels.integrate): the signatures compiled ahead of
-# time (multilift_sim.kernels.build_ahead_of_time)
-_ARRAY, _MATRIX = numba.float64[::1], numba.float64[:, ::1]
+# time (multilift_sim.kernels.build_ahead_of_time). Every array is read only here: the build
+# fails should the code write one, and callers may pass read-only arrays.
+_ARRAY = numba.types.Array(numba.float64, 1, 'C', readonly=True)
+_MATRIX = numba.types.Array(numba.float64, 2, 'C', readonly=True)
 _F8 = numba.float64
 AHEAD_OF_TIME = {
-    'integrate_period': numba.types.UniTuple(_ARRAY, 4)(
+    'integrate_period': numba.types.UniTuple(numba.float64[::1], 4)(
         _MATRIX, _MATRIX, _F8, _F8, _F8, _F8, _F8, numba.boolean, _F8, _ARRAY, _MATRIX, _F8,
         numba.int64),
 }

@@ -44,6 +44,7 @@ os.environ.setdefault('NUMBA_CACHE_DIR', str(Path(_cache_home) / 'multilift' / '
 VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), aot, jit or python: see the docstring
 MODES = ('auto', 'aot', 'jit', 'python')
 AHEAD_OF_TIME_DIR = Path(_cache_home) / 'multilift' / 'aot'
+_BUILD_FORMAT = 2  # of the files build_ahead_of_time writes: part of their names
 # compiled modules by (name, mode); None: the pure reference
 _modules: dict[tuple[str, str], Any] = {}
 
@@ -83,7 +84,8 @@ def compiled_module(name: str) -> Any:
 def ahead_of_time_files(name: str) -> tuple[Path, Path]:
     """(extension module, its argument checks) built from module `name` as it is now."""
     source = Path(importlib.util.find_spec(name).origin).read_bytes()
-    digest = hashlib.sha256(source + f'|{sys.version}|{np.__version__}'.encode()).hexdigest()
+    digest = hashlib.sha256(
+        source + f'|{sys.version}|{np.__version__}|{_BUILD_FORMAT}'.encode()).hexdigest()
     stem = f'{name}-{digest[:16]}'
     return (AHEAD_OF_TIME_DIR / f'{stem}{importlib.machinery.EXTENSION_SUFFIXES[0]}',
             AHEAD_OF_TIME_DIR / f'{stem}.json')
@@ -103,22 +105,24 @@ class _Checked:
     shape and layout). Each caller gets a checker of its own (`_AheadOfTimeModule`), so what
     it remembers is that caller's arrays."""
 
-    def __init__(self, function: Callable, arrays: list[tuple[int, str, int]]) -> None:
+    def __init__(self, function: Callable, arrays: list[tuple[int, str, int, bool]]) -> None:
         self.function = function
         self.__name__ = function.__name__
-        self.arrays = [(index, np.dtype(dtype), ndim) for index, dtype, ndim in arrays]
+        self.arrays = [(index, np.dtype(dtype), ndim, writes)
+                       for index, dtype, ndim, writes in arrays]
         self._passed: dict[int, np.ndarray] = {}
 
     def __call__(self, *args):
         passed = self._passed
-        for index, dtype, ndim in self.arrays:
+        for index, dtype, ndim, writes in self.arrays:
             value = args[index]
             if value is passed.get(index):
                 continue
             if (type(value) is not np.ndarray or value.dtype != dtype or value.ndim != ndim
-                    or not value.flags.c_contiguous):
-                raise TypeError(f'{self.__name__}: argument {index} must be a C-contiguous '
-                                f'{ndim}-d {dtype} array, got {_describe(value)}')
+                    or not value.flags.c_contiguous or (writes and not value.flags.writeable)):
+                raise TypeError(f'{self.__name__}: argument {index} must be a C-contiguous'
+                                f'{" writable" if writes else ""} {ndim}-d {dtype} array, got '
+                                f'{_describe(value)}')
             passed[index] = value
         return self.function(*args)
 
@@ -126,7 +130,8 @@ class _Checked:
 def _describe(value: object) -> str:
     if isinstance(value, np.ndarray):
         layout = 'C-contiguous' if value.flags.c_contiguous else 'strided'
-        return f'a {layout} {value.ndim}-d {value.dtype} array'
+        access = '' if value.flags.writeable else ' read-only'
+        return f'a {layout}{access} {value.ndim}-d {value.dtype} array'
     return type(value).__name__
 
 
@@ -140,9 +145,15 @@ def load_ahead_of_time(name: str) -> Any:
     loader = importlib.machinery.ExtensionFileLoader(extension_name, str(extension_path))
     spec = importlib.util.spec_from_file_location(extension_name, extension_path,
                                                   loader=loader)
-    extension = importlib.util.module_from_spec(spec)
-    loader.exec_module(extension)
-    return _AheadOfTimeModule(extension, json.loads(checks_path.read_text()))
+    try:
+        extension = importlib.util.module_from_spec(spec)
+        loader.exec_module(extension)
+        checks = json.loads(checks_path.read_text())
+    except (ImportError, OSError, ValueError) as error:  # a damaged build: the fallback runs
+        print(f'warning: {extension_path} does not load ({error}); compiling just in time',
+              file=sys.stderr)
+        return None
+    return _AheadOfTimeModule(extension, checks)
 
 
 class _AheadOfTimeModule:
@@ -176,7 +187,8 @@ def build_ahead_of_time(name: str) -> Path:
         checks = {}
         for function, signature in module.AHEAD_OF_TIME.items():
             compiler.export(function, signature)(getattr(module, function).py_func)
-            checks[function] = [(index, as_dtype(arg.dtype).str, arg.ndim)
+            # (position, dtype, dimensions, whether the compiled code may write it)
+            checks[function] = [(index, as_dtype(arg.dtype).str, arg.ndim, arg.mutable)
                                 for index, arg in enumerate(signature.args)
                                 if isinstance(arg, types.Array)]
         compiler.compile()

@@ -101,9 +101,10 @@ class _Checked:
     or crashes), the just-in-time dispatcher compiles for what it gets.
 
     An array object that passed is remembered by position and not checked again (a
-    controller's constants and memory come back every tick; numpy arrays keep their dtype,
-    shape and layout). Each caller gets a checker of its own (`_AheadOfTimeModule`), so what
-    it remembers is that caller's arrays."""
+    controller's constants and memory come back every tick). That trusts an array not to be
+    reshaped or retyped in place (`a.shape = ...`, `a.dtype = ...`), which no caller does.
+    Each caller gets a checker of its own (`_AheadOfTimeModule`), so what it remembers is that
+    caller's arrays."""
 
     def __init__(self, function: Callable, arrays: list[tuple[int, str, int, bool]]) -> None:
         self.function = function

@@ -13,7 +13,8 @@ import sys
 import numpy as np
 import pytest
 
-from multilift_control.cascade import CascadeController, FormationStates, UavState
+from multilift_control.cascade import (COMPILED_LAWS, CascadeController, FormationStates,
+                                      UavState)
 from multilift_control.formation import FormationFollower
 from multilift_control.headless import run_headless
 from multilift_control.mission import MissionPath
@@ -26,10 +27,10 @@ pytest.importorskip('numba')
 def _both(monkeypatch, build):
     """(compiled, pure) objects of `build()`: the kernels on, then off, at construction."""
     monkeypatch.setenv('MULTILIFT_KERNEL', 'auto')
-    assert kernels.compiled_module('multilift_control._numba_laws') is not None
+    assert kernels.compiled_module(COMPILED_LAWS) is not None
     compiled = build()
     monkeypatch.setenv('MULTILIFT_KERNEL', 'python')
-    assert kernels.compiled_module('multilift_control._numba_laws') is None
+    assert kernels.compiled_module(COMPILED_LAWS) is None
     return compiled, build()
 
 

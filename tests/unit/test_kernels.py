@@ -14,6 +14,7 @@ import sys
 import numpy as np
 import pytest
 
+from multilift_control.cascade import COMPILED_LAWS
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
 from multilift_sim.simulation import FormationSimulator
@@ -93,14 +94,14 @@ def test_loading_the_kernel_leaves_scipy_and_coverage_unimported_and_importable(
     assert out.split('\n')[:2] == ['False False', '[1.0, 1.0] True']
 
 
-AHEAD_OF_TIME = ('multilift_sim._numba_kernel', 'multilift_control._numba_laws')
+AHEAD_OF_TIME = (kernels.PHYSICS, COMPILED_LAWS)
 
 
 def test_setup_built_the_kernels_ahead_of_time_and_they_load_without_numba():
     for name in AHEAD_OF_TIME:
         assert all(path.is_file() for path in kernels.ahead_of_time_files(name)), name
     out = _a_tick_in_a_new_process(
-        'auto', 'law = kernels.compiled_module("multilift_control._numba_laws").cascade_update\n'
+        'auto', f'law = kernels.compiled_module("{COMPILED_LAWS}").cascade_update\n'
                 'print(kernels.enabled(), isinstance(law, kernels._Checked), sim.t > 0,\n'
                 '      "numba" in sys.modules)\n')
     assert out.split() == ['True', 'True', 'True', 'False']
@@ -134,7 +135,7 @@ def test_ahead_of_time_equals_just_in_time_bit_for_bit(name, monkeypatch):
 
 
 def test_an_argument_of_the_wrong_type_is_a_type_error_not_a_crash():
-    compiled = kernels.load_ahead_of_time('multilift_sim._numba_kernel')
+    compiled = kernels.load_ahead_of_time(kernels.PHYSICS)
     assert compiled is not None
     simulator = FormationSimulator(scenario_io.load('twin_lift'))
     constants = kernels.model_constants(simulator.model)
@@ -149,7 +150,7 @@ def test_an_argument_of_the_wrong_type_is_a_type_error_not_a_crash():
                                             f'array, got .*{words}'):
             compiled.integrate_period(*constants, bad, wrenches, 0.001, 2)
     # the laws write their memory: a read-only one is refused
-    laws = kernels.load_ahead_of_time('multilift_control._numba_laws')
+    laws = kernels.load_ahead_of_time(COMPILED_LAWS)
     frozen = np.zeros(4)
     frozen.flags.writeable = False
     with pytest.raises(TypeError, match='argument 3 must be a C-contiguous writable 1-d '

@@ -42,6 +42,7 @@ _cache_home = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
 os.environ.setdefault('NUMBA_CACHE_DIR', str(Path(_cache_home) / 'multilift' / 'numba'))
 
 VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), aot, jit or python: see the docstring
+PHYSICS = 'multilift_sim._numba_kernel'  # this kernel's compiled module
 MODES = ('auto', 'aot', 'jit', 'python')
 AHEAD_OF_TIME_DIR = Path(_cache_home) / 'multilift' / 'aot'
 _BUILD_FORMAT = 2  # of the files build_ahead_of_time writes: part of their names
@@ -60,7 +61,7 @@ def mode() -> str:
 def enabled() -> bool:
     """Whether the compiled kernel is to be used (built or numba importable, not switched
     off)."""
-    return compiled_module('multilift_sim._numba_kernel') is not None
+    return compiled_module(PHYSICS) is not None
 
 
 def compiled_module(name: str) -> Any:
@@ -234,7 +235,7 @@ def model_constants(model) -> tuple:
 def integrator() -> Callable:
     """The compiled `integrate_period`, for one caller to keep (each keeps its own checked
     function: `_AheadOfTimeModule`); after `enabled()` said yes."""
-    return compiled_module('multilift_sim._numba_kernel').integrate_period
+    return compiled_module(PHYSICS).integrate_period
 
 
 def integrate(kernel: Callable, constants: tuple, x: np.ndarray, wrenches: np.ndarray,

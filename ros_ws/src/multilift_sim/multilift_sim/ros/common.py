@@ -249,16 +249,7 @@ class RawPublishers:
 
     def _confirm(self) -> None:
         within, self._confirm_within = self._confirm_within, 0.0
-        deadline = time.monotonic() + within
-        unconfirmed = []
-        for topic, pub in self._by_topic.items():
-            try:
-                acked = pub.wait_for_all_acked(
-                    Duration(seconds=max(0.0, deadline - time.monotonic())))
-            except Exception:  # noqa: BLE001 - a context shut down: the run is ending anyway
-                return
-            if not acked:
-                unconfirmed.append(topic)
+        unconfirmed = wait_for_acknowledgements(self._by_topic.values(), within)
         if unconfirmed:
             print(f'warning: {", ".join(unconfirmed)}: not acknowledged by every subscriber '
                   f'{within:g} s after the first message (a reader that has not discovered '
@@ -266,19 +257,27 @@ class RawPublishers:
                   file=sys.stderr, flush=True)
 
 
+def wait_for_acknowledgements(publishers: Iterable, timeout: float) -> list[str]:
+    """Wait up to `timeout` [s] in all until every subscriber of each publisher acknowledged
+    what it sent; the topics still unacknowledged (the publishers the deadline left no time
+    for included; none once the context is shut down: nothing to wait for then)."""
+    deadline = time.monotonic() + timeout
+    unacknowledged = []
+    for pub in list(publishers):
+        left = deadline - time.monotonic()
+        try:
+            if left <= 0 or not pub.wait_for_all_acked(Duration(seconds=left)):
+                unacknowledged.append(pub.topic_name)
+        except Exception:  # noqa: BLE001 - a context already shut down
+            return []
+    return unacknowledged
+
+
 def flush_publishers(node: Node, timeout: float = FLUSH_TIMEOUT) -> None:
     """Wait until every subscriber acknowledged this node's messages. A reliable writer that
     is destroyed first takes its unacknowledged history with it: a recorder lagging behind
     would lose the last messages of the run."""
-    deadline = time.monotonic() + timeout
-    for pub in list(node.publishers):
-        left = deadline - time.monotonic()
-        if left <= 0:
-            return
-        try:
-            pub.wait_for_all_acked(Duration(seconds=left))
-        except Exception:  # noqa: BLE001 - a context already shut down: nothing to wait for
-            return
+    wait_for_acknowledgements(node.publishers, timeout)
 
 
 def _interrupt(signum, frame) -> None:

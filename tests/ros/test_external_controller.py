@@ -1,13 +1,17 @@
 """`multilift run SCENARIO --external uav1` with the example leader of examples/ (built with
 colcon as a user would), through the `multilift_run` fixture of multilift_tools.testing (the
 pytest plugin a user's own tests get): the user's node, written with default QoS, flies the
-formation; the bag holds its commands; a missing node is named at the startup timeout.
+formation; the bag holds its commands; our own follower node counts as an external controller
+(it reads /formation/snapshot, not /uav2/odom); a missing node is named at the startup timeout,
+and so is a node that publishes the commands but reads no state. Across hosts:
+test_multi_host.py.
 """
 from __future__ import annotations
 
 import os
 import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -18,6 +22,7 @@ from nav_msgs.msg import Odometry
 from rclpy.serialization import deserialize_message
 
 ROOT = Path(__file__).resolve().parents[2]
+MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 EXAMPLE = ROOT / 'examples' / 'multilift_example_leader'
 
 
@@ -81,11 +86,63 @@ def test_the_example_leader_flies_single_lift_and_is_recorded(multilift_run, exa
     assert '/tf' in topics and '/uav1/attitude_setpoint' not in topics
 
 
+def test_our_follower_node_is_an_external_controller(multilift_run, tmp_path):
+    bag = tmp_path / 'bag'
+    run = multilift_run('twin_lift', external='uav2', duration=1.0, bag=bag)
+    with open(tmp_path / 'follower.log', 'w') as log:
+        follower = subprocess.Popen(
+            [MULTILIFT, 'node', 'multilift_control', 'follower_node', '--ros-args', '-p',
+             'scenario:=twin_lift', '-p', 'uav_index:=2'], stdout=log,
+            stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
+    try:
+        assert run.wait(timeout=180) == 0, run.output() + (tmp_path / 'follower.log').read_text()
+    finally:
+        os.killpg(follower.pid, signal.SIGINT)
+        follower.wait(timeout=30)
+    recorded = read_bag(bag)
+    assert len(recorded['/uav2/rotor_cmd']) == len(recorded['/formation/snapshot']) > 0
+    assert len(recorded['/uav2/formation_error']) == len(recorded['/uav2/rotor_cmd'])
+
+
 def test_the_startup_timeout_names_the_missing_external_controller(multilift_run):
     run = multilift_run('twin_lift', external='uav2', duration=1.0, startup_timeout=3.0)
     assert run.wait(timeout=120) == 1, run.output()
-    assert ('waiting for the external controller of uav2 to subscribe to /uav2/odom; the '
+    assert ('waiting for the external controller of uav2 to subscribe to a state topic '
+            '(/uav2/odom, /formation/snapshot, /uav1/odom, /payload/odom, /tf); the '
             'external controller of uav2 to publish /uav2/rotor_cmd') in run.output()
+
+
+# publishes uav2's commands, reads only /clock (not a state: every sim-time node reads it)
+NO_STATE_READER = """
+import rclpy
+from multilift_msgs.msg import RotorCommand
+from rosgraph_msgs.msg import Clock
+rclpy.init()
+node = rclpy.create_node('reads_no_state')
+node.create_publisher(RotorCommand, '/uav2/rotor_cmd', 10)
+node.create_subscription(Clock, '/clock', lambda msg: None, 10)
+print('up', flush=True)
+try:
+    rclpy.spin(node)
+except KeyboardInterrupt:
+    pass
+"""
+
+
+def test_a_commanding_node_that_reads_no_state_is_named(multilift_run):
+    node = subprocess.Popen([sys.executable, '-c', NO_STATE_READER], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, text=True,
+                            start_new_session=True)
+    try:
+        assert node.stdout.readline() == 'up\n'
+        run = multilift_run('twin_lift', external='uav2', duration=1.0, startup_timeout=5.0)
+        assert run.wait(timeout=120) == 1, run.output()
+    finally:
+        os.killpg(node.pid, signal.SIGINT)
+        node.wait(timeout=30)
+    assert ('waiting for the external controller of uav2 to subscribe to a state topic '
+            '(/uav2/odom,') in run.output()
+    assert 'to publish /uav2/rotor_cmd' not in run.output()
 
 
 def test_external_names_a_uav_of_the_scenario(multilift_run):

@@ -57,6 +57,15 @@ def uav_topic(index: int, leaf: str) -> str:
 REFERENCE_TOPIC = uav_topic(1, REFERENCE)
 
 
+def state_topics(n_uavs: int) -> list[str]:
+    """The topics carrying the simulator's state at t, any of which a controller may read to
+    answer it (every UAV's odometry, the snapshot our controllers read, the payload's odometry,
+    /tf): before t = 0 the simulator waits for an external controller to subscribe to one
+    (`SimNode.missing_peers`). Not /clock: every node with use_sim_time reads it."""
+    return ([FORMATION_SNAPSHOT] + [uav_topic(i, ODOM) for i in range(1, n_uavs + 1)]
+            + [PAYLOAD_ODOM, TF])
+
+
 def parse_uav_topic(topic: str) -> tuple[int, str] | None:
     """(index, leaf) of a per-UAV topic such as `/uav2/odom`, or None for any other name."""
     match = _UAV_TOPIC.match(topic)

@@ -218,8 +218,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     if external:
         names = ', '.join(f'uav{i}' for i in external)
         print(f'waiting for external controllers of {names} (ROS_DOMAIN_ID '
-              f'{os.environ.get("ROS_DOMAIN_ID", "0")}): each subscribes to /uavN/odom and '
-              'answers every state with a /uavN/rotor_cmd of the same stamp', flush=True)
+              f'{os.environ.get("ROS_DOMAIN_ID", "0")}): each reads a state topic '
+              '(/uavN/odom, /formation/snapshot, ...) and answers every state with a '
+              '/uavN/rotor_cmd of the same stamp', flush=True)
     outcome, dead = Supervisor(children).run(on_tick=progress)
     progress()
     progress.close()

@@ -9,8 +9,9 @@ for a `/uav{i}/rotor_cmd` stamped t from every UAV, publishes `/formation/state`
 to the next tick. No command within `command_timeout` wall seconds stops the run naming the
 silent UAV. Parameters: scenario (name or path), record (wait for a recorder), realtime (pace to
 the wall clock), duration (override t_max, s), summary_dir, progress_file, external (`uav1,uav3`:
-UAVs flown by the user's own controller nodes; before t = 0 the simulator waits for a node
-subscribing to their odometry and publishing their rotor commands),
+UAVs flown by controller nodes it does not start, the user's own or ours on another host;
+before t = 0 the simulator waits for a node publishing their rotor commands that subscribes to
+a state topic, `topics.state_topics`),
 startup_timeout (wall seconds to wait for the graph, s; 0: STARTUP_TIMEOUT).
 
 The rotor command subscriptions adapt to the publishers' QoS (`introspection.
@@ -25,19 +26,20 @@ import numpy as np
 from geometry_msgs.msg import Vector3Stamped
 from multilift_msgs.msg import FormationSnapshot, FormationState, RotorCommand
 from nav_msgs.msg import Odometry
-from rclpy.node import Node
+from rclpy.node import Node, NodeNameNonExistentError
 from rclpy.qos import DurabilityPolicy
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, RECORDER_NODE,
-                                      STARTUP_TIMEOUT, Fatal, RawPublishers, ns_from_stamp,
+from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_TIMEOUT,
+                                      Fatal, RawPublishers, ns_from_stamp,
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import MARKER_DECIMATION, parse_external, uav_topic
+from multilift_sim.topics import (MARKER_DECIMATION, ODOM, parse_external, state_topics,
+                                   uav_topic)
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
 from multilift_sim.tick_messages import SimulatorMessages
@@ -118,12 +120,12 @@ class SimNode(Node):
                 if sub.subscription.get_publisher_count() < 1:
                     missing.append(f'a controller publishing {topic}')
                 continue
-            # a user's node: it must hear the state at t = 0 (a volatile reader gets only what
-            # is published after it matched) and answer on the command topic
-            odom = uav_topic(i + 1, 'odom')
-            if not any(info.node_name != RECORDER_NODE
-                       for info in self.get_subscriptions_info_by_topic(odom)):
-                missing.append(f'the external controller of uav{i + 1} to subscribe to {odom}')
+            # a node we did not start (a user's, or our leader or follower on another host):
+            # it must hear the state at t = 0 (a volatile reader gets only what is published
+            # after it matched), whichever state topic it reads, and answer on the command topic
+            if not self._reads_state(topic):
+                missing.append(f'the external controller of uav{i + 1} to subscribe to a state '
+                               f'topic ({self._state_topics_text(i + 1)})')
             if sub.subscription.get_publisher_count() < 1:
                 missing.append(f'the external controller of uav{i + 1} to publish {topic}')
             elif self.record and not recorder_hears(self, topic):
@@ -146,6 +148,29 @@ class SimNode(Node):
                                            self.tf_pub,
                                            *self.odom_pubs])
         return None
+
+    def _reads_state(self, command_topic: str) -> bool:
+        """Whether a node publishing `command_topic` subscribes to one of the simulator's state
+        topics. The graph lists a node's subscriptions once our participant discovered them,
+        which is when our writers match them."""
+        wanted = set(state_topics(self.sim.n))
+        for info in self.get_publishers_info_by_topic(command_topic):
+            if not info.node_namespace.startswith('/'):
+                continue  # the writer is known, its node not yet (_NODE_NAMESPACE_UNKNOWN_)
+            try:
+                read = self.get_subscriber_names_and_types_by_node(info.node_name,
+                                                                   info.node_namespace)
+            except NodeNameNonExistentError:  # its node's announcement has not arrived yet
+                continue
+            if any(name in wanted for name, _ in read):
+                return True
+        return False
+
+    def _state_topics_text(self, index: int) -> str:
+        """The state topics in words for UAV `index`: its own odometry first."""
+        own = uav_topic(index, ODOM)
+        others = [t for t in state_topics(self.sim.n) if t != own]
+        return ', '.join([own] + others)
 
     def publish_state(self) -> Snapshot:
         """The state at this tick, the controllers' snapshot first (they answer while the rest

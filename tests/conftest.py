@@ -1,14 +1,17 @@
 """Shared test fixtures: the repository paths, an isolated ROS environment, the two layers.
 
 Tests live in two layers, each a folder and a marker (set here from the folder):
-- `tests/unit/` (marker `unit`): no ROS graph and no node processes; physics, scenarios, message
-  definitions, the bag format, plots of synthetic bags, the import architecture, lint. Fast.
-- `tests/ros/` (marker `ros`): anything that starts nodes or talks to a ROS graph: runs of
-  `scripts/multilift run`, the topic and bag tools against live publishers, the Foxglove bridge.
+- `tests/unit/` (marker `unit`): no ROS graph and no processes (tests/unit/conftest.py refuses
+  them); physics, scenarios, message definitions, the bag format, plots of synthetic bags, the
+  import architecture. Fast: under a minute.
+- `tests/ros/` (marker `ros`), the process layer: anything that starts a process or talks to a
+  ROS graph: runs of `scripts/multilift run`, the topic and bag tools against live publishers,
+  the Foxglove bridge, the launcher, start-up in a new process, the command line, lint.
 `scripts/test` runs both; `scripts/test --unit` (or `scripts/test tests/unit`) the fast layer.
 """
 from __future__ import annotations
 
+import _posixsubprocess
 import itertools
 import os
 import re
@@ -23,8 +26,8 @@ import pytest
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
 SCENARIOS = ROOT / 'scenarios'
-LAYERS = {'unit': 'no ROS graph, no node processes (tests/unit/)',
-          'ros': 'starts nodes or talks to a ROS graph (tests/ros/)'}
+LAYERS = {'unit': 'no ROS graph, no processes (tests/unit/)',
+          'ros': 'starts processes or talks to a ROS graph (tests/ros/)'}
 T = TypeVar('T')
 _domains = itertools.count(int(os.environ.get('ROS_DOMAIN_ID', '77')) % 50 + 20)
 
@@ -32,6 +35,37 @@ _domains = itertools.count(int(os.environ.get('ROS_DOMAIN_ID', '77')) % 50 + 20)
 def pytest_configure(config) -> None:
     for name, what in LAYERS.items():
         config.addinivalue_line('markers', f'{name}: {what}')
+
+
+def _refuse_process(*args, **kwargs):
+    raise AssertionError('tests/unit starts no processes: a test that needs one belongs in '
+                         'tests/ros (the process layer)')
+
+
+@pytest.fixture(scope='module', autouse=True)
+def unit_layer_starts_no_process(request):
+    """In tests/unit, starting a process (subprocess, fork, spawn, multiprocessing) fails the
+    test. Module-wide, so a module's own fixtures are covered too (autouse fixtures of a scope
+    come first)."""
+    if Path(str(request.path)).resolve().relative_to(TESTS).parts[0] != 'unit':
+        yield
+        return
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(subprocess.Popen, '_execute_child', _refuse_process)
+        patch.setattr(_posixsubprocess, 'fork_exec', _refuse_process)  # multiprocessing's spawn
+        for name in ('fork', 'forkpty', 'posix_spawn', 'posix_spawnp', 'system', 'execv',
+                     'execve'):
+            if hasattr(os, name):
+                patch.setattr(os, name, _refuse_process)
+        yield
+
+
+def pytest_sessionstart(session) -> None:
+    """Fast DDS's shared-memory files of processes killed earlier (this suite's SIGKILL tests
+    of a previous run included) are removed before any test starts a node, as `multilift run`
+    does (multilift_sim.ros.shared_memory)."""
+    from multilift_sim.ros.shared_memory import remove_stale_files
+    remove_stale_files()
 
 
 def pytest_collection_modifyitems(config, items) -> None:
@@ -57,10 +91,15 @@ def twin():
     return scenario, simulator.snapshot()
 
 
+def next_domain() -> int:
+    """A ROS domain no earlier test of this session used (1..100, round robin)."""
+    return next(_domains) % 100 + 1
+
+
 @pytest.fixture
 def ros_env(monkeypatch) -> dict:
     """An environment on a ROS domain of its own, discovery limited to this machine."""
-    domain = str(next(_domains) % 100 + 1)
+    domain = str(next_domain())
     monkeypatch.setenv('ROS_DOMAIN_ID', domain)
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     return dict(os.environ)

@@ -35,7 +35,10 @@ def test_same_topics_types_and_counts(twin_bags):
         with AnyReader([bag]) as reader:
             counts.append({c.topic: (c.msgtype, c.msgcount) for c in reader.connections})
     assert counts[0] == counts[1]
-    assert counts[0]['/uav2/formation_error'] == ('multilift_msgs/msg/VirtualConstraintError', 601)
+    # the controllers answer the 600 states before t_max, not the state at t_max (601 ticks)
+    assert counts[0]['/uav2/formation_error'] == ('multilift_msgs/msg/VirtualConstraintError', 600)
+    assert counts[0]['/uav2/odom'] == ('nav_msgs/msg/Odometry', 601)
+    assert counts[0]['/formation/snapshot'][1] == 600
 
 
 def test_same_trajectories_to_rounding(twin_bags):
@@ -60,7 +63,7 @@ def test_same_run_statistics(twin_bags):
         assert ros[part].keys() == headless[part].keys()
         for key, value in ros[part].items():
             assert headless[part][key] == pytest.approx(value, rel=1e-6, abs=1e-9), key
-    assert headless['leader']['answered_states'] == 601
+    assert headless['leader']['answered_states'] == 600  # the states before t_max
     for key in ('max_abs_constraint', 'min_tension', 'max_tension', 'max_payload_swing',
                 'rms_payload_swing', 'simulated_time', 'max_rotor_speed', 'saturated_time'):
         assert headless['sim'][key] == pytest.approx(ros['sim'][key], rel=1e-6, abs=1e-9), key

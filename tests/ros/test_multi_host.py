@@ -1,8 +1,8 @@
 """Controllers on another host (docs/deployment.md): the simulator and the recorder in one
 network namespace, our controller nodes in another, a veth pair between them (10.77.0.1/24 and
 10.77.0.2/24), so discovery and data have to cross that link: no loopback reaches the other
-side. The controller side runs Fast DDS with the UDPv4-only profile of docs/deployment.md, so
-no message can take the shared memory (/dev/shm) both namespaces see, and the veth's byte
+side. Every side runs Fast DDS with our profile (UDP only: multilift_sim.ros.fastdds), so no
+message can take the shared memory (/dev/shm) both namespaces see, and the veth's byte
 counters show the data crossed. Lockstep makes the link irrelevant to the result: the bag equals
 the one-host run's, topic by topic, message for message. Discovery is Fast DDS's multicast
 (ROS_AUTOMATIC_DISCOVERY_RANGE SUBNET, SPDP multicast routed onto the veth): our follower alone
@@ -24,7 +24,7 @@ import pytest
 from mcap.reader import make_reader
 
 from conftest import ROOT
-from multilift_sim.ros.common import FASTDDS_HEARTBEAT_PROFILE
+from multilift_sim.ros.fastdds import FASTDDS_PROFILE
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 DEPLOYMENT = ROOT / 'docs' / 'deployment.md'
@@ -104,16 +104,9 @@ def link():
             _ip('netns', 'delete', space)
 
 
-def udp_only_profile(directory: Path) -> Path:
-    """The UDPv4-only Fast DDS profile of docs/deployment.md, written to a file."""
+def test_the_profile_in_the_deployment_guide_is_ours():
     [xml] = re.findall(r'```xml\n(.*?)```', DEPLOYMENT.read_text(), re.S)
-    # the profile keeps our nodes' writer heartbeat (multilift_sim.ros.common)
-    [heartbeat] = re.findall(r'<publisher.*?</publisher>', FASTDDS_HEARTBEAT_PROFILE, re.S)
-    assert ' '.join(heartbeat.split()) in ' '.join(xml.split())
-    assert '<useBuiltinTransports>false</useBuiltinTransports>' in xml
-    path = directory / 'fastdds_udp_only.xml'
-    path.write_text(xml)
-    return path
+    assert ' '.join(xml.split()) == ' '.join(FASTDDS_PROFILE.split())
 
 
 def read_bag(bag: Path) -> dict[str, list[bytes]]:
@@ -152,13 +145,13 @@ def _stop(process: subprocess.Popen) -> int:
 def fly_across(link: Link, tmp_path: Path, external: str, controllers: dict[str, list[str]]
                ) -> tuple[dict[str, list[bytes]], int, int]:
     """`multilift run SCENARIO --external EXTERNAL --bag` in the simulator's namespace and each
-    of `controllers` (log name -> `multilift node` arguments) in the other, with the UDPv4-only
-    profile there; discovery range SUBNET on both sides. Returns the bag's messages and the
+    of `controllers` (log name -> `multilift node` arguments) in the other, our profile (UDP
+    only) on both sides; discovery range SUBNET. Returns the bag's messages and the
     bytes the controllers' end of the veth received and sent meanwhile."""
     sim_env = {k: v for k, v in os.environ.items() if k not in PROFILE_VARIABLES}
     sim_env.update(ROS_DOMAIN_ID=DOMAIN, ROS_AUTOMATIC_DISCOVERY_RANGE='SUBNET',
                    PYTHONUNBUFFERED='1')
-    controller_env = dict(sim_env, FASTRTPS_DEFAULT_PROFILES_FILE=str(udp_only_profile(tmp_path)))
+    controller_env = sim_env  # our processes use our profile (UDP only) on their own
     bag = tmp_path / 'bag'
     logs = {name: tmp_path / f'{name}.log' for name in ['run', *controllers]}
     commands = {'run': ['ip', 'netns', 'exec', link.sim, MULTILIFT, 'run', SCENARIO,

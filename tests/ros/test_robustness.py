@@ -70,7 +70,9 @@ non_finite = st.sampled_from([math.nan, math.inf, -math.inf])
 
 # single-field rules of scenarios/single_lift.yaml: key -> (valid values, invalid values)
 NUMBER_RULES = {
-    'simulation.duration': (positive, st.floats(max_value=0.0)),
+    # at least one control period (0.01 s in single_lift.yaml)
+    'simulation.duration': (st.floats(min_value=0.01, max_value=1e6),
+                            st.floats(max_value=0.004)),
     'simulation.gravity': (st.floats(min_value=0.1, max_value=9.81), st.floats(max_value=0.0)),
     'simulation.baumgarte_alpha': (non_negative, st.floats(max_value=-1e-9)),
     'simulation.baumgarte_beta': (non_negative, st.floats(max_value=-1e-9)),
@@ -288,7 +290,8 @@ def test_formation_values_load_or_name_the_formation(n, geometry, distance, cabl
 # --------------------------------------------------------------------------- determinism
 def _trajectory(scenario) -> np.ndarray:
     states = []
-    run_headless(scenario, on_tick=lambda sim, snap, answers: states.append(
+    # the ticks before t_max, each with the commands that answer it (none answers the last)
+    run_headless(scenario, on_tick=lambda sim, snap, answers: answers and states.append(
         np.concatenate([sim.state, *[a.output.rotor_speeds for a in answers]])))
     return np.array(states)
 
@@ -298,7 +301,7 @@ def test_headless_runs_are_identical(name):
     text = (SCENARIOS / f'{name}.yaml').read_text()
     first = _trajectory(_short(scenario_io.loads(text), 4.0))
     second = _trajectory(_short(scenario_io.loads(text), 4.0))
-    assert first.shape[0] == 401
+    assert first.shape[0] == 400
     assert np.array_equal(first, second)  # bit for bit, rotor commands included
 
 
@@ -332,7 +335,8 @@ def test_ros_runs_give_byte_identical_state_messages(tmp_path):
         assert out.returncode == 0, out.stderr
         bags.append(_raw_messages(bag))
     for topic in STATE_TOPICS:
-        assert len(bags[0][topic]) == 301, topic
+        # the states at the 301 ticks of [0, 3] s; commands for the 300 before t = 3 s
+        assert len(bags[0][topic]) == (300 if topic.endswith('rotor_cmd') else 301), topic
         assert bags[0][topic] == bags[1][topic], topic  # CDR payloads, byte for byte
 
 
@@ -352,7 +356,8 @@ def test_two_runs_on_different_domains_do_not_see_each_other(tmp_path):
         topics = ['/clock', '/payload/odom', '/formation/state'] + \
             [f'/uav{i}/{leaf}' for i in range(1, n + 1) for leaf in ('odom', 'rotor_cmd')]
         for topic in topics:
-            assert len(data[topic]) == 301, (bag.name, topic, len(data[topic]))
+            expected = 300 if topic.endswith('rotor_cmd') else 301  # no command answers t_max
+            assert len(data[topic]) == expected, (bag.name, topic, len(data[topic]))
         # a twin-lift's second UAV must not appear in the single-lift's bag
         assert ('/uav2/odom' in data) == (n == 2)
 
@@ -452,6 +457,8 @@ def test_saturating_payload_runs_and_stays_within_rotor_limits():
     low, high = [math.inf], [-math.inf]
 
     def watch(sim, snap, answers):
+        if not answers:  # the state at t_max: nothing answers it
+            return
         low[0] = min(low[0], float(answers[0].output.rotor_speeds.min()))
         high[0] = max(high[0], float(answers[0].output.rotor_speeds.max()))
     sim = run_headless(_short(scenario, 30.0), on_tick=watch).simulator
@@ -533,28 +540,93 @@ def test_a_teardown_that_ends_leaves_no_warning():
     assert out.returncode == 0 and 'warning' not in out.stderr and not out.stderr, out.stderr
 
 
-# -- our nodes' Fast DDS profile (run_node's use_fastdds_profile) -------------------------------
-def test_the_fastdds_profile_is_written_and_parsed_and_a_users_own_wins(tmp_path, monkeypatch):
-    from multilift_sim.ros.common import FASTDDS_HEARTBEAT_PROFILE, use_fastdds_profile
+# -- our processes' Fast DDS profile (multilift_sim.ros.fastdds) ----------------------------------
+SHM_PROBE = ('import os, rclpy; from std_msgs.msg import String\n'
+             'def shm(): return {f for f in os.listdir("/dev/shm") if "fastrtps" in f}\n'
+             'before = shm()\n'
+             'rclpy.init(); node = rclpy.create_node("profile_probe")\n'
+             'pub = node.create_publisher(String, "/profile_probe", 10)\n'
+             'pub.publish(String(data="x")); opened = shm() - before\n'
+             'node.destroy_node(); rclpy.shutdown()\n'
+             'print("ok", sorted(opened))\n')
+
+
+@pytest.mark.parametrize('discovery,file', [('SUBNET', 'fastdds_profiles.xml'),
+                                            ('LOCALHOST', 'fastdds_profiles_localhost.xml')])
+def test_the_fastdds_profile_is_written_and_parsed_and_a_users_own_wins(tmp_path, monkeypatch,
+                                                                        discovery, file):
+    from multilift_sim.ros.fastdds import (FASTDDS_LOCALHOST_PROFILE, FASTDDS_PROFILE,
+                                           use_fastdds_profile)
     for name in ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE'):
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', discovery)
+    monkeypatch.setenv('ROS_DOMAIN_ID', '16')
+    default_env = dict(os.environ)
     path = use_fastdds_profile()
-    assert path == tmp_path / 'cache' / 'multilift' / 'fastdds_profiles.xml'
-    assert path.read_text() == FASTDDS_HEARTBEAT_PROFILE
+    assert path == tmp_path / 'cache' / 'multilift' / file
+    assert path.read_text() == (FASTDDS_PROFILE if discovery == 'SUBNET'
+                                else FASTDDS_LOCALHOST_PROFILE)
     assert os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] == str(path)
-    # Fast DDS reads it without complaint: a node with a publisher, under the profile
-    probe = ('import rclpy; from std_msgs.msg import String\n'
-             'rclpy.init(); node = rclpy.create_node("profile_probe")\n'
-             'pub = node.create_publisher(String, "/profile_probe", 10)\n'
-             'pub.publish(String(data="x")); node.destroy_node(); rclpy.shutdown()\n'
-             'print("ok")\n')
-    out = subprocess.run(['python', '-c', probe], capture_output=True, text=True, timeout=60,
-                         env=dict(os.environ))
-    assert out.returncode == 0 and out.stdout.strip() == 'ok', out.stderr
+    # LOCALHOST is kept by the profile itself (rmw's LOCALHOST would add shared memory)
+    assert os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'SUBNET'
+    # Fast DDS reads it without complaint: a node with a publisher, under the profile, and
+    # on UDP alone: its participant opens nothing in /dev/shm
+    out = subprocess.run(['python', '-c', SHM_PROBE], capture_output=True, text=True,
+                         timeout=60, env=dict(os.environ))
+    assert out.returncode == 0 and out.stdout.strip() == 'ok []', (out.stdout, out.stderr)
     assert 'error' not in out.stderr.lower(), out.stderr
-    # a profile the user names is left alone
+    # without it, Fast DDS's defaults open shared memory (what the lines above rule out)
+    out = subprocess.run(['python', '-c', SHM_PROBE], capture_output=True, text=True,
+                         timeout=60, env=default_env)
+    assert out.returncode == 0 and 'fastrtps_port' in out.stdout, (out.stdout, out.stderr)
+    # a profile the user names is left alone, and so is the discovery range
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', discovery)
     monkeypatch.setenv('FASTDDS_DEFAULT_PROFILES_FILE', str(tmp_path / 'theirs.xml'))
     monkeypatch.delenv('FASTRTPS_DEFAULT_PROFILES_FILE')
     assert use_fastdds_profile() is None
     assert 'FASTRTPS_DEFAULT_PROFILES_FILE' not in os.environ
+    assert os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] == discovery
+
+
+def test_our_localhost_participants_and_anyone_elses_hear_each_other(monkeypatch, tmp_path):
+    """A node of a user's under rmw's own LOCALHOST (shared memory and UDP) and one under our
+    LOCALHOST profile (UDP on 127.0.0.1) exchange messages both ways."""
+    from multilift_sim.ros.fastdds import use_fastdds_profile
+    for name in ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE'):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    monkeypatch.setenv('ROS_DOMAIN_ID', '17')
+    theirs = dict(os.environ)
+    use_fastdds_profile()
+    ours = dict(os.environ)
+    for publisher, subscriber in ((ours, theirs), (theirs, ours)):
+        listener = subprocess.Popen(['python', '-c', ECHO_ONE], env=subscriber, text=True,
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        talker = subprocess.Popen(['python', '-c', TALK_UNTIL_HEARD], env=publisher, text=True,
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        out, err = listener.communicate(timeout=60)
+        talker.communicate(timeout=60)
+        assert listener.returncode == 0 and out.strip() == 'heard hello', err
+
+
+# a subscriber that prints the first message it hears; a publisher that publishes until a
+# subscriber matched and then acknowledged a message (reliable, transient_local history)
+ECHO_ONE = ('import rclpy; from std_msgs.msg import String\n'
+            'from rclpy.qos import QoSProfile, DurabilityPolicy\n'
+            'rclpy.init(); node = rclpy.create_node("echo_one"); heard = []\n'
+            'qos = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)\n'
+            'node.create_subscription(String, "/interop", lambda m: heard.append(m.data), qos)\n'
+            'while not heard: rclpy.spin_once(node, timeout_sec=0.1)\n'
+            'print("heard", heard[0])\n')
+TALK_UNTIL_HEARD = ('import rclpy; from std_msgs.msg import String\n'
+                    'from rclpy.duration import Duration\n'
+                    'from rclpy.qos import QoSProfile, DurabilityPolicy\n'
+                    'rclpy.init(); node = rclpy.create_node("talker")\n'
+                    'qos = QoSProfile(depth=10, durability=DurabilityPolicy.TRANSIENT_LOCAL)\n'
+                    'pub = node.create_publisher(String, "/interop", qos)\n'
+                    'while pub.get_subscription_count() < 1: rclpy.spin_once(node, '
+                    'timeout_sec=0.1)\n'
+                    'pub.publish(String(data="hello"))\n'
+                    'pub.wait_for_all_acked(Duration(seconds=30))\n')

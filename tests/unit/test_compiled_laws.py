@@ -6,9 +6,6 @@ headless run flies the same trajectory."""
 from __future__ import annotations
 
 import dataclasses
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -126,29 +123,3 @@ def test_headless_run_compiled_equals_pure(monkeypatch):
     for key in ('leader', 'follower2'):
         for figure, value in a[key].items():
             assert value == pytest.approx(b[key][figure], rel=1e-9, abs=1e-12), (key, figure)
-
-
-@pytest.mark.parametrize('setting,expected', [(None, 'aot False ahead-of-time'),
-                                              ('jit', 'jit True just-in-time'),
-                                              ('python', 'python False pure')])
-def test_controller_nodes_run_the_laws_built_ahead_of_time_unless_told(setting, expected):
-    """A controller node (`prepare_node_laws`) runs the laws scripts/setup compiled ahead of
-    time, numba unimported, unless MULTILIFT_KERNEL says otherwise: with jit it loads the laws
-    compiled just in time before it answers, with python the pure methods."""
-    code = ('import os, sys\n'
-            'from multilift_control.runtime import ControllerRuntime, prepare_node_laws\n'
-            'from multilift_sim import kernels, scenario\n'
-            's = scenario.load("twin_lift")\n'
-            'prepare_node_laws(s, 1)\n'
-            'law = ControllerRuntime(s, 1).follower._compiled_update\n'
-            'kind = ("pure" if law is None else "ahead-of-time"\n'
-            '        if isinstance(law, kernels._Checked) else\n'
-            '        "just-in-time" if len(law.signatures) > 0 else "not loaded")\n'
-            'print(os.environ["MULTILIFT_KERNEL"], "numba" in sys.modules, kind)\n')
-    env = {k: v for k, v in os.environ.items() if k != 'MULTILIFT_KERNEL'}
-    if setting is not None:
-        env['MULTILIFT_KERNEL'] = setting
-    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
-                         timeout=300, env=env)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.split() == expected.split()

@@ -2,12 +2,11 @@
 from __future__ import annotations
 
 import math
-import subprocess
 
 import pytest
 import yaml
 
-from conftest import ROOT, SCENARIOS
+from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
 
 
@@ -123,19 +122,14 @@ def test_bad_values_name_key_and_rule(edit, message):
     assert str(err.value).startswith('x.yaml: ')
 
 
-def test_cli_bad_scenario_is_one_line_exit_2(tmp_path):
-    bad = tmp_path / 'bad.yaml'
-    bad.write_text(_edited('single_lift', lambda d: d['vehicle'].update(mass=-1.0)))
-    out = subprocess.run([str(ROOT / 'scripts' / 'multilift'), 'run', str(bad)],
-                         capture_output=True, text=True, timeout=60)
-    assert out.returncode == 2
-    assert out.stderr.strip().splitlines() == [
-        f'error: {bad}: vehicle.mass: -1.0 must be > 0']
-    assert 'Traceback' not in out.stderr
-
-
-def test_cli_unknown_scenario_lists_known():
-    out = subprocess.run([str(ROOT / 'scripts' / 'multilift'), 'run', 'no_such_thing'],
-                         capture_output=True, text=True, timeout=60)
-    assert out.returncode == 2
-    assert 'unknown scenario' in out.stderr and 'single_lift' in out.stderr
+def test_a_run_flies_at_least_one_control_period():
+    with pytest.raises(scenario_io.ScenarioError, match=r'x.yaml: simulation.duration: 0.004 '
+                       r'must be at least one control period \(1/control_rate = 0.01 s\)'):
+        scenario_io.loads(_edited('single_lift', lambda d: d['simulation'].update(
+            duration=0.004)), 'x.yaml')
+    scenario = scenario_io.load('single_lift')
+    assert scenario.with_duration(0.006).simulation.tick_count == 1
+    assert scenario.with_duration(3).simulation.duration == 3.0
+    for short in (0.004, 0.0, -1.0, math.nan, math.inf):
+        with pytest.raises(scenario_io.ScenarioError, match='at least one control period'):
+            scenario.with_duration(short)

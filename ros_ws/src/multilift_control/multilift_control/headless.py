@@ -18,7 +18,7 @@ from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answ
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot
 
-# on_tick(simulator, snapshot at t, every controller's answer to it)
+# on_tick(simulator, snapshot at t, every controller's answer to it: none at the last tick)
 TickObserver = Callable[[FormationSimulator, Snapshot, list[ControllerAnswer]], None]
 
 
@@ -51,7 +51,9 @@ def run_headless(scenario: Scenario, on_tick: TickObserver | None = None,
     try:
         while True:
             snapshot = sim.snapshot()
-            answers = answer_tick(runtimes, sim.t_ns, uav_states(snapshot))
+            # as through ROS, the controllers answer the states before t_max only
+            answers = [] if sim.finished else answer_tick(runtimes, sim.t_ns,
+                                                          uav_states(snapshot))
             if on_tick is not None:
                 on_tick(sim, snapshot, answers)
             if sim.finished:

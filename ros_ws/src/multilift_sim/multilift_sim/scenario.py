@@ -148,6 +148,15 @@ class Scenario:
             baumgarte_beta=sim.baumgarte_beta if baumgarte_beta is None else baumgarte_beta,
         )
 
+    def with_duration(self, duration: float) -> 'Scenario':
+        """The same scenario flown for `duration` [s] (a `--duration` override); ScenarioError
+        unless it is at least one control period."""
+        if not _flies_a_period(duration, self.simulation.control_rate):
+            raise ScenarioError(f'duration: {duration!r} '
+                                f'{_one_period_rule(self.simulation.control_rate)}')
+        return dataclasses.replace(
+            self, simulation=dataclasses.replace(self.simulation, duration=float(duration)))
+
     def total_weight(self) -> float:
         """Weight of every UAV and the payload [N]."""
         mass = sum(u.vehicle.mass for u in self.uavs) + self.payload.mass
@@ -308,6 +317,8 @@ def _scenario(data: Any, where: str) -> Scenario:
     physics_rate = s.positive('physics_rate')
     control_rate = s.number('control_rate', ..., lambda v: 0 < v <= physics_rate,
                             f'must be > 0 and <= physics_rate ({physics_rate})')
+    if not _flies_a_period(duration, control_rate):
+        raise s.fail('duration', duration, _one_period_rule(control_rate))
     ratio = physics_rate / control_rate
     if abs(ratio - round(ratio)) > 1e-9:
         raise s.fail('control_rate', control_rate,
@@ -448,6 +459,16 @@ def _scenario(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario
+
+
+def _flies_a_period(duration: float, control_rate: float) -> bool:
+    """A run integrates whole control periods and asks for commands before t_max only: it
+    needs at least one period, or there is nothing to integrate."""
+    return math.isfinite(duration) and round(duration * control_rate) >= 1
+
+
+def _one_period_rule(control_rate: float) -> str:
+    return f'must be at least one control period (1/control_rate = {1.0 / control_rate:g} s)'
 
 
 def _formation(f: _Section, n: int) -> FormationConfig:

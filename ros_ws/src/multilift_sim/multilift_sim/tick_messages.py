@@ -42,15 +42,17 @@ class SimulatorMessages:
         self._markers = cdr.MarkerArray(self._scene.specs)
 
     def state(self, snap: Snapshot, gust: Sequence[float],
-              applied: Sequence[np.ndarray] | None) -> list[Message]:
+              applied: Sequence[np.ndarray] | None, last: bool = False) -> list[Message]:
         """The state at the tick of `snap`, in the order the node sends it: /clock, then
         /formation/snapshot (what the controllers wait for; `applied`: the rotor speeds held
-        up to this tick, None at t = 0), then for users, tools and bags every /uav{i}/odom,
-        /payload/odom, /payload/gust (`gust`: the air velocity at the payload [m/s]) and /tf."""
+        up to this tick, None at t = 0; none at the run's `last` tick, which no controller
+        answers), then for users, tools and bags every /uav{i}/odom, /payload/odom,
+        /payload/gust (`gust`: the air velocity at the payload [m/s]) and /tf."""
         t_ns = snap.t_ns
-        out = [(CLOCK, self._clock.pack(t_ns)),
-               (FORMATION_SNAPSHOT, self._snapshot.pack(t_ns,
-                                                        *formation_snapshot(snap, applied)))]
+        out = [(CLOCK, self._clock.pack(t_ns))]
+        if not last:
+            out.append((FORMATION_SNAPSHOT,
+                        self._snapshot.pack(t_ns, *formation_snapshot(snap, applied))))
         for uav, (topic, packer) in zip(snap.uavs, self._odometry):
             out.append((topic, packer.pack(t_ns, *odometry(uav.position, uav.velocity,
                                                            uav.euler, uav.rotation,

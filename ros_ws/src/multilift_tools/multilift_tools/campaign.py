@@ -27,7 +27,7 @@ import re
 import shutil
 import time
 import traceback
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -391,8 +391,7 @@ def run_one(source: str, base: dict, edits: list, duration: float | None = None,
         scenario = scenario_io.loads(yaml.safe_dump(data, sort_keys=False),
                                      _label(source, edits))
         if duration is not None:
-            scenario = replace(scenario, simulation=replace(scenario.simulation,
-                                                            duration=duration))
+            scenario = scenario.with_duration(duration)
         bag_path = None
         if bag is not None:
             bag_path = Path(bag)

@@ -42,10 +42,13 @@ class HeadlessBag:
 
     def tick(self, sim: FormationSimulator, snap: Snapshot,
              answers: list[ControllerAnswer]) -> None:
-        """Write the state at tick t and every controller's answer to it."""
+        """Write the state at tick t and every controller's answer to it (none at the last
+        tick, whose cables are those of the commands held since the tick before)."""
         self.finish_pending(sim)
-        messages = self._simulator.state(snap, sim.payload_gust, self._applied)
-        self._applied = [a.output.rotor_speeds for a in answers]
+        messages = self._simulator.state(snap, sim.payload_gust, self._applied,
+                                         last=sim.finished)
+        if answers:
+            self._applied = [a.output.rotor_speeds for a in answers]
         for answer in answers:
             messages += self._answers.of(answer)
         self._write(messages, snap.t_ns)

@@ -86,9 +86,12 @@ def swing_history(scenario: Scenario) -> SwingHistory:
     from multilift_control.headless import run_headless
 
     rows: list[tuple[float, np.ndarray, np.ndarray, float]] = []
+    held: list[np.ndarray] = []  # the commands held since the tick before (the last tick's)
 
     def tick(sim: Any, snap: Any, answers: list) -> None:
-        tension = sim.cable_state([a.output.rotor_speeds for a in answers])[0]
+        if answers:
+            held[:] = [a.output.rotor_speeds for a in answers]
+        tension = sim.cable_state(held)[0]
         rows.append((sim.t, snap.uavs[0].position, snap.payload_position, float(tension[0])))
 
     run_headless(scenario, tick)

@@ -29,6 +29,7 @@ from multilift_sim.kinematics import (euler_from_quaternion, quaternion_from_eul
                                       rotation_matrix)
 
 from multilift_sim import msgvalues
+from multilift_sim.ros.fastdds import use_fastdds_profile
 from multilift_sim.msgvalues import WORLD_FRAME, uav_frame  # noqa: F401
 
 # Publishers keep their last messages for late joiners and our subscribers ask for them: a
@@ -183,41 +184,6 @@ def spin(node: Node) -> None:
 # stopped (a peer died, Ctrl-C) a dead reader never acknowledges, so the wait is kept short.
 FLUSH_TIMEOUT = 5.0
 FLUSH_TIMEOUT_STOPPING = 1.5
-
-
-# Fast DDS (rmw_fastrtps, the default RMW) has a reliable writer announce what it sent once a
-# heartbeat period, 3 s by default, and readers acknowledge only then: a node's final flush
-# (`wait_for_all_acked`) waited for that (2.3 s at the end of a twin-lift run here; 0.02 s
-# with this profile). Our nodes use it unless the user names a profile file of their own.
-FASTDDS_HEARTBEAT_PROFILE = """<?xml version="1.0" encoding="UTF-8" ?>
-<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
-  <publisher profile_name="multilift_writer" is_default_profile="true">
-    <times>
-      <heartbeatPeriod><sec>0</sec><nanosec>100000000</nanosec></heartbeatPeriod>
-    </times>
-  </publisher>
-</profiles>
-"""
-_PROFILE_VARIABLES = ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE')
-
-
-def use_fastdds_profile() -> Path | None:
-    """Point Fast DDS at FASTDDS_HEARTBEAT_PROFILE (written under the user's cache) before
-    rclpy starts, unless a profile file is named already; the file, or None."""
-    if any(os.environ.get(name) for name in _PROFILE_VARIABLES):
-        return None
-    cache = Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache') / 'multilift'
-    path = cache / 'fastdds_profiles.xml'
-    try:
-        if not path.is_file() or path.read_text() != FASTDDS_HEARTBEAT_PROFILE:
-            cache.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_name(f'{path.name}.{os.getpid()}.tmp')
-            tmp.write_text(FASTDDS_HEARTBEAT_PROFILE)
-            tmp.replace(path)
-    except OSError:  # no writable cache: Fast DDS's defaults, a slower exit
-        return None
-    os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(path)
-    return path
 
 
 # Discovery runs on each side of a writer-reader pair on its own: a reliable writer that has

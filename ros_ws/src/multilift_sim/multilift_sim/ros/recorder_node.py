@@ -62,6 +62,7 @@ from rosgraph_msgs.msg import Clock
 
 from multilift_sim import recording
 from multilift_sim.ros import introspection
+from multilift_sim.ros.fastdds import use_fastdds_profile
 from multilift_sim.bag import BagError, BagWriter
 from multilift_sim.bagyaml import qos_yaml
 
@@ -274,6 +275,7 @@ class RecorderNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Run the recorder until SIGINT/SIGTERM; 0 on a clean close, 2 on bad parameters."""
+    use_fastdds_profile()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     stop, abort = threading.Event(), threading.Event()
 

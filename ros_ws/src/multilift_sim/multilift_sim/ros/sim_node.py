@@ -66,9 +66,7 @@ class SimNode(Node):
             raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
         scenario = scenario_io.load(name)
         if duration > 0:
-            import dataclasses
-            scenario = dataclasses.replace(
-                scenario, simulation=dataclasses.replace(scenario.simulation, duration=duration))
+            scenario = scenario.with_duration(duration)  # a ScenarioError ends the node (2)
         self.scenario = scenario
         self.sim = FormationSimulator(scenario)
         n = scenario.n_uavs
@@ -174,9 +172,11 @@ class SimNode(Node):
 
     def publish_state(self) -> Snapshot:
         """The state at this tick, the controllers' snapshot first (they answer while the rest
-        goes out); returns the snapshot."""
+        goes out; at the run's last tick there is nothing to answer and no snapshot); returns
+        the snapshot."""
         snap = self.sim.snapshot()
-        self.outputs.send(self.packer.state(snap, self.sim.payload_gust, self.applied))
+        self.outputs.send(self.packer.state(snap, self.sim.payload_gust, self.applied,
+                                            last=self.sim.finished))
         return snap
 
     def wait_for_commands(self) -> None:
@@ -210,13 +210,15 @@ class SimNode(Node):
             while True:
                 self.commands = [None] * self.sim.n
                 snap = self.publish_state()
+                if self.sim.finished:
+                    # a run of duration T asks for commands for the states before T only: the
+                    # last tick's cables are those of the commands held since the tick before
+                    self.publish_formation(snap, self.sim.tick_cables(self.applied))
+                    break
                 self.wait_for_commands()
                 speeds = [np.array(c.angular_velocity, dtype=float) for c in self.commands]
                 flags = [np.array(c.saturated, dtype=bool) for c in self.commands]
                 held = self.sim.tick_cables(speeds)
-                if self.sim.finished:
-                    self.publish_formation(snap, held)
-                    break
                 try:
                     self.sim.advance(speeds, flags)
                 finally:  # a stopped run has its last tick's /formation/state too

@@ -1,0 +1,88 @@
+"""Our participants' Fast DDS settings: a profile file every multilift process points Fast DDS
+at before rclpy starts (`use_fastdds_profile`; run_node, the recorder and `scripts/multilift`
+call it), unless the user names a profile of their own. No rclpy here: the command line sets it
+before it knows whether a run needs ROS.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+# Our participants' Fast DDS (rmw_fastrtps, the default RMW) settings, unless the user names a
+# profile file of their own:
+# - UDP only, no shared memory. Fast DDS sends user data to a participant on the same host
+#   through shared memory alone, with no fallback to UDP, and a process killed at the wrong
+#   moment can leave port rings in /dev/shm that later participants reuse (SharedMemGlobal
+#   opens a port by its number; upstream reports of the same symptom: eProsima/Fast-DDS#5053,
+#   #5469). Seen here: a recorder that never received a follower's messages and a bridge that
+#   received none of a run's, after a day of killed test processes. Our nodes on UDP leave
+#   nothing in /dev/shm (the cost: benchmarks/results.md).
+# - A reliable writer announces what it sent every 100 ms (3 s by default, and readers
+#   acknowledge only then): a node's final flush (`wait_for_all_acked`) waited for that
+#   (2.3 s at the end of a twin-lift run here; 0.02 s with this profile).
+# - ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST: rmw_fastrtps (Jazzy) then gives the participant a
+#   shared-memory transport whatever the profile says (seen here), so the profile keeps to this
+#   machine itself (UDP on 127.0.0.1 alone, discovery by unicast to 127.0.0.1, as rmw's
+#   LOCALHOST does) and the range our processes hand to rmw becomes SUBNET: they still find,
+#   and are found by, LOCALHOST nodes on this machine, and nothing beyond it.
+_TRANSPORT = """    <transport_descriptor>
+      <transport_id>multilift_udp</transport_id>
+      <type>UDPv4</type>{whitelist}
+    </transport_descriptor>"""
+_LOCALHOST_TRANSPORT = """
+      <interfaceWhiteList><address>127.0.0.1</address></interfaceWhiteList>"""
+_LOCALHOST_DISCOVERY = """
+      <builtin>
+        <metatrafficUnicastLocatorList><locator/></metatrafficUnicastLocatorList>
+        <initialPeersList>
+          <locator><udpv4><address>127.0.0.1</address></udpv4></locator>
+        </initialPeersList>
+      </builtin>"""
+_PROFILE = """<?xml version="1.0" encoding="UTF-8" ?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <transport_descriptors>
+{transport}
+  </transport_descriptors>
+  <participant profile_name="multilift_participant" is_default_profile="true">
+    <rtps>{discovery}
+      <userTransports><transport_id>multilift_udp</transport_id></userTransports>
+      <useBuiltinTransports>false</useBuiltinTransports>
+    </rtps>
+  </participant>
+  <publisher profile_name="multilift_writer" is_default_profile="true">
+    <times>
+      <heartbeatPeriod><sec>0</sec><nanosec>100000000</nanosec></heartbeatPeriod>
+    </times>
+  </publisher>
+</profiles>
+"""
+FASTDDS_PROFILE = _PROFILE.format(transport=_TRANSPORT.format(whitelist=''), discovery='')
+FASTDDS_LOCALHOST_PROFILE = _PROFILE.format(
+    transport=_TRANSPORT.format(whitelist=_LOCALHOST_TRANSPORT), discovery=_LOCALHOST_DISCOVERY)
+_PROFILE_VARIABLES = ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE')
+_RANGE = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
+
+
+def use_fastdds_profile() -> Path | None:
+    """Point Fast DDS at our profile (FASTDDS_PROFILE, or FASTDDS_LOCALHOST_PROFILE with
+    ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, written under the user's cache) before rclpy
+    starts, unless a profile file is named already; the file, or None. Processes started
+    from here inherit it."""
+    if any(os.environ.get(name) for name in _PROFILE_VARIABLES):
+        return None
+    localhost = os.environ.get(_RANGE, '').upper() == 'LOCALHOST'
+    text = FASTDDS_LOCALHOST_PROFILE if localhost else FASTDDS_PROFILE
+    cache = Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache') / 'multilift'
+    path = cache / ('fastdds_profiles_localhost.xml' if localhost else 'fastdds_profiles.xml')
+    try:
+        if not path.is_file() or path.read_text() != text:
+            cache.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f'{path.name}.{os.getpid()}.tmp')
+            tmp.write_text(text)
+            tmp.replace(path)
+    except OSError:  # no writable cache: Fast DDS's defaults, a slower exit
+        return None
+    os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(path)
+    if localhost:
+        os.environ[_RANGE] = 'SUBNET'  # the profile keeps to this machine (see above)
+    return path

@@ -3,7 +3,9 @@ before `multilift run` starts subscribes to every channel as soon as it is adver
 app does) and decodes every message with the channel's ros2msg schema (mcap_ros2's dynamic
 decoder, not our message classes). It must receive every message the run recorded, each with its
 header stamp as its time, and never be refused a subscription; the server's time follows /clock.
-At full speed and with --realtime.
+At full speed and with --realtime, and for runs so short at full speed (a few simulated seconds,
+about a second of the nodes' wall time) that only the bridge's graph events let it subscribe
+while the publishers live: such a run too is forwarded from its first message.
 """
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 from mcap_ros2._dynamic import generate_dynamic
+from mcap_ros2.decoder import DecoderFactory
 from websockets.sync.client import connect
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -99,6 +102,19 @@ def recorded_counts(bag: Path) -> dict[str, int]:
             for cid, n in summary.statistics.channel_message_counts.items()}
 
 
+def recorded_stamps(bag: Path) -> dict[str, list[int]]:
+    """topic -> the sorted stamps (`stamp`) of the bag's messages that have one."""
+    [path] = bag.glob('*.mcap')
+    stamps: dict[str, list[int]] = defaultdict(list)
+    with open(path, 'rb') as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        for _, channel, _, message in reader.iter_decoded_messages():
+            own = stamp(message)
+            if own is not None:
+                stamps[channel.topic].append(own)
+    return {topic: sorted(values) for topic, values in stamps.items()}
+
+
 def stamp(message) -> int | None:
     """The stamp the bridge should use: header, Clock, first element of an array."""
     if hasattr(message, 'header'):
@@ -137,21 +153,21 @@ def bridge(tmp_path, ros_env):
     log.close()
 
 
-# Runs long enough that the bridge discovers every node while it still lives (seconds on a
-# loaded machine: the nodes now live only ~2 s through a 6 s twin-lift run at full speed, and
-# the bridge then once saw none of its topics), and short enough that what the bridge missed
-# comes from the publishers' kept history (1000 messages, 10 s).
-@pytest.mark.parametrize('scenario, duration, pace', [('twin_lift', 9.5, []),
-                                                      ('single_lift', 5.0, ['--realtime'])])
-def test_a_client_gets_every_message_of_a_run_with_its_stamp(bridge, ros_env, tmp_path,
-                                                             scenario, duration, pace):
-    client, log, process = bridge
+def run_and_check(client, log: Path, process, ros_env: dict, bag: Path, scenario: str,
+                  duration: float, pace: list[str], record: bool = True) -> None:
+    """`multilift run` with `bag` (else without a recorder, and `bag` is the run's reference:
+    the same run headless); the client must get every message the bag has, each with its own
+    stamp, and the server's time must follow /clock."""
     assert client.info['metadata']['ROS_DISTRO'] == 'jazzy'
     assert 'time' in client.info['capabilities']
-    bag = tmp_path / 'bag'
+    if not record:
+        reference = subprocess.run([str(MULTILIFT), 'run', scenario, '--headless', '--duration',
+                                    str(duration), '--bag', str(bag)], env=ros_env,
+                                   capture_output=True, text=True, timeout=300)
+        assert reference.returncode == 0, reference.stdout + reference.stderr
     run = subprocess.run([str(MULTILIFT), 'run', scenario, '--duration', str(duration),
-                          '--bag', str(bag), *pace], env=ros_env, capture_output=True,
-                         text=True, timeout=300)
+                          *(['--bag', str(bag)] if record else []), *pace], env=ros_env,
+                         capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr
     expected = recorded_counts(bag)
     assert '/tf' in expected
@@ -175,3 +191,31 @@ def test_a_client_gets_every_message_of_a_run_with_its_stamp(bridge, ros_env, tm
     simulated = [t for t in client.times if t <= int(duration * 1e9)]  # else wall time
     assert simulated and simulated == sorted(simulated)
     assert 'dropped' not in log.read_text()
+
+
+# Long enough that discovery by polling, as the bridge once did, mostly saw the nodes while they
+# lived, and short enough that the publishers' kept history (1000 messages) covers the run.
+@pytest.mark.parametrize('scenario, duration, pace', [('twin_lift', 9.5, []),
+                                                      ('single_lift', 5.0, ['--realtime'])])
+def test_a_client_gets_every_message_of_a_run_with_its_stamp(bridge, ros_env, tmp_path,
+                                                             scenario, duration, pace):
+    client, log, process = bridge
+    run_and_check(client, log, process, ros_env, tmp_path / 'bag', scenario, duration, pace)
+
+
+# Full speed, a few simulated seconds: the nodes publish for a fraction of a second to a second of
+# wall time, the shortest without a recorder (nothing waits for one before t = 0): less than the
+# bridge's old 0.5 s poll needed to see every node. Without a recorder the reference is the same
+# run headless (tests/ros/test_headless.py: the same topics and counts).
+@pytest.mark.parametrize('scenario, duration, record', [('single_lift', 3.0, False),
+                                                        ('twin_lift', 2.0, True)])
+def test_a_short_full_speed_run_is_forwarded_from_its_first_message(bridge, ros_env, tmp_path,
+                                                                    scenario, duration, record):
+    client, log, process = bridge
+    bag = tmp_path / 'bag'
+    run_and_check(client, log, process, ros_env, bag, scenario, duration, [], record)
+    # the same messages as the bag from the first on: every stamp, the first /clock at 0
+    for topic, stamps in recorded_stamps(bag).items():
+        got = sorted(stamp(message) for _, message in client.messages[topic])
+        assert got == stamps, (topic, got[:3], stamps[:3])
+    assert client.messages['/clock'][0][0] == 0

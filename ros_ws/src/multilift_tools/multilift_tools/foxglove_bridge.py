@@ -2,12 +2,21 @@
 protocol, for the Foxglove app (Open connection -> Foxglove WebSocket -> ws://localhost:8765).
 `multilift foxglove --layout FILE SCENARIO` writes a Foxglove layout for a scenario instead.
 
-A node (`multilift_foxglove`) polls the graph every POLL_PERIOD s and subscribes raw to every
-topic that has a publisher (hidden topics and /parameter_events excepted); each topic is a
-channel with message encoding `cdr` and a `ros2msg` schema named `pkg/msg/Type` holding the full
-message definition (`msgdefs.message_definition`, as in our bags), so the app decodes custom
-messages too. The CDR bytes go out untouched. The WebSocket server is this module's own
-(`FoxgloveServer`, the `websockets` package, subprotocols foxglove.websocket.v1 and
+A node (`multilift_foxglove`) subscribes raw to every topic that has a publisher (hidden topics
+and /parameter_events excepted) as soon as the graph shows it: a thread waits on the node's
+graph guard condition, which the rmw triggers on every discovery event (`GraphEvents`), and has
+the executor look at the graph again (`FoxgloveBridge.poll`), so a topic is subscribed to within
+milliseconds of its publisher's discovery and a run of any length is forwarded from its first
+message (the publishers keep their history for late joiners, see Subscriptions); a poll every
+POLL_PERIOD s stays as a safety net and closes channels (below). Discovery itself is the
+rmw's: a node that starts after the bridge shows up when Fast DDS matches the two participants
+(with discovery limited to localhost this was seen to wait for the bridge's next participant
+announcement, 3 s by default).
+
+Each topic is a channel with message encoding `cdr` and a `ros2msg` schema named `pkg/msg/Type`
+holding the full message definition (`msgdefs.message_definition`, as in our bags), so the app
+decodes custom messages too. The CDR bytes go out untouched. The WebSocket server is this
+module's own (`FoxgloveServer`, the `websockets` package, subprotocols foxglove.websocket.v1 and
 foxglove.sdk.v1): a channel is registered before it is advertised, so a client that subscribes
 as soon as it sees the advertisement is never refused; a topic without publishers for
 REMOVE_AFTER s loses its channel (the app is told) and gets it back, under the same id, when a
@@ -58,7 +67,8 @@ from multilift_sim.topics import CLOCK
 
 DEFAULT_PORT = 8765
 DEFAULT_HOST = '127.0.0.1'
-POLL_PERIOD = 0.5  # [s] graph poll for new and vanished topics
+POLL_PERIOD = 1.0  # [s] fallback graph poll (graph events come first) and channel removal
+WALL_TIME_PERIOD = 0.5  # [s] wall time broadcast while there is no /clock
 REMOVE_AFTER = 2.0  # [s] without a publisher before a topic's channel is removed
 SUBSCRIPTION_DEPTH = 1000  # keep_last depth of the raw subscriptions
 TAKE_BATCH = 256  # messages of one topic taken in one callback (see recorder_node)
@@ -318,11 +328,100 @@ class FoxgloveServer:
                     client.by_channel.pop(channel_id, None)
 
 
+class GraphEvents:
+    """Calls `on_change()`, from a thread of its own, each time the rmw reports a change of the
+    ROS graph as `node` sees it (a participant, publisher or subscription discovered or gone):
+    rcl's graph guard condition of the node (`rcl_node_get_graph_guard_condition`). rclpy
+    (Jazzy) neither exposes it nor lets its EventsExecutor wait on guard conditions, so the
+    thread waits on it in an rcl wait set of its own, through ctypes on librcl (the library
+    rclpy has loaded), together with a guard condition of its own that `close` triggers.
+    `on_change` should be cheap: a burst of discovery events calls it once per event."""
+
+    def __init__(self, node: Any, on_change) -> None:
+        import ctypes
+        from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+
+        class WaitSet(ctypes.Structure):  # rcl_wait_set_t (rcl/wait.h)
+            _fields_ = [(f'{kind}{part}', ctypes.c_void_p if part == 's' else ctypes.c_size_t)
+                        for kind in ('subscription', 'guard_condition', 'timer', 'client',
+                                     'service', 'event') for part in ('s', '_count')] + [
+                ('impl', ctypes.c_void_p)]
+
+        class Allocator(ctypes.Structure):  # rcutils_allocator_t
+            _fields_ = [(name, ctypes.c_void_p) for name in (
+                'allocate', 'deallocate', 'reallocate', 'zero_allocate', 'state')]
+
+        rcl, rcutils = ctypes.CDLL('librcl.so'), ctypes.CDLL('librcutils.so')
+        rcutils.rcutils_get_default_allocator.restype = Allocator
+        rcl.rcl_node_get_graph_guard_condition.restype = ctypes.c_void_p
+        rcl.rcl_node_get_graph_guard_condition.argtypes = [ctypes.c_void_p]
+        wait_set_p = ctypes.POINTER(WaitSet)
+        rcl.rcl_wait_set_init.argtypes = [wait_set_p] + [ctypes.c_size_t] * 6 + [
+            ctypes.c_void_p, Allocator]
+        rcl.rcl_wait_set_add_guard_condition.argtypes = [wait_set_p, ctypes.c_void_p,
+                                                         ctypes.c_void_p]
+        rcl.rcl_wait_set_clear.argtypes = [wait_set_p]
+        rcl.rcl_wait.argtypes = [wait_set_p, ctypes.c_int64]
+        rcl.rcl_wait_set_fini.argtypes = [wait_set_p]
+        self._rcl, self._rcutils, self._ctypes = rcl, rcutils, ctypes
+        self.on_change = on_change
+        self._node = node  # keeps the rcl node (and its graph guard condition) alive
+        self._graph = rcl.rcl_node_get_graph_guard_condition(node.handle.pointer)
+        if not self._graph:
+            raise RuntimeError('the node has no graph guard condition')
+        self._stop = _rclpy.GuardCondition(node.context.handle)
+        self._wait_set = WaitSet()
+        ret = rcl.rcl_wait_set_init(ctypes.byref(self._wait_set), 0, 2, 0, 0, 0, 0,
+                                    node.context.handle.pointer,
+                                    rcutils.rcutils_get_default_allocator())
+        if ret != 0:
+            rcutils.rcutils_reset_error()
+            self._stop.destroy_when_not_in_use()
+            raise RuntimeError(f'rcl_wait_set_init returned {ret}')
+        self._stopping = False
+        self.error: str | None = None
+        self._thread = threading.Thread(target=self._run, daemon=True, name='graph-events')
+        self._thread.start()
+
+    def _run(self) -> None:
+        rcl, ctypes = self._rcl, self._ctypes
+        wait_set = ctypes.byref(self._wait_set)
+        while not self._stopping:
+            rcl.rcl_wait_set_clear(wait_set)
+            rcl.rcl_wait_set_add_guard_condition(wait_set, self._graph, None)
+            rcl.rcl_wait_set_add_guard_condition(wait_set, self._stop.pointer, None)
+            ret = rcl.rcl_wait(wait_set, -1)  # rcl_wait nulls the entries not triggered
+            if self._stopping:
+                return
+            if ret != 0:
+                self._rcutils.rcutils_reset_error()
+                self.error = f'rcl_wait returned {ret}'
+                return
+            if ctypes.cast(self._wait_set.guard_conditions,
+                           ctypes.POINTER(ctypes.c_void_p))[0]:
+                try:
+                    self.on_change()
+                except Exception as error:  # noqa: BLE001 - the poll remains
+                    self.error = f'{type(error).__name__}: {error}'
+                    return
+
+    def close(self) -> None:
+        """Stop the thread (before the node is destroyed) and free the wait set."""
+        self._stopping = True
+        self._stop.trigger_guard_condition()
+        self._thread.join(timeout=5)
+        if not self._thread.is_alive():  # else it still waits: leave it its wait set
+            self._rcl.rcl_wait_set_fini(self._ctypes.byref(self._wait_set))
+            self._stop.destroy_when_not_in_use()
+
+
 class FoxgloveBridge:
-    """The bridge node and its WebSocket server (see the module docstring)."""
+    """The bridge node and its WebSocket server (see the module docstring). With `executor`
+    the node is added to it and graph events schedule a `poll` on it (`GraphEvents`); without
+    one only the POLL_PERIOD poll finds topics."""
 
     def __init__(self, port: int = DEFAULT_PORT, host: str = DEFAULT_HOST,
-                 log=print) -> None:
+                 log=print, executor: Any = None) -> None:
         from rclpy.node import Node
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from rosgraph_msgs.msg import Clock
@@ -349,7 +448,16 @@ class FoxgloveBridge:
             QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT,
                        durability=DurabilityPolicy.VOLATILE))
         self.node.create_timer(POLL_PERIOD, self.poll)
+        self.graph_events: GraphEvents | None = None
+        self._executor = executor
+        self._poll_scheduled = False
         self.poll()
+        if executor is not None:
+            executor.add_node(self.node)
+            try:
+                self.graph_events = GraphEvents(self.node, self._graph_changed)
+            except (OSError, AttributeError, RuntimeError) as error:
+                log(f'no graph events ({error}); polling the graph every {POLL_PERIOD} s')
 
     @property
     def port(self) -> int:
@@ -362,6 +470,17 @@ class FoxgloveBridge:
         return sum(self.server.dropped.values())
 
     # -- graph -----------------------------------------------------------------------------
+    def _graph_changed(self) -> None:
+        """From the GraphEvents thread: one poll on the executor for a burst of events (an event
+        during that poll schedules the next)."""
+        if not self._poll_scheduled:
+            self._poll_scheduled = True
+            self._executor.create_task(self._poll_after_event)
+
+    def _poll_after_event(self) -> None:
+        self._poll_scheduled = False
+        self.poll()
+
     def poll(self) -> None:
         """Add channels for new topics, drop those without publishers, pick the time base."""
         graph = dict(self.node.get_topic_names_and_types())
@@ -457,8 +576,12 @@ class FoxgloveBridge:
             self.server.broadcast_time(time.time_ns())
 
     def close(self) -> None:
-        """Stop the server and destroy the node."""
+        """Stop the graph events and the server, destroy the node."""
         self._report_drops(final=True)
+        if self.graph_events is not None:
+            self.graph_events.close()
+            if self.graph_events.error:
+                self.log(f'graph events had stopped: {self.graph_events.error}')
         self.server.stop()
         self.node.destroy_node()
 
@@ -513,19 +636,18 @@ def foxglove_main(argv: list[str]) -> int:
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     bridge = None
     try:
+        executor = make_executor()
         try:
-            bridge = FoxgloveBridge(args.port, args.host, log)
+            bridge = FoxgloveBridge(args.port, args.host, log, executor)
         except RuntimeError as error:  # the server could not bind
             print(f'foxglove: cannot serve on {args.host}:{args.port}: {error}', file=sys.stderr)
             return 1
         log(f'serving ws://{args.host}:{bridge.port} (subprotocol {SUBPROTOCOL}); '
             'Ctrl-C stops')
-        executor = make_executor()
-        executor.add_node(bridge.node)
         last_wall_broadcast = 0.0
         while not stop.is_set() and rclpy.ok():
             executor.spin_once(timeout_sec=0.1)
-            if time.monotonic() - last_wall_broadcast >= POLL_PERIOD:
+            if time.monotonic() - last_wall_broadcast >= WALL_TIME_PERIOD:
                 last_wall_broadcast = time.monotonic()
                 bridge.broadcast_wall_time()
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -23,7 +23,8 @@ import time
 from pathlib import Path
 
 from multilift_sim import scenario as scenario_io
-from multilift_sim.ros.fastdds import use_fastdds_profile
+from multilift_sim.ros.fastdds import LIVE_VIEW_ANNOUNCEMENT, use_fastdds_profile
+from multilift_sim.ros.shared_memory import remove_before_start
 from multilift_tools.launcher import Child, Supervisor, find_executable
 from multilift_sim.topics import parse_external, run_topics
 
@@ -213,7 +214,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder')
         children.append(recorder)
     progress = Progress(work / 'progress', sys.stdout.isatty())
-    _remove_stale_shared_memory()
+    remove_before_start()  # Fast DDS's shared memory of killed processes
     print(f'multilift run {scenario.name}: {scenario.n_uavs} UAV(s), '
           f'{args.duration or scenario.simulation.duration:g} s, logs in {work}', flush=True)
     if external:
@@ -248,16 +249,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     else:
         shutil.rmtree(work, ignore_errors=True)
     return 0
-
-
-def _remove_stale_shared_memory() -> None:
-    """Before our nodes start: Fast DDS's shared-memory files of killed processes, which have
-    cost later runs their topics, are removed (live processes' files are not touched); a note
-    says how many when there were any."""
-    from multilift_sim.ros.shared_memory import remove_stale_files
-    found = remove_stale_files()
-    if found.segments_removed or found.ports_removed:
-        print(f'note: {found}', file=sys.stderr)
 
 
 def _bag_state(bag: Path, recorder: Child) -> str:
@@ -394,7 +385,8 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `multilift bag info B | head` ends quietly
-    use_fastdds_profile()  # for every subcommand's participants and the nodes `run` starts
+    # our Fast DDS profile for every subcommand's participants and the nodes `run` starts
+    use_fastdds_profile(LIVE_VIEW_ANNOUNCEMENT if argv[:1] == ['foxglove'] else None)
     # subcommands that parse their own options get them untouched (argparse's REMAINDER would
     # reject a leading option such as `foxglove --port 8765`)
     if argv and argv[0] in (*DELEGATED, 'topic'):

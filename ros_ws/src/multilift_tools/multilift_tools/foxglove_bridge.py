@@ -625,7 +625,11 @@ def foxglove_main(argv: list[str]) -> int:
     from rclpy.signals import SignalHandlerOptions
 
     from multilift_sim.ros.common import make_executor
+    from multilift_sim.ros.fastdds import LIVE_VIEW_ANNOUNCEMENT, use_fastdds_profile
+    from multilift_sim.ros.shared_memory import remove_before_start
 
+    use_fastdds_profile(LIVE_VIEW_ANNOUNCEMENT)  # (scripts/multilift has set it already)
+    remove_before_start()  # Fast DDS's shared memory of killed processes
     stop = threading.Event()
     signal.signal(signal.SIGINT, lambda signum, frame: stop.set())
     signal.signal(signal.SIGTERM, lambda signum, frame: stop.set())

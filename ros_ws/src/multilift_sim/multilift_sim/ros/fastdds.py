@@ -31,13 +31,18 @@ _TRANSPORT = """    <transport_descriptor>
     </transport_descriptor>"""
 _LOCALHOST_TRANSPORT = """
       <interfaceWhiteList><address>127.0.0.1</address></interfaceWhiteList>"""
+_BUILTIN = """
+      <builtin>{announcement}{localhost}
+      </builtin>"""
 _LOCALHOST_DISCOVERY = """
-      <builtin>
         <metatrafficUnicastLocatorList><locator/></metatrafficUnicastLocatorList>
         <initialPeersList>
           <locator><udpv4><address>127.0.0.1</address></udpv4></locator>
-        </initialPeersList>
-      </builtin>"""
+        </initialPeersList>"""
+_ANNOUNCEMENT = """
+        <discovery_config>
+          <leaseAnnouncement><sec>0</sec><nanosec>{nanosec}</nanosec></leaseAnnouncement>
+        </discovery_config>"""
 _PROFILE = """<?xml version="1.0" encoding="UTF-8" ?>
 <profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
   <transport_descriptors>
@@ -56,24 +61,48 @@ _PROFILE = """<?xml version="1.0" encoding="UTF-8" ?>
   </publisher>
 </profiles>
 """
-FASTDDS_PROFILE = _PROFILE.format(transport=_TRANSPORT.format(whitelist=''), discovery='')
-FASTDDS_LOCALHOST_PROFILE = _PROFILE.format(
-    transport=_TRANSPORT.format(whitelist=_LOCALHOST_TRANSPORT), discovery=_LOCALHOST_DISCOVERY)
+# A participant learns of one that starts after it only when that one hears its next
+# announcement (Fast DDS: every 3 s by default; seen here under our LOCALHOST profile): the nodes
+# of a run that lives a second at full speed were gone before they had found a live view started
+# before them (0 of 6 short runs forwarded; 6 of 6 with this period). The live view
+# (`multilift foxglove`) announces itself this often; nodes keep the default.
+LIVE_VIEW_ANNOUNCEMENT = 0.1  # [s]
+
+
+def fastdds_profile(localhost: bool, announcement: float | None = None) -> str:
+    """Our profile's text: UDP only (on 127.0.0.1 alone, discovery by unicast to it, with
+    `localhost`), the writer heartbeat, and with `announcement` [s] the participant's
+    announcement period."""
+    builtin = ''
+    if localhost or announcement is not None:
+        builtin = _BUILTIN.format(
+            announcement='' if announcement is None else _ANNOUNCEMENT.format(
+                nanosec=int(round(announcement * 1e9))),
+            localhost=_LOCALHOST_DISCOVERY if localhost else '')
+    return _PROFILE.format(
+        transport=_TRANSPORT.format(whitelist=_LOCALHOST_TRANSPORT if localhost else ''),
+        discovery=builtin)
+
+
+FASTDDS_PROFILE = fastdds_profile(localhost=False)
+FASTDDS_LOCALHOST_PROFILE = fastdds_profile(localhost=True)
 _PROFILE_VARIABLES = ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE')
 _RANGE = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
 
 
-def use_fastdds_profile() -> Path | None:
-    """Point Fast DDS at our profile (FASTDDS_PROFILE, or FASTDDS_LOCALHOST_PROFILE with
-    ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, written under the user's cache) before rclpy
-    starts, unless a profile file is named already; the file, or None. Processes started
-    from here inherit it."""
+def use_fastdds_profile(announcement: float | None = None) -> Path | None:
+    """Point Fast DDS at our profile (`fastdds_profile`: for ROS_AUTOMATIC_DISCOVERY_RANGE=
+    LOCALHOST the localhost one; `announcement` [s] as there), written under the user's cache,
+    before rclpy starts, unless a profile file is named already; the file, or None. Processes
+    started from here inherit it."""
     if any(os.environ.get(name) for name in _PROFILE_VARIABLES):
         return None
     localhost = os.environ.get(_RANGE, '').upper() == 'LOCALHOST'
-    text = FASTDDS_LOCALHOST_PROFILE if localhost else FASTDDS_PROFILE
+    text = fastdds_profile(localhost, announcement)
     cache = Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache') / 'multilift'
-    path = cache / ('fastdds_profiles_localhost.xml' if localhost else 'fastdds_profiles.xml')
+    name = 'fastdds_profiles' + ('_localhost' if localhost else '') + (
+        '' if announcement is None else f'_announce{announcement:g}s')
+    path = cache / f'{name}.xml'
     try:
         if not path.is_file() or path.read_text() != text:
             cache.mkdir(parents=True, exist_ok=True)

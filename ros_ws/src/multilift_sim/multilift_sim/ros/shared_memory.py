@@ -17,6 +17,7 @@ from __future__ import annotations
 import fcntl
 import os
 import re
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -95,3 +96,11 @@ def _names(shm_dir: Path) -> list[str]:
         return sorted(os.listdir(shm_dir))
     except OSError:  # no /dev/shm: nothing Fast DDS could have left
         return []
+
+
+def remove_before_start() -> None:
+    """What `multilift run` and `multilift foxglove` do before they start a participant:
+    `remove_stale_files`, with a note on stderr when there were any."""
+    found = remove_stale_files()
+    if found.segments_removed or found.ports_removed:
+        print(f'note: {found}', file=sys.stderr)

@@ -1,12 +1,14 @@
 """`multilift sweep` campaigns and `multilift plot-sweep`.
 
 The campaign logic without Dask (parsing, grid, seeded draws, tables); campaigns on a local
-Dask cluster (rows against an in-process run, stopped rows, bad input, SIGTERM); and through a
-real command-line cluster: `dask scheduler` and two `dask worker` hosts (each its own process
-group: nanny and worker) on 127.0.0.1, ports chosen by the OS, dashboards off, every process
-killed at teardown. One worker host SIGKILLed mid-campaign still gives every row exactly once;
-the same sampled campaign twice gives the same table; a drawn value the scenario rejects is an
-`error` row."""
+Dask cluster (rows against an in-process run, stopped rows, bad input, SIGTERM, Ctrl-C and a
+hang-up); and through a real command-line cluster: `dask scheduler` and two `dask worker` hosts
+(each its own process group: nanny, worker and multiprocessing's resource tracker) on
+127.0.0.1, ports chosen by the OS, dashboards off, every process stopped at teardown. One worker
+host SIGKILLed mid-campaign still gives every row exactly once; the same sampled campaign twice
+gives the same table; a drawn value the scenario rejects is an `error` row. No sweep, finished
+or interrupted, and no cluster leaves a multiprocessing semaphore (/dev/shm/sem.mp-*) behind:
+the nannies' queues are made of them, and nothing else would ever remove them."""
 from __future__ import annotations
 
 import os
@@ -261,29 +263,127 @@ class _Lines:
         return ''.join(self.lines)
 
 
-def test_sigterm_stops_the_local_cluster_and_writes_what_finished(tmp_path):
+def _group(pgid: int) -> list[int]:
+    """The live processes of process group `pgid` (zombies are gone)."""
+    pids = []
+    for entry in Path('/proc').iterdir():
+        try:
+            fields = (entry / 'stat').read_text().rsplit(')', 1)[1].split()
+        except (OSError, IndexError):   # not a process, or gone meanwhile
+            continue
+        if fields[0] != 'Z' and int(fields[2]) == pgid:
+            pids.append(int(entry.name))
+    return pids
+
+
+class _Semaphores:
+    """The multiprocessing semaphores (/dev/shm/sem.mp-*) that the processes of some process
+    groups have open (mapped, in /proc/PID/maps), `sample`d now or polled in a thread. `left`:
+    those of them still in /dev/shm once the groups ended. Only names that our processes
+    opened count, so semaphores of other processes on the machine, made or left meanwhile, do
+    not."""
+
+    def __init__(self, *pgids: int, poll: bool = False):
+        self.pgids = pgids
+        self.names: set[str] = set()
+        self.lock = threading.Lock()
+        self.stop = threading.Event()
+        self.thread = None
+        if poll:
+            self.thread = threading.Thread(target=self._poll, daemon=True)
+            self.thread.start()
+
+    def _poll(self) -> None:
+        while True:
+            self.sample()
+            if self.stop.wait(0.05):
+                return
+
+    def sample(self) -> None:
+        found = set()
+        for pgid in self.pgids:
+            for pid in _group(pgid):
+                try:
+                    found.update(re.findall(r'/dev/shm/(sem\.mp-[^\s/]+)',
+                                            Path(f'/proc/{pid}/maps').read_text()))
+                except OSError:   # gone meanwhile
+                    pass
+        with self.lock:
+            self.names |= found
+
+    def left(self, timeout: float = 10.0) -> set[str]:
+        """The names seen that are still in /dev/shm `timeout` s after the processes ended
+        (a resource tracker unlinks what it holds as it exits, after the last of them)."""
+        self.stop.set()
+        if self.thread is not None:
+            self.thread.join()
+        assert self.names, 'no process of ours had a sem.mp-* open: nothing was checked'
+        deadline = time.monotonic() + timeout
+        while True:
+            left = {name for name in self.names if (Path('/dev/shm') / name).exists()}
+            if not left or time.monotonic() > deadline:
+                return left
+            time.sleep(0.1)
+
+
+# as a terminal starts it: Ctrl-C raises KeyboardInterrupt even should this test run with SIGINT
+# ignored (a background job of a script), which a child would inherit
+CLI = [PYTHON, '-c', 'import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler)'
+       '; from multilift_tools.cli import main; sys.exit(main())']
+
+
+def test_a_finished_local_sweep_leaves_no_semaphore(tmp_path):
     out = tmp_path / 'sweep.csv'
-    proc = subprocess.Popen([PYTHON, '-m', 'multilift_tools.cli', 'sweep', 'twin_lift',
+    proc = subprocess.Popen([*CLI, 'sweep', 'twin_lift', '--set', 'payload.mass=0.8,0.9',
+                             '--duration', '1', '--workers', '2', '--out', str(out),
+                             '--no-progress'],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    semaphores = _Semaphores(proc.pid, poll=True)
+    try:
+        err = _Lines(proc.stderr)
+        assert proc.wait(timeout=180) == 0, err.text()
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert not semaphores.left(), err.text()
+    assert [r['status'] for r in _table(out)] == ['ok', 'ok']
+
+
+@pytest.mark.parametrize('how', ['SIGTERM', 'Ctrl-C', 'hang-up'])
+def test_an_interrupted_local_sweep_stops_its_cluster_and_writes_what_finished(tmp_path, how):
+    """SIGTERM to the sweep; Ctrl-C and a closed terminal signal its whole process group
+    (SIGINT, SIGHUP): the workers too and multiprocessing's resource tracker."""
+    out = tmp_path / 'sweep.csv'
+    proc = subprocess.Popen([*CLI, 'sweep', 'twin_lift',
                              '--set', 'payload.mass=0.5,0.6,0.7,0.8,0.9,1.0', '--workers', '2',
                              '--out', str(out)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    semaphores = _Semaphores(proc.pid, poll=True)
     try:
         err = _Lines(proc.stderr)
         err.wait_for(r'\[sweep\] 6 run\(s\) submitted', 120)   # 120 s missions: none done
         children = _descendants(proc.pid)
         assert len(children) >= 2   # the two worker processes
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=60) == 130, err.text()
+        semaphores.sample()   # the nannies' queues, open now
+        if how == 'SIGTERM':
+            proc.send_signal(signal.SIGTERM)
+        else:
+            os.killpg(proc.pid, signal.SIGINT if how == 'Ctrl-C' else signal.SIGHUP)
+        code = proc.wait(timeout=60)
     finally:
         if proc.poll() is None:
-            proc.kill()
+            os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
-    assert '(interrupted)' in err.text()
     for pid in children:   # every worker (and multiprocessing's helpers) gone within 10 s
         gone = time.monotonic() + 10.0
         while time.monotonic() < gone and _running(pid):
             time.sleep(0.1)
         assert not _running(pid), pid
+    assert not semaphores.left(), err.text()
+    assert code == 130 and '(interrupted)' in err.text(), err.text()
     columns, rows, _ = cp.read_table(out)
     assert columns[:2] == ['run', 'payload.mass'] and len(rows) < 6
 
@@ -314,7 +414,9 @@ def test_plot_sweep_draws_each_parameter_and_lists_the_worst(tmp_path, capsys):
 
 # --------------------------------------------------------------------------- command-line cluster
 class Cluster:
-    """`dask scheduler` and two `dask worker` hosts on 127.0.0.1, each in its own session."""
+    """`dask scheduler` and two `dask worker` hosts on 127.0.0.1, each in its own session;
+    `semaphores`: the multiprocessing semaphores their processes opened (each nanny's queues
+    to its worker)."""
 
     def __init__(self, tmp_path: Path):
         self.procs: list[subprocess.Popen] = []
@@ -334,6 +436,8 @@ class Cluster:
         from distributed import Client
         self.client = Client(self.address, timeout='30s')
         self.client.wait_for_workers(2, timeout=120)
+        self.semaphores = _Semaphores(*(proc.pid for proc in self.procs))
+        self.semaphores.sample()
 
     def _start(self, argv, env, log) -> subprocess.Popen:
         proc = subprocess.Popen(argv, env=env, stdout=log, stderr=subprocess.STDOUT,
@@ -365,17 +469,40 @@ class Cluster:
         return (self.logs / f'{name}.log').read_text()
 
     def kill_host(self, name: str) -> None:
-        os.killpg(self.hosts[name].pid, signal.SIGKILL)   # nanny and worker at once
+        """SIGKILL the host's nanny and worker at once: its process group but multiprocessing's
+        resource tracker. A dead host's /dev/shm goes with it; these hosts share this
+        machine's, and the tracker unlinks the host's semaphores once the others are gone."""
+        nanny = self.hosts[name].pid
+        os.kill(nanny, signal.SIGKILL)   # first: it starts no worker after this
+        for pid in _group(nanny):
+            try:
+                if b'multiprocessing.resource_tracker' not in \
+                        Path(f'/proc/{pid}/cmdline').read_bytes():
+                    os.kill(pid, signal.SIGKILL)
+            except (FileNotFoundError, ProcessLookupError):
+                pass
         self.hosts[name].wait(timeout=30)
 
     def close(self) -> None:
+        """Stop every process as Ctrl-C would: SIGTERM to each session's leader (a nanny stops
+        its worker), the hosts first; SIGKILL for what is left of a session after 30 s."""
+        self.semaphores.sample()
         try:
             self.client.close(timeout=10)
         finally:
-            for proc in self.procs:
+            for proc in reversed(self.procs):
+                if proc.poll() is None:
+                    proc.send_signal(signal.SIGTERM)
+                    try:
+                        proc.wait(timeout=30)
+                    except subprocess.TimeoutExpired:
+                        pass
+                deadline = time.monotonic() + 30
+                while _group(proc.pid) and time.monotonic() < deadline:
+                    time.sleep(0.1)   # the worker, then the resource tracker, end after it
                 try:
                     os.killpg(proc.pid, signal.SIGKILL)
-                except ProcessLookupError:
+                except ProcessLookupError:   # the session is empty, as it should be
                     pass
                 proc.wait(timeout=30)
 
@@ -387,6 +514,8 @@ def cluster(tmp_path):
         yield c
     finally:
         c.close()
+    # every host's semaphores went with it, the SIGKILLed host's too
+    assert not c.semaphores.left()
 
 
 SAMPLED = ['single_lift_swing', '--sample', 'payload.mass=uniform(0.3, 0.6)', '--sample',

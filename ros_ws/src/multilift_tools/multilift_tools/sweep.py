@@ -38,7 +38,18 @@ worker; each result is read once and released, so no row is lost or doubled. A r
 its worker three times is an `error` row (KilledWorker). Progress on stderr: runs done,
 failed (stopped or error), ETA. Exit codes: 0 the campaign finished (failed runs are rows),
 1 the cluster cannot be reached or went away mid-campaign (the finished rows are written),
-2 bad input, 130 interrupted (Ctrl-C or SIGTERM: the finished rows are written).
+2 bad input, 130 interrupted (Ctrl-C, SIGTERM, or SIGHUP when the terminal closes: the
+finished rows are written).
+
+The local cluster's nannies (in this process) make their worker processes' multiprocessing
+queues from named POSIX semaphores, /dev/shm/sem.mp-*. They are unlinked when this process
+closes the cluster, which every interruption does (a SIGTERM or SIGHUP that comes while the
+cluster starts is held until it stands; a Ctrl-C then is lost: SIGINT is ignored while the
+workers start, which inherit that), and else by multiprocessing's resource tracker, a child of
+this process that unlinks what it registered once every process of the sweep is gone. The
+tracker ignores SIGINT and SIGTERM and is started here with SIGHUP blocked, so that a closed
+terminal, which hangs up the whole process group, does not kill it. Only SIGKILL of the tracker
+itself (`kill -9 -PGID`: every process of the sweep at once) leaves semaphores behind.
 """
 from __future__ import annotations
 
@@ -50,14 +61,42 @@ import signal
 import sys
 import threading
 import time
+from multiprocessing import resource_tracker
 from pathlib import Path
 
 from multilift_sim import scenario as scenario_io
 from multilift_tools import campaign as cp
 
 
-def _interrupt(signum, frame) -> None:
-    raise KeyboardInterrupt
+class _Interrupts:
+    """SIGTERM (unattended) and SIGHUP (the terminal closed) as Ctrl-C: a KeyboardInterrupt,
+    which closes the cluster. While `holding` (the local cluster is starting, not yet ours to
+    close) one is noted and `release` raises it once the cluster stands."""
+
+    SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+    def __init__(self):
+        self.holding = False
+        self.held = False
+        self.old = {}
+
+    def __call__(self, signum, frame) -> None:
+        if self.holding:
+            self.held = True
+            return
+        raise KeyboardInterrupt
+
+    def install(self) -> None:
+        self.old = {signum: signal.signal(signum, self) for signum in self.SIGNALS}
+
+    def restore(self) -> None:
+        for signum, handler in self.old.items():
+            signal.signal(signum, handler)
+
+    def release(self) -> None:
+        self.holding = False
+        if self.held:
+            raise KeyboardInterrupt
 
 
 class ClusterLost(RuntimeError):
@@ -147,6 +186,13 @@ def open_client(scheduler: str | None, workers: int):
 
     if scheduler is not None:
         return Client(scheduler, timeout='10s'), None
+    # the resource tracker that unlinks the nannies' semaphores should this process die: with
+    # SIGHUP blocked (a mask it inherits) it outlives a closed terminal
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGHUP})
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
     # the worker processes start with SIGINT ignored (a disposition they inherit): Ctrl-C on
     # a terminal reaches the whole process group, and this process stops them itself
     main = threading.current_thread() is threading.main_thread()
@@ -158,7 +204,11 @@ def open_client(scheduler: str | None, workers: int):
     finally:
         if main:
             signal.signal(signal.SIGINT, old)
-    return Client(cluster), cluster
+    try:
+        return Client(cluster), cluster
+    except BaseException:   # Ctrl-C included: the cluster is closed here, not by nobody
+        cluster.close(timeout=10)
+        raise
 
 
 def close_client(client, cluster) -> None:
@@ -242,15 +292,22 @@ def sweep_main(argv: list[str] | None = None) -> int:
     interrupted = False
     lost = ''
     rows: dict[int, dict] = {}
-    old_term = signal.signal(signal.SIGTERM, _interrupt)  # unattended: SIGTERM as Ctrl-C
+    interrupts = _Interrupts()
+    interrupts.install()
     client = cluster = None
     try:
+        interrupts.holding = args.scheduler is None
         try:
             client, cluster = open_client(args.scheduler, workers)
         except (OSError, TimeoutError) as exc:
             print(f'error: cannot reach the Dask scheduler {args.scheduler}: {exc}',
                   file=sys.stderr)
             return 1
+        except Exception:
+            if interrupts.held:   # e.g. the workers hung up with us as they started
+                raise KeyboardInterrupt from None
+            raise
+        interrupts.release()
         run_campaign(client, campaign, args.duration, bags, progress, rows)
     except KeyboardInterrupt:
         interrupted = True
@@ -263,7 +320,7 @@ def sweep_main(argv: list[str] | None = None) -> int:
                 close_client(client, cluster)
             except (KeyboardInterrupt, Exception):  # noqa: BLE001 - leaving anyway
                 pass
-        signal.signal(signal.SIGTERM, old_term)
+        interrupts.restore()
     columns = cp.table_columns(campaign, bags is not None)
     table = [rows[i] for i in sorted(rows)]
     if args.out:

@@ -25,6 +25,8 @@ def _fly(name: str) -> dict:
     t, thrust, tilt, z, saturated = [], [], [], [], []
 
     def on_tick(sim, snap, answers):
+        if not answers:  # the state at t_max: nothing answers it
+            return
         outputs = [a.output for a in answers]
         t.append(sim.t)
         thrust.append([u.vehicle.thrust_coefficient * float(np.sum(o.rotor_speeds ** 2))

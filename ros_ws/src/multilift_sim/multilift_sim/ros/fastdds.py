@@ -25,12 +25,20 @@ from pathlib import Path
 #   machine itself (UDP on 127.0.0.1 alone, discovery by unicast to 127.0.0.1, as rmw's
 #   LOCALHOST does) and the range our processes hand to rmw becomes SUBNET: they still find,
 #   and are found by, LOCALHOST nodes on this machine, and nothing beyond it.
+# With discovery by unicast to 127.0.0.1, a participant announces itself to the ports of the
+# first participant ids only (Fast DDS's maxInitialPeersRange, 4 by default), and two
+# participants of higher ids never learn of each other (Fast DDS relays no participant): a "V" of
+# five (seven participants) hung at its start, the simulator never finding two followers (1 of 3
+# runs here). So our participants announce themselves to this many ids: the processes of a V of
+# 30 with its recorder, a live view and a few tools.
+LOCALHOST_PARTICIPANTS = 64
 _TRANSPORT = """    <transport_descriptor>
       <transport_id>multilift_udp</transport_id>
       <type>UDPv4</type>{whitelist}
     </transport_descriptor>"""
 _LOCALHOST_TRANSPORT = """
-      <interfaceWhiteList><address>127.0.0.1</address></interfaceWhiteList>"""
+      <interfaceWhiteList><address>127.0.0.1</address></interfaceWhiteList>
+      <maxInitialPeersRange>{peers}</maxInitialPeersRange>""".format(peers=LOCALHOST_PARTICIPANTS)
 _BUILTIN = """
       <builtin>{announcement}{localhost}
       </builtin>"""

@@ -77,9 +77,14 @@ class Child:
         return f'exit code {code}'
 
     def signal(self, sig: int) -> None:
+        """Send `sig` to the child's process group, and SIGCONT after it: a stopped child
+        (SIGSTOP, Ctrl-Z: a frozen controller) handles SIGINT and SIGTERM only once it runs
+        again, and would otherwise sit out both deadlines of `Supervisor.stop` (13 s)."""
         if self.process is not None and self.process.poll() is None:
             try:
                 os.killpg(self.process.pid, sig)
+                if sig != signal.SIGKILL:
+                    os.killpg(self.process.pid, signal.SIGCONT)
             except ProcessLookupError:
                 pass
 

@@ -105,6 +105,18 @@ def ros_env(monkeypatch) -> dict:
     return dict(os.environ)
 
 
+def raw_messages(bag: Path) -> dict[str, list[bytes]]:
+    """Every topic's messages in a bag directory (its one MCAP file, finished or not), as CDR
+    bytes in log time order."""
+    from mcap.reader import make_reader
+    [path] = bag.glob('*.mcap')
+    messages: dict[str, list[bytes]] = {}
+    with open(path, 'rb') as stream:
+        for _, channel, message in make_reader(stream).iter_messages(log_time_order=True):
+            messages.setdefault(channel.topic, []).append(message.data)
+    return messages
+
+
 # -- waiting for conditions (tests never wait a fixed time) ----------------------------------------
 def wait_for(condition: Callable[[], T], timeout: float, what: str, poll: float = 0.1) -> T:
     """Poll `condition()` until it returns something truthy and return that; after `timeout`

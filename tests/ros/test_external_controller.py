@@ -16,10 +16,11 @@ from pathlib import Path
 
 import pytest
 import yaml
-from mcap.reader import make_reader
 from multilift_msgs.msg import RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.serialization import deserialize_message
+
+from conftest import raw_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
@@ -49,15 +50,6 @@ def start_example_leader(prefix: Path, log: Path) -> subprocess.Popen:
                             stdin=subprocess.DEVNULL, start_new_session=True)
 
 
-def read_bag(bag: Path) -> dict[str, list[bytes]]:
-    [path] = bag.glob('*.mcap')
-    messages: dict[str, list[bytes]] = {}
-    with open(path, 'rb') as stream:
-        for _, channel, message in make_reader(stream).iter_messages(log_time_order=True):
-            messages.setdefault(channel.topic, []).append(message.data)
-    return messages
-
-
 def test_the_example_leader_flies_single_lift_and_is_recorded(multilift_run, example_install,
                                                                tmp_path):
     bag = tmp_path / 'bag'
@@ -70,7 +62,7 @@ def test_the_example_leader_flies_single_lift_and_is_recorded(multilift_run, exa
         os.killpg(leader.pid, signal.SIGINT)
         leader.wait(timeout=30)
     assert 'leader tracking' not in run.output()  # none of our controllers ran
-    recorded = read_bag(bag)
+    recorded = raw_messages(bag)
     commands = [deserialize_message(d, RotorCommand) for d in recorded['/uav1/rotor_cmd']]
     states = [deserialize_message(d, Odometry) for d in recorded['/uav1/odom']]
     assert len(states) == 201  # t = 0, 0.01, .. 2 s
@@ -101,7 +93,7 @@ def test_our_follower_node_is_an_external_controller(multilift_run, tmp_path):
     finally:
         os.killpg(follower.pid, signal.SIGINT)
         follower.wait(timeout=30)
-    recorded = read_bag(bag)
+    recorded = raw_messages(bag)
     assert len(recorded['/uav2/rotor_cmd']) == len(recorded['/formation/snapshot']) > 0
     assert len(recorded['/uav2/formation_error']) == len(recorded['/uav2/rotor_cmd'])
 
@@ -196,7 +188,7 @@ def test_a_run_of_duration_t_needs_commands_before_t_only(multilift_run, tmp_pat
         if node.poll() is None:
             os.killpg(node.pid, signal.SIGINT)
             node.wait(timeout=30)
-    recorded = read_bag(tmp_path / 'bag')
+    recorded = raw_messages(tmp_path / 'bag')
     assert len(recorded['/uav1/odom']) == 51          # the states at t = 0, 0.01, .. 0.5 s
     assert len(recorded['/uav1/rotor_cmd']) == 50     # the answers to the states before 0.5 s
     assert len(recorded['/formation/state']) == 51    # the last under the commands held

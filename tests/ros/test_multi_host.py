@@ -21,9 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from mcap.reader import make_reader
 
-from conftest import ROOT
+from conftest import ROOT, raw_messages
 from multilift_sim.ros.fastdds import FASTDDS_PROFILE
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
@@ -109,16 +108,6 @@ def test_the_profile_in_the_deployment_guide_is_ours():
     assert ' '.join(xml.split()) == ' '.join(FASTDDS_PROFILE.split())
 
 
-def read_bag(bag: Path) -> dict[str, list[bytes]]:
-    """Every topic's messages (CDR bytes) in log time order."""
-    [path] = bag.glob('*.mcap')
-    messages: dict[str, list[bytes]] = {}
-    with open(path, 'rb') as stream:
-        for _, channel, message in make_reader(stream).iter_messages(log_time_order=True):
-            messages.setdefault(channel.topic, []).append(message.data)
-    return messages
-
-
 @pytest.fixture(scope='module')
 def one_host_bag(tmp_path_factory) -> dict[str, list[bytes]]:
     """The same scenario and duration on this host alone, our controllers started by `run`."""
@@ -127,7 +116,7 @@ def one_host_bag(tmp_path_factory) -> dict[str, list[bytes]]:
     out = subprocess.run([MULTILIFT, 'run', SCENARIO, '--duration', DURATION, '--bag', str(bag)],
                          capture_output=True, text=True, timeout=RUN_TIMEOUT, env=env)
     assert out.returncode == 0, out.stdout + out.stderr
-    return read_bag(bag)
+    return raw_messages(bag)
 
 
 def _stop(process: subprocess.Popen) -> int:
@@ -177,7 +166,7 @@ def fly_across(link: Link, tmp_path: Path, external: str, controllers: dict[str,
     # the nodes answered until the run ended and stopped cleanly at Ctrl-C
     assert all(c == 0 for c in codes.values()), (codes, output())
     after = link.controller_bytes()
-    return read_bag(bag), after[0] - before[0], after[1] - before[1]
+    return raw_messages(bag), after[0] - before[0], after[1] - before[1]
 
 
 def assert_same_bag(bag: dict[str, list[bytes]], one_host: dict[str, list[bytes]]) -> None:

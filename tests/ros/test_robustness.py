@@ -11,16 +11,14 @@ import os
 import signal
 import subprocess
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
-from rosbags.highlevel import AnyReader
 
-from conftest import ROOT, SCENARIOS, wait_for, wait_until_simulated
+from conftest import ROOT, SCENARIOS, raw_messages, wait_for, wait_until_simulated
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
 from multilift_sim.allocation import FRAME_TYPES
@@ -314,14 +312,6 @@ def _ros_env(domain: int) -> dict:
     return dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
 
 
-def _raw_messages(bag: Path) -> dict[str, list[bytes]]:
-    out: dict[str, list[bytes]] = {}
-    with AnyReader([bag]) as reader:
-        for conn, _, raw in reader.messages():
-            out.setdefault(conn.topic, []).append(bytes(raw))
-    return out
-
-
 STATE_TOPICS = ['/uav1/odom', '/payload/odom', '/formation/state', '/uav1/rotor_cmd']
 
 
@@ -333,7 +323,7 @@ def test_ros_runs_give_byte_identical_state_messages(tmp_path):
                               str(bag)], capture_output=True, text=True, timeout=300,
                              env=_ros_env(12))
         assert out.returncode == 0, out.stderr
-        bags.append(_raw_messages(bag))
+        bags.append(raw_messages(bag))
     for topic in STATE_TOPICS:
         # the states at the 301 ticks of [0, 3] s; commands for the 300 before t = 3 s
         assert len(bags[0][topic]) == (300 if topic.endswith('rotor_cmd') else 301), topic
@@ -352,7 +342,7 @@ def test_two_runs_on_different_domains_do_not_see_each_other(tmp_path):
         _, err = proc.communicate(timeout=300)
         assert proc.returncode == 0, err
     for proc, bag, n in runs:
-        data = _raw_messages(bag)
+        data = raw_messages(bag)
         topics = ['/clock', '/payload/odom', '/formation/state'] + \
             [f'/uav{i}/{leaf}' for i in range(1, n + 1) for leaf in ('odom', 'rotor_cmd')]
         for topic in topics:
@@ -492,7 +482,7 @@ def test_sigterm_leaves_no_process_and_a_closed_bag(tmp_path):
     assert (bag / 'metadata.yaml').is_file()
     mcap = next(bag.glob('*.mcap'))
     assert mcap.read_bytes()[-8:] == b'\x89MCAP0\r\n'   # footer magic: the file was closed
-    data = _raw_messages(bag)
+    data = raw_messages(bag)
     assert len(data['/uav1/odom']) > 50
     assert abs(len(data['/uav1/odom']) - len(data['/uav2/rotor_cmd'])) <= 1
 

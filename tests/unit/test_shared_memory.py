@@ -71,3 +71,12 @@ def test_a_missing_directory_is_nothing_to_remove(tmp_path):
     assert stale_locks(tmp_path / 'none') == []
     found = remove_stale_files(tmp_path / 'none')
     assert (found.segments_removed, found.ports_removed, found.in_use) == (0, 0, 0)
+
+
+def test_a_set_with_two_stale_locks_is_one_set(tmp_path):
+    for name in ('fastrtps_port9003', 'fastrtps_port9003_el', 'fastrtps_port9003_sl',
+                 'sem.fastrtps_port9003_mutex'):
+        (tmp_path / name).write_bytes(b'')
+    found = remove_stale_files(tmp_path)
+    assert (found.segments_removed, found.ports_removed, found.in_use) == (0, 1, 0)
+    assert list(tmp_path.iterdir()) == []

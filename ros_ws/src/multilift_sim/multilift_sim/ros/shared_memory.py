@@ -78,14 +78,14 @@ def remove_stale_files(shm_dir: Path = SHM_DIR) -> StaleFiles:
     """Remove the Fast DDS file sets in `shm_dir` whose lock no live process holds: a segment
     with its lock, a port with its lock and its mutex."""
     segments = ports = 0
-    for lock in stale_locks(shm_dir):
-        data = lock.name[:-3]
-        if _SEGMENT_LOCK.match(lock.name):
-            _remove(shm_dir / data, lock)
-            segments += 1
-        else:
-            _remove(shm_dir / data, lock, shm_dir / f'sem.{data}_mutex')
+    # one file set per name, however many of its locks (`_el`, `_sl`) were found stale
+    for data in sorted({lock.name[:-3] for lock in stale_locks(shm_dir)}):
+        _remove(shm_dir / data, shm_dir / f'{data}_el', shm_dir / f'{data}_sl')
+        if data.startswith('fastrtps_port'):
+            _remove(shm_dir / f'sem.{data}_mutex')
             ports += 1
+        else:
+            segments += 1
     in_use = sum(1 for name in _names(shm_dir)
                  if _SEGMENT_LOCK.match(name) or _PORT_LOCK.match(name))
     return StaleFiles(segments, ports, in_use)

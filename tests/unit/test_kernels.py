@@ -130,3 +130,28 @@ def test_the_ahead_of_time_build_is_named_by_its_source(tmp_path, monkeypatch):
     second = kernels.ahead_of_time_files('aot_naming_probe')
     assert first[0] != second[0] and first[1] != second[1]
     assert first[0].parent == kernels.AHEAD_OF_TIME_DIR
+
+
+def test_uncompiled_runs_the_same_source_in_python_all_the_way_down():
+    """kernels.uncompiled: the reference is the compiled function's own source run by Python,
+    and so are the compiled functions it calls (no compiled code underneath it)."""
+    import numba
+
+    from multilift_sim import _numba_kernel
+    reference = kernels.uncompiled(_numba_kernel.integrate_period)
+    assert not hasattr(reference, 'py_func')
+    assert reference.__code__ is _numba_kernel.integrate_period.py_func.__code__
+    solve = reference.__globals__['solve']
+    assert solve.__code__ is _numba_kernel.solve.py_func.__code__
+    assert not isinstance(solve, numba.core.dispatcher.Dispatcher)
+    assert not isinstance(solve.__globals__['force_per_mass'], numba.core.dispatcher.Dispatcher)
+    # the module's own functions are untouched
+    assert isinstance(_numba_kernel.solve, numba.core.dispatcher.Dispatcher)
+    simulator = _swinging('twin_lift', ticks=2)
+    constants = kernels.model_constants(simulator.model)
+    wrenches = simulator.model.wrenches([np.full(4, 1500.0)] * simulator.n)
+    compiled = _numba_kernel.integrate_period(*constants, simulator.state, wrenches,
+                                              simulator.dt, 3)
+    python = reference(*constants, simulator.state, wrenches, simulator.dt, 3)
+    for a, b in zip(compiled, python):
+        assert np.array_equal(a, b)  # the same operations in the same order: the same bits

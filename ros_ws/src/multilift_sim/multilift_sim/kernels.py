@@ -32,6 +32,7 @@ import os
 import shutil
 import sys
 import tempfile
+import types
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable
@@ -201,6 +202,34 @@ def build_ahead_of_time(name: str) -> Path:
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return extension_path
+
+
+def uncompiled(function: Callable) -> Callable:
+    """The pure-Python run of a compiled function's own source: numba's `py_func`, with every
+    compiled function it calls by a global name (of its module or imported by name) replaced by
+    that function's uncompiled run too, recursively. The reference the compiled code is tested
+    against, with no second copy of an equation. `function` may be a numba dispatcher or a plain
+    function (returned as it is when it calls nothing compiled)."""
+    return _uncompiled(function, {})
+
+
+def _uncompiled(function: Callable, done: dict[int, Callable]) -> Callable:
+    python = getattr(function, 'py_func', function)
+    if id(python) in done:
+        return done[id(python)]
+    if not isinstance(python, types.FunctionType):
+        return function
+    names = dict(python.__globals__)
+    copy = types.FunctionType(python.__code__, names, python.__name__, python.__defaults__,
+                              python.__closure__)
+    copy.__kwdefaults__ = python.__kwdefaults__
+    copy.__doc__ = python.__doc__
+    done[id(python)] = copy
+    for name in python.__code__.co_names:
+        value = names.get(name)
+        if hasattr(value, 'py_func'):
+            names[name] = _uncompiled(value, done)
+    return copy
 
 
 def _import_numba_quietly() -> None:

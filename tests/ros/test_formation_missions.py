@@ -1,4 +1,6 @@
-"""Twin-lift and "V" multi-lift fly the seed's 120 s mission through the ROS stack (seed Ch. 4).
+"""Twin-lift and "V" multi-lift fly the seed's 120 s mission (seed Ch. 4): the twin-lift through
+the ROS stack, its bag equal to the headless run's over the whole mission (1e-9 m), the V
+headless (the same laws and tick: tests/ros/test_headless.py, and here the twin-lift).
 
 Checked against physics computed here from the recorded positions (Eq. 2.73 force balance),
 not against recorded outputs of our own code. The figures the README quotes are printed.
@@ -19,11 +21,11 @@ K_T = 1.83e-6        # Table 4.2 [N s^2/rad^2]
 M_UAV, M_P, G = 2.5, 0.8, 9.81
 
 
-def _fly(name: str, tmp_path_factory, domain: str):
+def _fly(name: str, tmp_path_factory, domain: str, *options: str):
     env = dict(os.environ, ROS_DOMAIN_ID=domain, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     bag = tmp_path_factory.mktemp(name) / 'bag'
-    out = subprocess.run([MULTILIFT, 'run', name, '--bag', str(bag)], capture_output=True,
-                         text=True, timeout=1200, env=env)
+    out = subprocess.run([MULTILIFT, 'run', name, '--bag', str(bag), *options],
+                         capture_output=True, text=True, timeout=1200, env=env)
     assert out.returncode == 0, out.stderr[-2000:]
     print(out.stdout)
     return load_run(bag)
@@ -36,7 +38,16 @@ def twin(tmp_path_factory):
 
 @pytest.fixture(scope='module')
 def multi(tmp_path_factory):
-    return _fly('multi_lift', tmp_path_factory, '44')
+    return _fly('multi_lift', tmp_path_factory, '44', '--headless')
+
+
+def test_the_ros_mission_is_the_headless_one(twin, tmp_path_factory):
+    """The whole 120 s twin-lift through ROS nodes equals the headless run (lockstep)."""
+    headless = _fly('twin_lift', tmp_path_factory, '43', '--headless')
+    assert np.array_equal(twin.t, headless.t) and twin.t[-1] == pytest.approx(120.0)
+    assert np.abs(twin.uav_positions() - headless.uav_positions()).max() < 1e-9
+    assert np.abs(twin.payload_position() - headless.payload_position()).max() < 1e-9
+    assert np.abs(twin.rotor_speeds(2) - headless.rotor_speeds(2)).max() < 1e-6
 
 
 def _thrust(run, i):

@@ -58,6 +58,7 @@ import logging
 import math
 import os
 import signal
+import socket
 import sys
 import threading
 import time
@@ -179,12 +180,22 @@ def run_campaign(client, campaign: cp.Campaign, duration: float | None, bags: Pa
             progress.update(result['status'])
 
 
+def _probe(scheduler: str) -> None:
+    """OSError at once when nothing listens at a tcp:// scheduler's address (Dask's client
+    would retry a refused connection for its whole 10 s timeout); other addresses pass."""
+    from urllib.parse import urlsplit
+    address = urlsplit(scheduler)
+    if address.scheme == 'tcp' and address.hostname and address.port:
+        socket.create_connection((address.hostname, address.port), timeout=10).close()
+
+
 def open_client(scheduler: str | None, workers: int):
     """(client, cluster or None): a connection to `scheduler`, or a local cluster of `workers`
     processes with one thread each on 127.0.0.1, no dashboard."""
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
+        _probe(scheduler)
         return Client(scheduler, timeout='10s'), None
     # the resource tracker that unlinks the nannies' semaphores should this process die: with
     # SIGHUP blocked (a mask it inherits) it outlives a closed terminal

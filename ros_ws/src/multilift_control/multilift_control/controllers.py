@@ -9,8 +9,10 @@ from typing import Protocol
 
 import numpy as np
 
+from multilift_control import laws
 from multilift_control.cascade import (CascadeController, ControlOutput, UavState,
                                        balancing_rotor_speed)
+from multilift_control.laws.cascade import leader_update
 from multilift_control.mission import MissionPath, Reference
 from multilift_sim.scenario import Scenario
 
@@ -42,7 +44,8 @@ class ConstantRotorSpeed:
 
 
 class MissionLeader:
-    """The leader: cascade control along the mission path."""
+    """The leader: cascade control along the mission path, one law a tick
+    (`laws.cascade.leader_update`) over the cascade's and the path's arrays."""
 
     def __init__(self, scenario: Scenario, index: int):
         uav = scenario.uavs[index]
@@ -50,11 +53,13 @@ class MissionLeader:
         self.cascade = CascadeController(uav.vehicle, scenario.control, hover_mass,
                                          scenario.simulation.gravity)
         self.path = MissionPath(scenario.mission)
+        self._law = laws.runnable(leader_update)
 
     def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
-        ref = self.path(t)
-        out = self.cascade.update(t, state, ref.position, ref.velocity, ref.acceleration)
-        return out, ref
+        c, p = self.cascade, self.path
+        *out, reference = self._law(c.constants, c.mixer.rows, c.memory, p.mission, p.segments,
+                                    p.steps, float(t), state.row())
+        return ControlOutput(*out), Reference.of(reference)
 
 
 LEADER_CONTROLLERS = {'cascade': MissionLeader, 'constant_rotor_speed': ConstantRotorSpeed}

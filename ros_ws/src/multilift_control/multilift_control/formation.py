@@ -4,9 +4,9 @@ The followers keep the formation geometry by producing, with their thrust, the c
 that would hold the UAVs on the hypersurface g_vc(r_f) = 0 (Eq. 3.5). Everything is in the world
 frame (z up) of docs/conventions.md; the seed writes its equations in a z-down frame, so its
 "V" offsets v_1i go through `multilift_sim.frames` (`formation_geometry.v_offset`).
-UAV 1 (index 0) is the leader. Pure numpy; with the compiled kernels on, a follower of linear
-(and V) rows runs its tick compiled (`multilift_control._numba_laws`), these methods the
-reference.
+UAV 1 (index 0) is the leader. The arithmetic is the laws' (`multilift_control.laws`:
+`constraints` the rows, `follower` the forces and a follower's tick); the classes here build
+their arrays once and call them, compiled or not as MULTILIFT_KERNEL says (`laws.runnable`).
 """
 from __future__ import annotations
 
@@ -16,19 +16,29 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_control.cascade import (COMPILED_LAWS, CascadeController, ControlOutput,
-                                       FormationStates, UavState)
-from multilift_sim import kernels
+from multilift_control import laws
+from multilift_control.cascade import (CascadeController, ControlOutput, FormationStates,
+                                       UavState)
+from multilift_control.laws import constraints as rows_laws
+from multilift_control.laws.follower import follower_force, follower_update
+from multilift_control.laws.follower import virtual_forces as virtual_forces_law
+from multilift_control.laws.layout import (FOLLOWER_ALTITUDE_OFFSET, FOLLOWER_BETA_SQ,
+                                           FOLLOWER_COMMANDED, FOLLOWER_FREE_MODE_GAIN,
+                                           FOLLOWER_GRAVITY, FOLLOWER_HOVER_MASS,
+                                           FOLLOWER_INTEGRAL, FOLLOWER_INTEGRAL_LIMIT,
+                                           FOLLOWER_KD_Z, FOLLOWER_KI_Z, FOLLOWER_KP_Z,
+                                           FOLLOWER_LIFT, FOLLOWER_LINEAR,
+                                           FOLLOWER_MEMORY_SIZE, FOLLOWER_SIZE,
+                                           FOLLOWER_TWO_ALPHA, FOLLOWER_YAW, ROW_AXIS,
+                                           ROW_DISTANCE, ROW_FIRST, ROW_SECOND, ROW_SIZE)
 from multilift_sim import formation_geometry  # start places and the V offsets v_1i, world
-from multilift_sim.kinematics import thrust_axis
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario import ControlConfig
 
 GEOMETRIES = ('linear', 'distance', 'v', 'circle')  # seed Table 3.1 rows
 
-E_Z = np.array([0.0, 0.0, 1.0])
 OWN_THRUST = ('commanded', 'measured')  # where a follower's u_i comes from (FormationFollower)
-_COND_LIMIT = 1e10  # cond(J M^-1 J^T) above which Eq. 3.12 is solved by least squares
+_COND_LIMIT = 1e10  # cond(J M^-1 J^T) above which the linear law takes its pseudo-inverse
 
 
 @dataclass(frozen=True)
@@ -150,18 +160,18 @@ class VirtualConstraints:
         self.axes = np.array(axes, dtype=int)
         self.targets = np.array(targets, dtype=float)
         self.m = len(self.pairs)
-        self._constant_jacobian: np.ndarray | None = None   # linear rows: J_vc (Eq. 3.7)
-        self._free_motions: dict[float, np.ndarray] = {}    # linear rows: by tol
-        # linear rows read r_f at fixed places: r_f[3 i + axis] - r_f[3 j + axis]
-        self._flat_first = 3 * self.pairs[:, 0] + self.axes if self.linear else None
-        self._flat_second = 3 * self.pairs[:, 1] + self.axes if self.linear else None
-        if self.linear:
-            jac = np.zeros((self.m, 3 * self.n))
-            rows = np.arange(self.m)
-            jac[rows, 3 * self.pairs[:, 0] + self.axes] = 1.0
-            jac[rows, 3 * self.pairs[:, 1] + self.axes] = -1.0
-            jac.flags.writeable = False
-            self._constant_jacobian = jac
+        # the laws' rows (ROW_* slots): a distance row's axis is ROW_DISTANCE
+        self.rows = np.empty((self.m, ROW_SIZE), dtype=np.int64)
+        self.rows[:, ROW_FIRST] = self.pairs[:, 0]
+        self.rows[:, ROW_SECOND] = self.pairs[:, 1]
+        self.rows[:, ROW_AXIS] = self.axes if self.linear else ROW_DISTANCE
+        for array in (self.pairs, self.axes, self.targets, self.rows):
+            array.flags.writeable = False
+        self._residual = laws.runnable(rows_laws.residual)
+        self._jacobian = laws.runnable(rows_laws.jacobian)
+        self._rates = laws.runnable(rows_laws.rates)
+        self._jacobian_rate_product = laws.runnable(rows_laws.jacobian_rate_product)
+        self._free_follower_motions = laws.runnable(rows_laws.free_follower_motions)
 
     def offsets(self) -> np.ndarray:
         """(n-1, 3) desired r_1 - r_i per follower [m], world (linear and v only)."""
@@ -186,43 +196,21 @@ class VirtualConstraints:
 
     def residual(self, r: np.ndarray) -> np.ndarray:
         """g_vc(r) (m,): [m] for linear rows, [m^2] for distance rows."""
-        r = self._check(r)
-        if self.linear:
-            flat = r.reshape(-1)
-            return flat[self._flat_first] - flat[self._flat_second] - self.targets
-        diff = r[self.pairs[:, 0]] - r[self.pairs[:, 1]]
-        return np.einsum('kd,kd->k', diff, diff) - self.targets ** 2
+        return self._residual(self.rows, self.targets, self._check(r))
 
     def jacobian(self, r: np.ndarray) -> np.ndarray:
         """J_vc = d g_vc / d r_f, shape (m, 3n); constant (Eq. 3.7) for linear rows."""
-        r = self._check(r)
-        if self._constant_jacobian is not None:
-            return self._constant_jacobian.copy()
-        jac = np.zeros((self.m, 3 * self.n))
-        rows = np.arange(self.m)
-        i, j = self.pairs[:, 0], self.pairs[:, 1]
-        diff = 2.0 * (r[i] - r[j])
-        for axis in range(3):
-            jac[rows, 3 * i + axis] = diff[:, axis]
-            jac[rows, 3 * j + axis] = -diff[:, axis]
-        return jac
+        return self._jacobian(self.rows, self._check(r))
 
     def rate(self, r: np.ndarray, v: np.ndarray) -> np.ndarray:
         """g_vc_dot = J_vc r_f_dot (m,): [m/s] or [m^2/s]."""
-        jac = self._constant_jacobian if self.linear else self.jacobian(r)
-        if self.linear:
-            self._check(r)
-        return jac @ self._check(v, 'v').reshape(-1)
+        return self._rates(self.rows, self._check(r), self._check(v, 'v'))
 
     def jacobian_rate_product(self, r: np.ndarray, v: np.ndarray) -> np.ndarray:
         """J_vc_dot r_f_dot (m,): zero for linear rows, 2 |v_i - v_j|^2 for distance rows
         [m^2/s^2]."""
         self._check(r)
-        v = self._check(v, 'v')
-        if self.linear:
-            return np.zeros(self.m)
-        dv = v[self.pairs[:, 0]] - v[self.pairs[:, 1]]
-        return 2.0 * np.einsum('kd,kd->k', dv, dv)
+        return self._jacobian_rate_product(self.rows, self._check(v, 'v'))
 
     def rows_of(self, i: int) -> list[int]:
         """Indices of the rows that involve UAV index i (0 = leader)."""
@@ -233,19 +221,10 @@ class VirtualConstraints:
     def free_follower_motions(self, r: np.ndarray, tol: float = 1e-9) -> np.ndarray:
         """Orthonormal basis (2(n-1), k) of the followers' horizontal motions that leave every
         row unchanged to first order with the leader held: the null space of J_vc's follower
-        x, y columns (stacked x_2, y_2, .., x_n, y_n). Empty (k = 0) for linear rows; for a
-        circle the rotation about the leader, for 'distance' each follower's tangent."""
-        if self.linear and tol in self._free_motions:  # J_vc is constant: so is its null space
-            self._check(r)
-            return self._free_motions[tol].copy()
-        cols = [3 * i + axis for i in range(1, self.n) for axis in (0, 1)]
-        follower_jac = self.jacobian(r)[:, cols]
-        _, sv, vt = np.linalg.svd(follower_jac)
-        rank = int(np.sum(sv > tol * max(float(sv.max(initial=0.0)), 1e-300)))
-        basis = vt[rank:].T
-        if self.linear:
-            self._free_motions[tol] = basis.copy()
-        return basis
+        x, y columns (stacked x_2, y_2, .., x_n, y_n), singular values up to `tol` times the
+        largest counting as zero. Empty (k = 0) for linear rows; for a circle the rotation
+        about the leader, for 'distance' each follower's tangent."""
+        return self._free_follower_motions(self.rows, self._check(r), float(tol))
 
     def nominal_positions(self, leader_position: np.ndarray) -> np.ndarray:
         """(n, 3) positions [m], world, satisfying every row, all at the leader's altitude
@@ -268,43 +247,18 @@ class VirtualConstraints:
 def virtual_forces(constraints: VirtualConstraints, r: np.ndarray, v: np.ndarray,
                    thrust_vectors: np.ndarray, masses: np.ndarray, gravity: float,
                    alpha_vc: float, beta_vc: float) -> tuple[np.ndarray, np.ndarray]:
-    """Virtual constraint forces u_vf = -J_vc^T Lambda_c (seed Eq. 3.8-3.12), world frame.
+    """Virtual constraint forces u_vf = -J_vc^T Lambda_c (seed Eq. 3.8-3.12), world frame
+    (`laws.follower.virtual_forces`, which tells how the print is read).
 
     r (n, 3) [m], v (n, 3) [m/s], thrust_vectors u_i (n, 3) [N] (the lift R_i e_z u_T,i of each
     UAV), masses m_i (n,) [kg], gravity g [m/s^2], alpha_vc [1/s], beta_vc [1/s].
-    With M = diag(m_i I_3), f_i = m_i g e_z (the weight moved to the left of Eq. 3.9, in the
-    z-up frame) and the formation dynamics M r_ddot + f + J^T Lambda = u (Eq. 3.9), Lambda makes
-    g_ddot + 2 alpha g_dot + beta^2 g = 0 (Eq. 3.8):
-
-        Lambda = (J M^-1 J^T)^-1 (J M^-1 (u - f) + J_dot r_dot + 2 alpha J r_dot + beta^2 g_vc)
-
-    Read from the print (Eq. 3.11-3.12): its M_c and J_c are M_f,r and J_vc; its "- c_c" is
-    + v_c, so the stabilised residual is g_vc itself (J r + v_c, Eq. 3.6); the J_dot r_dot term
-    is not printed (the V's rows are linear) and is added for the nonlinear rows.
-    J M^-1 J^T is singular when J_vc loses row rank: a distance row whose two UAVs coincide,
-    or circle rows whose UAVs are collinear. Then (or when its condition number passes 1e10)
-    Lambda is the least-squares, minimum-norm solution.
     Returns (u_vf (n, 3) [N], Lambda (m,) [N/m or N/m^2]).
     """
-    n = constraints.n
-    r = constraints._check(r)
-    v = constraints._check(v, 'v')
-    u = constraints._check(thrust_vectors, 'thrust_vectors')
-    masses = np.asarray(masses, dtype=float).reshape(n)
-    inv_m = np.repeat(1.0 / masses, 3)                      # M^-1 diagonal
-    jac = constraints.jacobian(r)
-    weights = masses[:, None] * gravity * E_Z               # f_i = m_i g e_z
-    rhs = (jac @ (inv_m * (u - weights).reshape(-1))         # Eq. 3.12
-           + constraints.jacobian_rate_product(r, v)
-           + 2.0 * alpha_vc * (jac @ v.reshape(-1))
-           + beta_vc ** 2 * constraints.residual(r))
-    a = (jac * inv_m) @ jac.T                                # J M^-1 J^T
-    if np.linalg.cond(a) < _COND_LIMIT:
-        lam = np.linalg.solve(a, rhs)
-    else:
-        lam = np.linalg.lstsq(a, rhs, rcond=None)[0]
-    u_vf = -(jac.T @ lam).reshape(n, 3)
-    return u_vf, lam
+    masses = np.asarray(masses, dtype=float).reshape(constraints.n)
+    return laws.runnable(virtual_forces_law)(
+        constraints.rows, constraints.targets, masses, float(gravity), 2.0 * alpha_vc,
+        beta_vc ** 2, constraints._check(r), constraints._check(v, 'v'),
+        constraints._check(thrust_vectors, 'thrust_vectors'))
 
 
 # The last (J, M^-1) -> A^+ of `_law_inverse`: every follower of a formation needs the same one
@@ -388,41 +342,54 @@ class FormationFollower:
         self.gravity = gravity
         self.alpha_vc = alpha_vc
         self.beta_vc = beta_vc
-        self.yaw = yaw
         self.rows = constraints.rows_of(index)
-        self._row_index = np.array(self.rows, dtype=int)
-        self._linear_law = self._linear_law_matrices() if constraints.linear else None
         if altitude_offset is None:  # d_z of a linear geometry, else 0
             nominal = constraints.nominal_positions(np.zeros(3))
             altitude_offset = nominal[index, 2] - nominal[0, 2]
         self.altitude_offset = float(altitude_offset)  # z_d,i - z_1 [m]
         self.cascade = CascadeController(vehicle, gains, hover_mass, gravity)
         self.integral_limit = 0.5 * gravity
-        # what the law remembers, in one array the methods and the compiled code update: the
-        # altitude integral [m/s^2], the time of the last tick [s] and the last lift asked
-        # R(eta_d) e_z u_T, world [N] (NaN: none yet)
-        self._memory = np.array([0.0, math.nan, math.nan, math.nan, math.nan])
-        laws = kernels.compiled_module(COMPILED_LAWS) if constraints.linear else None
-        self._compiled_update = None if laws is None else laws.linear_follower_update
-        p, q, inv_m, weights, own_rows = self._linear_law or (None,) * 5
-        self._compiled_law = None if laws is None else (  # the _numba_laws.FOLLOWER_* layout
-            np.array([2.0 * alpha_vc, beta_vc ** 2, self.altitude_offset, hover_mass, gravity,
-                      gains.position_kp[2], gains.position_kd[2], gains.position_ki[2],
-                      self.integral_limit, vehicle.thrust_coefficient,
-                      float(own_thrust == 'commanded')], dtype=float),
-            index, p, q, inv_m, weights, np.ascontiguousarray(own_rows),
-            constraints._flat_first, constraints._flat_second, constraints.targets,
-            self._row_index)
+        self.constants = np.empty(FOLLOWER_SIZE)  # the FOLLOWER_* slots
+        self.constants[FOLLOWER_TWO_ALPHA] = 2.0 * alpha_vc
+        self.constants[FOLLOWER_BETA_SQ] = beta_vc ** 2
+        self.constants[FOLLOWER_ALTITUDE_OFFSET] = self.altitude_offset
+        self.constants[FOLLOWER_HOVER_MASS] = hover_mass
+        self.constants[FOLLOWER_GRAVITY] = gravity
+        self.constants[FOLLOWER_KP_Z] = gains.position_kp[2]
+        self.constants[FOLLOWER_KD_Z] = gains.position_kd[2]
+        self.constants[FOLLOWER_KI_Z] = gains.position_ki[2]
+        self.constants[FOLLOWER_INTEGRAL_LIMIT] = self.integral_limit
+        self.constants[FOLLOWER_COMMANDED] = float(own_thrust == 'commanded')
+        self.constants[FOLLOWER_FREE_MODE_GAIN] = (math.nan if free_mode_gain is None
+                                                   else free_mode_gain)
+        self.constants[FOLLOWER_LINEAR] = float(constraints.linear)
+        self.constants.flags.writeable = False
+        # linear rows: the law's constant matrices P, Q (none for nonlinear rows)
+        self.law_p, self.law_q = (self._linear_law_matrices() if constraints.linear
+                                  else (np.zeros((3, 0)), np.zeros((3, 0))))
+        # what the law remembers (FOLLOWER_INTEGRAL, _LAST_T, _LIFT, _YAW; NaN: none yet)
+        self.memory = np.full(FOLLOWER_MEMORY_SIZE, math.nan)
+        self.memory[FOLLOWER_INTEGRAL] = 0.0
+        self.memory[FOLLOWER_YAW] = math.nan if yaw is None else yaw
+        self._update = laws.runnable(follower_update)
+        self._force = laws.runnable(follower_force)
 
     @property
     def lift(self) -> np.ndarray | None:
         """The lift asked at the last tick, R(eta_d) e_z u_T, world [N] (None before it)."""
-        return None if math.isnan(self._memory[2]) else self._memory[2:5].copy()
+        lift = self.memory[FOLLOWER_LIFT:FOLLOWER_LIFT + 3]
+        return None if math.isnan(lift[0]) else lift.copy()
 
     @property
     def integral(self) -> float:
         """The altitude loop's integral term [m/s^2]."""
-        return float(self._memory[0])
+        return float(self.memory[FOLLOWER_INTEGRAL])
+
+    @property
+    def yaw(self) -> float | None:
+        """The heading held [rad] (None before the first tick measured it)."""
+        yaw = float(self.memory[FOLLOWER_YAW])
+        return None if math.isnan(yaw) else yaw
 
     @classmethod
     def from_scenario(cls, scenario, index: int, **options) -> FormationFollower:
@@ -454,23 +421,23 @@ class FormationFollower:
                    float(masses[index]), scenario.simulation.gravity, config.alpha_vc,
                    config.beta_vc, **options)
 
-    def _linear_law_matrices(self) -> tuple[np.ndarray, ...]:
+    def _linear_law_matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """For linear (and V) rows J_vc and M are constant, so this follower's row of
         u_vf = -J^T (J M^-1 J^T)^-1 rhs (`virtual_forces`) is a fixed linear map of rhs:
         u_vf,i = P rhs with P = -J_i^T A^+ (A^+ = A^-1, or the pseudo-inverse when A is
         ill-conditioned: the least-squares, minimum-norm Lambda of `virtual_forces`). With
         rhs = J (M^-1 (u - f) + 2 alpha v) + beta^2 g_vc (J_dot = 0) this is
         u_vf,i = Q (M^-1 (u - f) + 2 alpha v) + beta^2 P g_vc, Q = P J: O(n) per tick instead
-        of the O(n^3) solve (and cond) of the general law.
-        Returns (P (3, m), Q (3, 3n), M^-1 diagonal (3n,), f = m g e_z stacked (3n,),
-        this follower's rows of J (len(rows), 3n))."""
+        of the O(n^3) solve of the general law (`laws.follower.linear_virtual_force`).
+        Returns (P (3, m), Q (3, 3n)), read-only."""
         c = self.constraints
         jac = c.jacobian(np.zeros((c.n, 3)))
-        inv_m = np.repeat(1.0 / self.masses, 3)
-        a_plus = _law_inverse(jac, inv_m)
+        a_plus = _law_inverse(jac, np.repeat(1.0 / self.masses, 3))
         p = -(jac[:, 3 * self.index:3 * self.index + 3].T @ a_plus)
-        weights = (self.masses[:, None] * self.gravity * E_Z).reshape(-1)
-        return p, p @ jac, inv_m, weights, jac[self.rows]
+        q = p @ jac
+        for array in (p, q):
+            array.flags.writeable = False
+        return p, q
 
     def desired_force(self, t: float, states: Sequence[UavState], thrust_vectors: np.ndarray
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -479,78 +446,23 @@ class FormationFollower:
         The force the thrust should produce (the law of the class docstring) before Eq. 3.13;
         advances the altitude integral to t [s]. `update` calls it once per tick.
         """
-        i = self.index
-        states = FormationStates.of(states)
-        r, v = states.positions, states.velocities
-        u = np.array(thrust_vectors, dtype=float)
-        if self.own_thrust == 'commanded' and not math.isnan(self._memory[2]):
-            u[i] = self._memory[2:5]
-        if self._linear_law is not None:  # the same law, O(n): see _linear_law_matrices
-            p, q, inv_m, weights, own_rows = self._linear_law
-            residual = self.constraints.residual(r)
-            rates = own_rows @ v.reshape(-1)
-            u_vf_i = (q @ (inv_m * (u.reshape(-1) - weights) + 2.0 * self.alpha_vc * v.reshape(-1))
-                      + self.beta_vc ** 2 * (p @ residual))
-        else:
-            u_vf, _ = virtual_forces(self.constraints, r, v, u, self.masses, self.gravity,
-                                     self.alpha_vc, self.beta_vc)
-            u_vf_i = u_vf[i]
-            residual = rates = None
-        t_prev = float(self._memory[1])
-        dt = 0.0 if math.isnan(t_prev) else max(0.0, t - t_prev)
-        self._memory[1] = t
-        # z_d,i = z_1 (seed §3.2, after Eq. 3.13), a reference the outer loop updates each tick:
-        # the damping acts on the follower's own climb rate, not on z_1_dot - z_i_dot, hence
-        # the follower's lag in the climb (§4.3, Fig. 4.7) and the leader's larger thrust
-        # (Fig. 4.8)
-        error = r[0, 2] + self.altitude_offset - r[i, 2]
-        error_rate = -v[i, 2]
-        self._memory[0] = min(max(self.integral + self.gains.position_ki[2] * error * dt,
-                                  -self.integral_limit), self.integral_limit)
-        force = np.empty(3)
-        force[:2] = u[i, :2] + u_vf_i[:2]
-        if self.free_mode_gain is not None:  # not in the seed: see the class docstring
-            force[:2] += self._free_mode_correction(r, v, u)
-        force[2] = self.hover_mass * (self.gravity + self.gains.position_kp[2] * error
-                                      + self.gains.position_kd[2] * error_rate + self.integral)
-        if residual is None:
-            residual = self.constraints.residual(r)
-            rates = self.constraints.rate(r, v)[self.rows]
-        return force, residual[self._row_index], rates
-
-    def _free_mode_correction(self, r: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
-        """Horizontal force [N] that replaces, in the free follower motions, the followers'
-        forces by m_i (a_1 + k_f (v_1 - v_i)); zero when there are no free motions."""
-        basis = self.constraints.free_follower_motions(r)
-        if basis.shape[1] == 0:
-            return np.zeros(2)
-        leader_accel = u[0, :2] / self.masses[0]  # (u_1 - f_1)_xy / m_1: the weight is vertical
-        target = self.masses[1:, None] * (leader_accel + self.free_mode_gain
-                                          * (v[0, :2] - v[1:, :2]))
-        correction = basis @ (basis.T @ (target - u[1:, :2]).reshape(-1))
-        return correction[2 * (self.index - 1):2 * self.index]
+        return self._force(self.constants, self.masses, self.constraints.rows,
+                           self.constraints.targets, self.law_p, self.law_q, self.index,
+                           self.memory, float(t), FormationStates.of(states).array,
+                           np.asarray(thrust_vectors, dtype=float))
 
     def update(self, t: float, states: Sequence[UavState], thrust_vectors: np.ndarray
                ) -> tuple[ControlOutput, np.ndarray, np.ndarray]:
-        """One control tick at simulated time t [s].
+        """One control tick at simulated time t [s] (`laws.follower.follower_update`).
 
         states: all n UAVs at the same tick; thrust_vectors (n, 3): each UAV's current lift
         R_i e_z u_T,i, world [N]. Returns (ControlOutput, the follower's rows of g_vc [m or
         m^2], their rates [m/s or m^2/s]).
         """
-        state = states[self.index]
-        if self.yaw is None:
-            self.yaw = float(state.euler[2])  # hold the initial heading
-        if self._compiled_update is not None:  # this method's arithmetic, compiled
-            states = FormationStates.of(states)
-            speeds, saturated, setpoint, thrust, errors, rates = self._compiled_update(
-                *self._compiled_law, self._memory, t, states.positions, states.velocities,
-                np.asarray(thrust_vectors, dtype=float), *self.cascade.compiled_constants,
-                state.euler, state.body_rates, self.yaw)
-            return ControlOutput(speeds, saturated, setpoint, thrust), errors, rates
-        force, errors, rates = self.desired_force(t, states, thrust_vectors)
-        out = self.cascade.command(state, force, self.yaw)  # Eq. 3.13, attitude loop, mixer
-        # what the rotors will give after saturation, along the thrust axis asked for
-        thrust = self.vehicle.collective_thrust(out.rotor_speeds)
-        self._memory[2:5] = thrust_axis(*out.attitude_setpoint.tolist()) * thrust
-        return out, errors, rates
+        c = self.cascade
+        speeds, saturated, setpoint, thrust, errors, rates = self._update(
+            self.constants, self.masses, self.constraints.rows, self.constraints.targets,
+            self.law_p, self.law_q, self.index, self.memory, float(t),
+            FormationStates.of(states).array, np.asarray(thrust_vectors, dtype=float),
+            c.constants, c.mixer.rows)
+        return ControlOutput(speeds, saturated, setpoint, thrust), errors, rates

@@ -17,12 +17,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_control.cascade import COMPILED_LAWS, ControlOutput, FormationStates, UavState
+from multilift_control import laws
+from multilift_control.cascade import ControlOutput, FormationStates, UavState
 from multilift_control.controllers import make_controller
 from multilift_control.formation import FormationFollower
+from multilift_control.laws.follower import lift_vectors
+from multilift_control.laws.mixer import collective_thrust
 from multilift_control.mission import Reference
 from multilift_sim import kernels
-from multilift_sim.kinematics import thrust_axis_floats
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
@@ -46,21 +48,26 @@ class ThrustBook:
     The leader's thrust is its answer to the same state (a follower waits for it); the other
     followers' are their latest answers to earlier states (a follower does not wait for its
     peers, so the result does not depend on who answers first); before any answer, the thrust
-    that carries the UAV and its share of the payload.
+    that carries the UAV and its share of the payload. The arithmetic is the laws'
+    (`laws.mixer.collective_thrust`, `laws.follower.lift_vectors`).
     """
 
     def __init__(self, scenario: Scenario):
         share = scenario.payload.mass / scenario.n_uavs
         gravity = scenario.simulation.gravity
-        self.vehicles = [u.vehicle for u in scenario.uavs]
-        self.thrusts = [(v.mass + share) * gravity for v in self.vehicles]  # [N]
+        self.thrust_coefficients = [float(u.vehicle.thrust_coefficient) for u in scenario.uavs]
+        self.thrusts = np.array([(u.vehicle.mass + share) * gravity
+                                 for u in scenario.uavs])  # [N]
         self.leader: dict[int, float] = {}               # t_ns -> the leader's u_T [N]
         self.pending: dict[int, dict[int, float]] = {}   # t_ns -> {follower: u_T [N]}
         self._formed: tuple[int, np.ndarray] | None = None  # (t_ns, vectors) last formed
+        self._collective_thrust = laws.runnable(collective_thrust)
+        self._lift_vectors = laws.runnable(lift_vectors)
 
     def note(self, index: int, t_ns: int, rotor_speeds: np.ndarray) -> None:
         """UAV `index` (from 0) answered the state at t_ns with these rotor speeds [rad/s]."""
-        thrust = self.vehicles[index].collective_thrust(rotor_speeds)
+        thrust = self._collective_thrust(self.thrust_coefficients[index],
+                                         np.asarray(rotor_speeds, dtype=float))
         if index == 0:
             self.leader[t_ns] = thrust
         else:
@@ -81,8 +88,7 @@ class ThrustBook:
         for stamp in [k for k in self.leader if k < t_ns]:
             del self.leader[stamp]
         self.thrusts[0] = self.leader.pop(t_ns)
-        vectors = np.array([[axis * u for axis in thrust_axis_floats(*s.euler.tolist())]
-                            for s, u in zip(states, self.thrusts)])
+        vectors = self._lift_vectors(FormationStates.of(states).array, self.thrusts)
         vectors.flags.writeable = False
         self._formed = (t_ns, vectors)
         return vectors
@@ -171,16 +177,15 @@ def prepare_node_laws(scenario: Scenario, index: int) -> None:
     """Choose and load the control laws of a controller node of UAV `index` (from 0), before
     its topics appear (the simulator's `command_timeout` counts from the first state).
 
-    A node runs the laws compiled ahead of time where scripts/setup built them (they load in
-    a millisecond), else their pure methods: MULTILIFT_KERNEL defaults to `aot` here, because
-    importing numba for the just-in-time laws costs every process about 0.5 s of CPU plus
-    0.2 s to load the cached laws, more than they save where a node's time goes to rclpy, and
-    the start-up of many nodes shares two cores (a V of 30 started in 44 s against 19 s pure;
-    `benchmarks/results.md`). With MULTILIFT_KERNEL=auto or jit the laws may be compiled just
-    in time: one throwaway answer to the scenario's start loads them here (or compiles them,
-    seconds)."""
+    MULTILIFT_KERNEL defaults to `aot` here, so a node runs the laws uncompiled
+    (`laws.runnable`: they are not built ahead of time) unless MULTILIFT_KERNEL says auto or
+    jit, when they are compiled just in time: one throwaway answer to the scenario's start
+    loads them from numba's cache here (or compiles them, seconds). `aot` was the default
+    while scripts/setup built the laws ahead of time (a millisecond to load, where the
+    just-in-time cache costs 0.2 s and numba's import 0.5 s of a process that shares two
+    cores with many: `benchmarks/results.md`)."""
     os.environ.setdefault(kernels.VARIABLE, 'aot')
-    if kernels.compiled_module(COMPILED_LAWS) is None:
+    if laws.runnable(collective_thrust) is not collective_thrust:  # uncompiled
         return
     runtime = ControllerRuntime(scenario, index)
     if runtime.is_follower:

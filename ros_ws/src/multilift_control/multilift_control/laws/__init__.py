@@ -1,0 +1,41 @@
+"""The control laws, each written once: numba functions over float arrays (constants, memory,
+states), compiled just in time (`numba.njit(cache=True)`, the cache under NUMBA_CACHE_DIR) or
+run uncompiled (`multilift_sim.kernels.uncompiled`: their own source in Python), as
+MULTILIFT_KERNEL says (`runnable`).
+
+One concern per module: `layout` (the named slots of every array below), `reference` (the
+mission reference and its prefilter), `cascade` (position loop, attitude from force, attitude
+loop, a leader's tick), `mixer` (allocation inverse and saturation, collective thrust),
+`linalg` (the small SVD the nonlinear rows need), `constraints` (the virtual constraint rows
+g_vc, seed Eq. 3.1-3.7), `follower` (the virtual-constraint force, Eq. 3.8-3.12, and a
+follower's tick). The classes of `multilift_control.cascade`, `formation`, `mission`,
+`controllers` and `runtime` only build these arrays and call the laws.
+
+World frame z up, body FLU, ZYX Euler angles [rad], SI units (docs/conventions.md).
+"""
+from __future__ import annotations
+
+import functools
+from typing import Callable
+
+from multilift_sim import kernels
+
+# numba's array code without the scipy and coverage imports it does not need (their cost in
+# every process: kernels._import_numba_quietly)
+kernels._import_numba_quietly()
+import numba  # noqa: E402 - after the quiet import above
+
+# every law: compiled just in time, cached on disk, IEEE arithmetic in the source's order
+jit = numba.njit(cache=True, fastmath=False, nogil=True)
+
+
+def runnable(law: Callable) -> Callable:
+    """`law` as MULTILIFT_KERNEL says: compiled under auto and jit; its uncompiled run under
+    python, and under aot, which means "built ahead of time or the pure reference" and has no
+    ahead-of-time build of the laws (multilift_sim.kernels). A caller keeps what it got."""
+    return law if kernels.mode() in ('auto', 'jit') else _uncompiled(law)
+
+
+@functools.cache
+def _uncompiled(law: Callable) -> Callable:
+    return kernels.uncompiled(law)

@@ -1,0 +1,156 @@
+"""The multirotor cascade (seed Ch. 3): position loop -> the force the thrust should produce
+-> attitude setpoint and thrust (Eq. 3.13) -> attitude loop -> body torques -> `mixer`; and a
+leader's tick along the mission (`reference`).
+
+constants: CASCADE_* slots, memory: CASCADE_INTEGRAL, CASCADE_LAST_T (layout); a UAV's state
+is a row of UAV_* slots (world, z up; body FLU; ZYX Euler angles [rad])."""
+import math
+
+import numpy as np
+
+from multilift_control.laws import jit
+from multilift_control.laws.layout import (CASCADE_ATT_KD, CASCADE_ATT_KP, CASCADE_GRAVITY,
+                                           CASCADE_HOVER_MASS, CASCADE_INERTIA,
+                                           CASCADE_INTEGRAL, CASCADE_INTEGRAL_LIMIT, CASCADE_KD,
+                                           CASCADE_KI, CASCADE_KP, CASCADE_LAST_T,
+                                           CASCADE_MAX_TILT, CASCADE_SQUARE_MAX,
+                                           CASCADE_SQUARE_MIN, REFERENCE_ACCELERATION,
+                                           REFERENCE_POSITION, REFERENCE_VELOCITY,
+                                           UAV_BODY_RATES, UAV_EULER, UAV_POSITION,
+                                           UAV_VELOCITY)
+from multilift_control.laws.mixer import rotor_speeds
+from multilift_control.laws.reference import mission_reference
+
+
+@jit
+def clipped(value, limit):
+    """value within [-limit, limit] (NaN stays NaN): np.minimum(np.maximum(value, -limit),
+    limit) of one float."""
+    if value < -limit:
+        value = -limit
+    if value > limit:
+        value = limit
+    return value
+
+
+@jit
+def wrap_angle(angle):
+    """An angle [rad] wrapped to [-pi, pi) (numba's float % follows Python's)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+@jit
+def elapsed(memory, slot, t):
+    """The time since the tick noted in memory[slot] [s] (0 at the first: NaN there, and never
+    negative); notes t [s] there."""
+    t_prev = memory[slot]
+    dt = 0.0 if math.isnan(t_prev) else max(0.0, t - t_prev)
+    memory[slot] = t
+    return dt
+
+
+@jit
+def position_force(constants, memory, t, state, reference):
+    """The force the thrust should produce, world [N] (3,), at t [s]: PID on position with the
+    reference's velocity and acceleration fed forward and gravity fed forward with the hover
+    mass (the UAV and its static payload share; the cable's pull beyond it is a disturbance
+    the integral absorbs, as in the seed). Advances the integral (clamped per axis to
+    CASCADE_INTEGRAL_LIMIT) in memory. reference: REFERENCE_* slots."""
+    dt = elapsed(memory, CASCADE_LAST_T, t)
+    limit = constants[CASCADE_INTEGRAL_LIMIT]
+    force = np.empty(3)
+    for axis in range(3):
+        error = reference[REFERENCE_POSITION + axis] - state[UAV_POSITION + axis]
+        slot = CASCADE_INTEGRAL + axis
+        memory[slot] = clipped(memory[slot] + constants[CASCADE_KI + axis] * error * dt, limit)
+        accel = (reference[REFERENCE_ACCELERATION + axis] + constants[CASCADE_KP + axis] * error
+                 + constants[CASCADE_KD + axis] * (reference[REFERENCE_VELOCITY + axis]
+                                                   - state[UAV_VELOCITY + axis])
+                 + memory[slot])
+        gravity = constants[CASCADE_GRAVITY] if axis == 2 else 0.0  # gravity e_z
+        force[axis] = constants[CASCADE_HOVER_MASS] * (accel + gravity)
+    return force
+
+
+@jit
+def attitude_from_force(force, yaw, max_tilt):
+    """(roll [rad], pitch [rad], thrust [N]) that point the thrust along `force` (world) [N] at
+    heading `yaw` [rad]: seed Eq. 3.13 with u_T = |force|, R e_z = (c_phi s_theta c_psi +
+    s_phi s_psi, c_phi s_theta s_psi - s_phi c_psi, c_phi c_theta) for ZYX angles. The tilt is
+    limited to `max_tilt` [rad] by shrinking the horizontal part (and f_z kept >= 1e-6 N)."""
+    fx, fy, fz = force[0], force[1], force[2]
+    if fz < 1e-6:
+        fz = 1e-6
+    horizontal = math.hypot(fx, fy)
+    limit = fz * math.tan(max_tilt)
+    if horizontal > limit:
+        fx, fy = fx * (limit / horizontal), fy * (limit / horizontal)
+    thrust = math.sqrt(fx * fx + fy * fy + fz * fz)
+    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
+    roll = math.asin(max(-1.0, min(1.0, (fx * s_psi - fy * c_psi) / thrust)))
+    pitch = math.atan2(fx * c_psi + fy * s_psi, fz)
+    return roll, pitch, thrust
+
+
+@jit
+def thrust_axis(roll, pitch, yaw):
+    """R(eta) e_z (x, y, z) [unit, world]: the body z axis along which the rotors push, the
+    third column of the ZYX rotation (seed Eq. 2.3; multilift_sim.kinematics.thrust_axis)."""
+    s_phi, c_phi = math.sin(roll), math.cos(roll)
+    s_theta, c_theta = math.sin(pitch), math.cos(pitch)
+    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
+    return (c_psi * s_theta * c_phi + s_psi * s_phi, s_psi * s_theta * c_phi - c_psi * s_phi,
+            c_theta * c_phi)
+
+
+@jit
+def attitude_torque(constants, state, setpoint):
+    """Body torque [N m] (3,) driving the Euler angles to `setpoint` (roll, pitch, yaw) [rad]:
+    PD on each angle, J-scaled, plus the gyroscopic omega x J omega."""
+    p = state[UAV_BODY_RATES]
+    q = state[UAV_BODY_RATES + 1]
+    r = state[UAV_BODY_RATES + 2]
+    jp = constants[CASCADE_INERTIA] * p
+    jq = constants[CASCADE_INERTIA + 1] * q
+    jr = constants[CASCADE_INERTIA + 2] * r
+    gyro = (q * jr - r * jq, r * jp - p * jr, p * jq - q * jp)  # omega x J omega
+    rates = (p, q, r)
+    torque = np.empty(3)
+    for axis in range(3):
+        error = wrap_angle(setpoint[axis] - state[UAV_EULER + axis])
+        accel = (constants[CASCADE_ATT_KP + axis] * error
+                 - constants[CASCADE_ATT_KD + axis] * rates[axis])
+        torque[axis] = constants[CASCADE_INERTIA + axis] * accel + gyro[axis]
+    return torque
+
+
+@jit
+def command(constants, mixer, state, force, yaw):
+    """(rotor speeds [rad/s], saturated, setpoint (roll, pitch, yaw) [rad], thrust [N]) that
+    produce `force` (world) [N] at heading `yaw` [rad]: Eq. 3.13, the attitude loop, the mixer.
+    The thrust is asked along the current body z."""
+    roll, pitch, thrust = attitude_from_force(force, yaw, constants[CASCADE_MAX_TILT])
+    setpoint = np.array((roll, pitch, yaw))
+    torque = attitude_torque(constants, state, setpoint)
+    wrench = np.array((thrust, torque[0], torque[1], torque[2]))
+    speeds, saturated = rotor_speeds(mixer, constants[CASCADE_SQUARE_MIN],
+                                     constants[CASCADE_SQUARE_MAX], wrench)
+    return speeds, saturated, setpoint, thrust
+
+
+@jit
+def cascade_update(constants, mixer, memory, t, state, reference, yaw):
+    """One tick of the cascade at t [s] tracking `reference` (REFERENCE_* slots) at heading
+    `yaw` [rad]: `position_force`, then `command`."""
+    force = position_force(constants, memory, t, state, reference)
+    return command(constants, mixer, state, force, yaw)
+
+
+@jit
+def leader_update(constants, mixer, memory, mission, segments, steps, t, state):
+    """A leader's tick at t [s]: the mission reference (`reference.mission_reference`) tracked
+    by the cascade at heading 0. Returns (speeds, saturated, setpoint, thrust, reference)."""
+    reference = mission_reference(mission, segments, steps, t)
+    speeds, saturated, setpoint, thrust = cascade_update(constants, mixer, memory, t, state,
+                                                         reference, 0.0)
+    return speeds, saturated, setpoint, thrust, reference

@@ -1,0 +1,238 @@
+"""Formation control by virtual constraints (seed §3.2, Eq. 3.8-3.13): the force a follower's
+thrust should produce to keep its rows of g_vc (`constraints`) and the leader's altitude, and
+a follower's tick through the cascade (`cascade.command`). The law and its departures from
+the print are told in `multilift_control.formation.FormationFollower`'s docstring.
+
+constants: FOLLOWER_* slots, memory: FOLLOWER_INTEGRAL, _LAST_T, _LIFT, _YAW (layout);
+masses: the m_i of M_f,r (n,) [kg]; rows, targets: the constraint rows; states (n,
+UAV_STATE_SIZE) of every UAV, the leader (index 0) first; thrust_vectors (n, 3): each UAV's
+lift R_i e_z u_T,i, world [N]. World frame z up."""
+import math
+
+import numpy as np
+
+from multilift_control.laws import jit
+from multilift_control.laws.cascade import clipped, command, elapsed, thrust_axis
+from multilift_control.laws.constraints import (free_follower_motions, jacobian,
+                                                jacobian_rate_product, residual, row_rate,
+                                                rows_of)
+from multilift_control.laws.layout import (CASCADE_THRUST_COEFFICIENT,
+                                           FOLLOWER_ALTITUDE_OFFSET, FOLLOWER_BETA_SQ,
+                                           FOLLOWER_COMMANDED, FOLLOWER_FREE_MODE_GAIN,
+                                           FOLLOWER_GRAVITY, FOLLOWER_HOVER_MASS,
+                                           FOLLOWER_INTEGRAL, FOLLOWER_INTEGRAL_LIMIT,
+                                           FOLLOWER_KD_Z, FOLLOWER_KI_Z, FOLLOWER_KP_Z,
+                                           FOLLOWER_LAST_T, FOLLOWER_LIFT, FOLLOWER_LINEAR,
+                                           FOLLOWER_TWO_ALPHA, FOLLOWER_YAW, UAV_EULER,
+                                           UAV_POSITION, UAV_VELOCITY)
+from multilift_control.laws.linalg import minimum_norm_solve
+from multilift_control.laws.mixer import collective_thrust
+
+_FREE_TOL = 1e-9  # singular values of the followers' columns that count as zero (relative)
+
+
+@jit
+def virtual_forces(rows, targets, masses, gravity, two_alpha, beta_sq, positions, velocities,
+                   thrust_vectors):
+    """Virtual constraint forces u_vf = -J_vc^T Lambda_c (seed Eq. 3.8-3.12), world frame:
+    (u_vf (n, 3) [N], Lambda (m,) [N/m or N/m^2]). gravity g [m/s^2], two_alpha = 2 alpha_vc
+    [1/s], beta_sq = beta_vc^2 [1/s^2]; positions, velocities (n, 3).
+
+    With M = diag(m_i I_3), f_i = m_i g e_z (the weight moved to the left of Eq. 3.9, in the
+    z-up frame) and the formation dynamics M r_ddot + f + J^T Lambda = u (Eq. 3.9), Lambda makes
+    g_ddot + 2 alpha g_dot + beta^2 g = 0 (Eq. 3.8):
+
+        Lambda = (J M^-1 J^T)^-1 (J M^-1 (u - f) + J_dot r_dot + 2 alpha J r_dot + beta^2 g_vc)
+
+    Read from the print (Eq. 3.11-3.12): its M_c and J_c are M_f,r and J_vc; its "- c_c" is
+    + v_c, so the stabilised residual is g_vc itself (J r + v_c, Eq. 3.6); the J_dot r_dot term
+    is not printed (the V's rows are linear) and is added for the nonlinear rows.
+    J M^-1 J^T is singular when J_vc loses row rank: a distance row whose two UAVs coincide,
+    or circle rows whose UAVs are collinear; Lambda is then the least-squares, minimum-norm
+    solution (`linalg.minimum_norm_solve`)."""
+    n = positions.shape[0]
+    m = rows.shape[0]
+    jac = jacobian(rows, positions)
+    driven = np.empty(3 * n)  # M^-1 (u - f)
+    for j in range(n):
+        for axis in range(3):
+            weight = masses[j] * gravity if axis == 2 else 0.0  # f_j = m_j g e_z
+            driven[3 * j + axis] = (1.0 / masses[j]) * (thrust_vectors[j, axis] - weight)
+    g = residual(rows, targets, positions)
+    curvature = jacobian_rate_product(rows, velocities)
+    rhs = np.empty(m)  # Eq. 3.12
+    a = np.empty((m, m))  # J M^-1 J^T
+    for k in range(m):
+        pushed = 0.0
+        moving = 0.0
+        for c in range(3 * n):
+            pushed += jac[k, c] * driven[c]
+            moving += jac[k, c] * velocities[c // 3, c % 3]
+        rhs[k] = pushed + curvature[k] + two_alpha * moving + beta_sq * g[k]
+        for other in range(m):
+            total = 0.0
+            for c in range(3 * n):
+                total += jac[k, c] * (1.0 / masses[c // 3]) * jac[other, c]
+            a[k, other] = total
+    lam = minimum_norm_solve(a, rhs)
+    u_vf = np.zeros((n, 3))
+    for c in range(3 * n):
+        total = 0.0
+        for k in range(m):
+            total += jac[k, c] * lam[k]
+        u_vf[c // 3, c % 3] = -total
+    return u_vf, lam
+
+
+@jit
+def free_mode_correction(masses, gain, index, positions, velocities, thrust_vectors, rows):
+    """Horizontal force [N] (2,) for follower `index` that replaces, in the free follower
+    motions (`constraints.free_follower_motions`), the followers' forces u_j by
+    m_j (a_1 + k_f (v_1 - v_j)), a_1 = (u_1)_xy / m_1 the leader's horizontal thrust
+    acceleration (the weight is vertical), gain k_f [1/s]; zero without free motions. Not in
+    the seed: see FormationFollower."""
+    basis = free_follower_motions(rows, positions, _FREE_TOL)
+    correction = np.zeros(2)
+    if basis.shape[1] == 0:
+        return correction
+    n = positions.shape[0]
+    wanted = np.empty(2 * (n - 1))  # target - u over the followers' x, y
+    for j in range(1, n):
+        for axis in range(2):
+            leader_accel = thrust_vectors[0, axis] / masses[0]
+            target = masses[j] * (leader_accel + gain * (velocities[0, axis]
+                                                         - velocities[j, axis]))
+            wanted[2 * (j - 1) + axis] = target - thrust_vectors[j, axis]
+    for k in range(basis.shape[1]):
+        along = 0.0
+        for c in range(2 * (n - 1)):
+            along += basis[c, k] * wanted[c]
+        for axis in range(2):
+            correction[axis] += basis[2 * (index - 1) + axis, k] * along
+    return correction
+
+
+@jit
+def linear_virtual_force(constants, masses, law_p, law_q, index, positions, velocities, u,
+                         g):
+    """This follower's u_vf,i (3,) [N] for linear (and V) rows, where J_vc and M are constant:
+    u_vf,i = Q (M^-1 (u - f) + 2 alpha v) + beta^2 P g_vc (J_dot = 0), law_p = P (3, m),
+    law_q = Q (3, 3n) (FormationFollower._linear_law_matrices): O(n) per tick instead of the
+    O(n^3) solve of `virtual_forces`. g: g_vc (m,)."""
+    n = positions.shape[0]
+    gravity = constants[FOLLOWER_GRAVITY]
+    driven = np.empty(3 * n)  # M^-1 (u - f) + 2 alpha v
+    for j in range(n):
+        for axis in range(3):
+            weight = masses[j] * gravity if axis == 2 else 0.0  # f_j = m_j g e_z
+            driven[3 * j + axis] = ((1.0 / masses[j]) * (u[j, axis] - weight)
+                                    + constants[FOLLOWER_TWO_ALPHA] * velocities[j, axis])
+    out = np.empty(3)
+    for axis in range(3):
+        pushed = 0.0
+        for c in range(3 * n):
+            pushed += law_q[axis, c] * driven[c]
+        held = 0.0
+        for k in range(g.shape[0]):
+            held += law_p[axis, k] * g[k]
+        out[axis] = pushed + constants[FOLLOWER_BETA_SQ] * held
+    return out
+
+
+@jit
+def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory, t, states,
+                   thrust_vectors):
+    """(F world [N] (3,), this follower's rows of g_vc [m or m^2], their rates [m/s or
+    m^2/s]) at t [s]: the force the thrust should produce before Eq. 3.13, and the altitude
+    integral advanced in memory.
+
+    horizontal: F_xy = (u_i + u_vf,i)_xy (+ `free_mode_correction` with FOLLOWER_FREE_MODE_GAIN
+    on and nonlinear rows: linear rows have no free motions), u_i the lift asked at the last
+    tick when FOLLOWER_COMMANDED (memory), else thrust_vectors[i]; vertical: the altitude loop
+    to z_1 + FOLLOWER_ALTITUDE_OFFSET."""
+    n = states.shape[0]
+    positions = np.empty((n, 3))
+    velocities = np.empty((n, 3))
+    for j in range(n):
+        for axis in range(3):
+            positions[j, axis] = states[j, UAV_POSITION + axis]
+            velocities[j, axis] = states[j, UAV_VELOCITY + axis]
+    u = thrust_vectors.copy()
+    if constants[FOLLOWER_COMMANDED] != 0.0 and not math.isnan(memory[FOLLOWER_LIFT]):
+        for axis in range(3):
+            u[index, axis] = memory[FOLLOWER_LIFT + axis]
+    g = residual(rows, targets, positions)
+    force = np.empty(3)
+    if constants[FOLLOWER_LINEAR] != 0.0:
+        u_vf = linear_virtual_force(constants, masses, law_p, law_q, index, positions,
+                                    velocities, u, g)
+        for axis in range(2):
+            force[axis] = u[index, axis] + u_vf[axis]
+    else:
+        u_vf_all, _ = virtual_forces(rows, targets, masses, constants[FOLLOWER_GRAVITY],
+                                     constants[FOLLOWER_TWO_ALPHA], constants[FOLLOWER_BETA_SQ],
+                                     positions, velocities, u)
+        for axis in range(2):
+            force[axis] = u[index, axis] + u_vf_all[index, axis]
+        gain = constants[FOLLOWER_FREE_MODE_GAIN]
+        if not math.isnan(gain):  # not in the seed: see FormationFollower
+            correction = free_mode_correction(masses, gain, index, positions, velocities, u,
+                                              rows)
+            for axis in range(2):
+                force[axis] += correction[axis]
+    dt = elapsed(memory, FOLLOWER_LAST_T, t)
+    # z_d,i = z_1 (seed §3.2, after Eq. 3.13), a reference the outer loop updates each tick:
+    # the damping acts on the follower's own climb rate, not on z_1_dot - z_i_dot, hence
+    # the follower's lag in the climb (§4.3, Fig. 4.7) and the leader's larger thrust
+    # (Fig. 4.8)
+    error = positions[0, 2] + constants[FOLLOWER_ALTITUDE_OFFSET] - positions[index, 2]
+    error_rate = -velocities[index, 2]
+    memory[FOLLOWER_INTEGRAL] = clipped(
+        memory[FOLLOWER_INTEGRAL] + constants[FOLLOWER_KI_Z] * error * dt,
+        constants[FOLLOWER_INTEGRAL_LIMIT])
+    force[2] = constants[FOLLOWER_HOVER_MASS] * (
+        constants[FOLLOWER_GRAVITY] + constants[FOLLOWER_KP_Z] * error
+        + constants[FOLLOWER_KD_Z] * error_rate + memory[FOLLOWER_INTEGRAL])
+    own = rows_of(rows, index)
+    errors = np.empty(own.shape[0])
+    rates = np.empty(own.shape[0])
+    for k in range(own.shape[0]):
+        errors[k] = g[own[k]]
+        rates[k] = row_rate(rows, positions, velocities, own[k])
+    return force, errors, rates
+
+
+@jit
+def follower_update(constants, masses, rows, targets, law_p, law_q, index, memory, t, states,
+                    thrust_vectors, cascade_constants, mixer):
+    """One follower's tick at t [s]: `follower_force`, Eq. 3.13 and the cascade's attitude loop
+    and mixer at the held heading (memory FOLLOWER_YAW: the one measured at the first tick when
+    NaN), and the lift the rotors give after saturation along the thrust axis asked for, kept
+    in memory (FOLLOWER_LIFT). cascade_constants: CASCADE_* slots, mixer: MIXER_* rows.
+    Returns (speeds [rad/s], saturated, setpoint [rad], thrust [N], rows of g_vc, their
+    rates)."""
+    if math.isnan(memory[FOLLOWER_YAW]):
+        memory[FOLLOWER_YAW] = states[index, UAV_EULER + 2]  # hold the initial heading
+    force, errors, rates = follower_force(constants, masses, rows, targets, law_p, law_q,
+                                          index, memory, t, states, thrust_vectors)
+    speeds, saturated, setpoint, thrust = command(cascade_constants, mixer, states[index],
+                                                  force, memory[FOLLOWER_YAW])
+    lifted = collective_thrust(cascade_constants[CASCADE_THRUST_COEFFICIENT], speeds)
+    axis = thrust_axis(setpoint[0], setpoint[1], setpoint[2])
+    for k in range(3):
+        memory[FOLLOWER_LIFT + k] = axis[k] * lifted
+    return speeds, saturated, setpoint, thrust, errors, rates
+
+
+@jit
+def lift_vectors(states, thrusts):
+    """Every UAV's lift R_j e_z u_T,j, world [N] (n, 3), of the states' attitudes and the
+    collective thrusts u_T,j [N] (n,): the thrust vectors u_f,r of Eq. 3.9-3.12."""
+    n = states.shape[0]
+    out = np.empty((n, 3))
+    for j in range(n):
+        axis = thrust_axis(states[j, UAV_EULER], states[j, UAV_EULER + 1],
+                           states[j, UAV_EULER + 2])
+        for k in range(3):
+            out[j, k] = axis[k] * thrusts[j]
+    return out

@@ -1,0 +1,90 @@
+"""The named slots of every array the control laws read and write, in one place.
+
+A law's constants (gains, masses, limits) are one float array per controller, built once from
+the scenario; its memory (integrals, the time of the last tick, a follower's last lift and
+held heading) one small float array it updates in place, NaN standing for "none yet". The
+formation's measured states are one (n, UAV_STATE_SIZE) array, a UAV a row. Units: SI, angles
+[rad], world frame z up, body FLU (docs/conventions.md).
+"""
+
+# --- a UAV's measured state: one row of the formation's states (n, UAV_STATE_SIZE) ------------
+UAV_POSITION = 0       # (3) world [m]
+UAV_VELOCITY = 3       # (3) world [m/s]
+UAV_EULER = 6          # (3) roll, pitch, yaw [rad]
+UAV_BODY_RATES = 9     # (3) body angular velocity, FLU [rad/s]
+UAV_STATE_SIZE = 12
+
+# --- the mission reference a leader tracks (reference.mission_reference's result) -------------
+REFERENCE_POSITION = 0      # (3) [m]
+REFERENCE_VELOCITY = 3      # (3) [m/s]
+REFERENCE_ACCELERATION = 6  # (3) [m/s^2]
+REFERENCE_SIZE = 9
+# the mission's constants
+MISSION_START = 0   # (3) position at t = 0 [m]
+MISSION_FINAL = 3   # (3) position after the last segment [m]
+MISSION_OMEGA = 6   # 1 / tau of the reference prefilter [1/s]; 0: the raw path
+MISSION_SIZE = 7
+# the mission's segments, a row each (segments, SEGMENT_SIZE)
+SEGMENT_START_TIME = 0  # [s]
+SEGMENT_END_TIME = 1    # [s]
+SEGMENT_VELOCITY = 2    # (3) [m/s]
+SEGMENT_ORIGIN = 5      # (3) position at the segment's start [m]
+SEGMENT_SIZE = 8
+# its velocity steps (the first from rest at t = 0, the last the stop), a row each
+STEP_TIME = 0   # [s]
+STEP_DV = 1     # (3) velocity step [m/s]
+STEP_SIZE = 4
+
+# --- the cascade (CascadeController): constants ------------------------------------------------
+CASCADE_KP = 0                 # (3) position gains [1/s^2]
+CASCADE_KD = 3                 # (3) [1/s]
+CASCADE_KI = 6                 # (3) [1/s^3]
+CASCADE_INTEGRAL_LIMIT = 9     # |integral| bound per axis [m/s^2]
+CASCADE_HOVER_MASS = 10        # the UAV and its payload share [kg]
+CASCADE_GRAVITY = 11           # [m/s^2]
+CASCADE_MAX_TILT = 12          # [rad]
+CASCADE_INERTIA = 13           # (3) principal moments [kg m^2]
+CASCADE_ATT_KP = 16            # (3) attitude gains [1/s^2]
+CASCADE_ATT_KD = 19            # (3) [1/s]
+CASCADE_SQUARE_MIN = 22        # omega_min^2 [rad^2/s^2]
+CASCADE_SQUARE_MAX = 23        # omega_max^2 [rad^2/s^2]
+CASCADE_THRUST_COEFFICIENT = 24  # k_T [N s^2/rad^2]
+CASCADE_SIZE = 25
+# its memory
+CASCADE_INTEGRAL = 0   # (3) position loop integral [m/s^2]
+CASCADE_LAST_T = 3     # time of the last tick [s] (NaN: none yet)
+CASCADE_MEMORY_SIZE = 4
+
+# --- the rotor mixer: a row per rotor (n_rotors, MIXER_SIZE) -----------------------------------
+MIXER_WRENCH = 0       # (4) its row of the allocation's pseudo-inverse: omega^2 [rad^2/s^2] per
+#                        newton of u_T and per N m of each body torque
+MIXER_COLLECTIVE = 4   # omega^2 per newton of collective thrust [rad^2/(s^2 N)]
+MIXER_SIZE = 5
+
+# --- the virtual constraint rows g_vc: a row each (m, ROW_SIZE) of ints ------------------------
+ROW_FIRST = 0    # UAV index i of the row (0 = the leader)
+ROW_SECOND = 1   # UAV index j
+ROW_AXIS = 2     # linear row: the axis of (r_i - r_j)_axis - target [m]; ROW_DISTANCE: squared
+ROW_SIZE = 3     # distance |r_i - r_j|^2 - target^2 [m^2]
+ROW_DISTANCE = -1
+
+# --- a follower (FormationFollower): constants -------------------------------------------------
+FOLLOWER_TWO_ALPHA = 0          # 2 alpha_vc [1/s]
+FOLLOWER_BETA_SQ = 1            # beta_vc^2 [1/s^2]
+FOLLOWER_ALTITUDE_OFFSET = 2    # z_d,i - z_1 [m]
+FOLLOWER_HOVER_MASS = 3         # [kg]
+FOLLOWER_GRAVITY = 4            # [m/s^2]
+FOLLOWER_KP_Z = 5               # altitude loop gains [1/s^2]
+FOLLOWER_KD_Z = 6               # [1/s]
+FOLLOWER_KI_Z = 7               # [1/s^3]
+FOLLOWER_INTEGRAL_LIMIT = 8     # [m/s^2]
+FOLLOWER_COMMANDED = 9          # 1: u_i is the lift asked at the last tick; 0: as measured
+FOLLOWER_FREE_MODE_GAIN = 10    # k_f [1/s] (NaN: off)
+FOLLOWER_LINEAR = 11            # 1: linear (and V) rows, the O(n) law of constant matrices
+FOLLOWER_SIZE = 12
+# its memory
+FOLLOWER_INTEGRAL = 0   # altitude loop integral [m/s^2]
+FOLLOWER_LAST_T = 1     # time of the last tick [s] (NaN: none yet)
+FOLLOWER_LIFT = 2       # (3) the lift asked at the last tick R(eta_d) e_z u_T, world [N] (NaN)
+FOLLOWER_YAW = 5        # the heading held [rad] (NaN: the one measured at the first tick)
+FOLLOWER_MEMORY_SIZE = 6

@@ -1,0 +1,55 @@
+"""Body wrench -> rotor speeds with saturation (the inverse of seed Eq. 2.14, Eq. 2.15), and
+the collective thrust of rotor speeds (Eq. 2.9)."""
+import numpy as np
+
+from multilift_control.laws import jit
+from multilift_control.laws.layout import MIXER_COLLECTIVE, MIXER_WRENCH
+
+
+@jit
+def rotor_speeds(mixer, square_min, square_max, wrench):
+    """(omega (n_rotors,) [rad/s], saturated (n_rotors,) bool) for wrench = (u_T [N], body
+    torque (3) [N m]); mixer (n_rotors, MIXER_SIZE), square_min/max = omega_min^2, omega_max^2
+    [rad^2/s^2].
+
+    Attitude comes first: when a rotor would leave [omega_min, omega_max], the collective part
+    is shifted (equal omega^2 on every rotor changes thrust only) to bring the request inside;
+    what still does not fit is clipped. `saturated` flags the rotors whose request was out of
+    range."""
+    n_rotors = mixer.shape[0]
+    request = np.empty(n_rotors)
+    saturated = np.empty(n_rotors, dtype=np.bool_)
+    highest = lowest = 0  # np.argmax, np.argmin: the first of equals
+    for k in range(n_rotors):
+        total = 0.0
+        for j in range(4):
+            total += mixer[k, MIXER_WRENCH + j] * wrench[j]
+        request[k] = total
+        saturated[k] = total > square_max or total < square_min
+        if total > request[highest]:
+            highest = k
+        if total < request[lowest]:
+            lowest = k
+    high, low = request[highest], request[lowest]
+    if high > square_max or low < square_min:
+        if high - low <= square_max - square_min:
+            # shift along the collective direction until every rotor fits
+            above = (high - square_max) / mixer[highest, MIXER_COLLECTIVE]
+            below = (square_min - low) / mixer[lowest, MIXER_COLLECTIVE]
+            shift = -above if above > 0 else (below if below > 0 else 0.0)
+            for k in range(n_rotors):
+                request[k] = request[k] + shift * mixer[k, MIXER_COLLECTIVE]
+        for k in range(n_rotors):
+            request[k] = min(max(request[k], square_min), square_max)
+    return np.sqrt(request), saturated
+
+
+@jit
+def collective_thrust(thrust_coefficient, speeds):
+    """u_T = k_T sum_k omega_k^2 [N] (seed Eq. 2.9) of rotor speeds [rad/s], k_T [N s^2/rad^2].
+    Summed in order: numpy's sum of fewer than 8 terms (multirotor.collective_thrust) to the
+    bit; an octo's may differ in the last bit (numpy sums 8 or more pairwise)."""
+    total = 0.0
+    for k in range(speeds.shape[0]):
+        total += speeds[k] * speeds[k]
+    return thrust_coefficient * total

@@ -1,8 +1,8 @@
 """The formulations of the formation DAE a scenario can name (`simulation.integrator`).
 
 Every formulation has the same interface (`Formulation`): the simulation loop calls
-`integrate` once per control period, whatever the formulation and whatever kernel (plain
-floats or numpy arrays) it uses inside, and reads the reporting queries. A new formulation is
+`integrate` once per control period, whatever the formulation and however it computes
+(compiled physics functions, numpy), and reads the reporting queries. A new formulation is
 a class with these methods, added to `FORMULATIONS` under its scenario name.
 """
 from __future__ import annotations

@@ -1,12 +1,10 @@
-"""The float kernel of FormationModel (`_solve_floats`, `rk4_floats`, `_residuals_floats`)
-compiled with numba: the same arithmetic in the same order, one control period per call.
+"""Loading the numba-compiled functions: the physics (multilift_sim.physics, each function's
+uncompiled run the reference: `uncompiled`, `runnable`) and the control laws
+(multilift_control._numba_laws, their methods the reference). `compiled_module` loads a module
+of compiled functions in one of two forms, under MULTILIFT_KERNEL:
 
-The pure-Python kernel in dynamics.py stays the reference (tests/test_kernels.py holds them
-equal). `compiled_module` loads a module of compiled functions (this kernel,
-multilift_sim._numba_kernel, and the control laws', multilift_control._numba_laws) in one of
-two forms, under MULTILIFT_KERNEL:
-
-- ahead of time (`build_ahead_of_time`, run by scripts/setup): numba's pycc compiles the
+- ahead of time (`build_ahead_of_time`, run by scripts/setup for a module with an
+  `AHEAD_OF_TIME` dict; the physics has none yet): numba's pycc compiles the
   module's `AHEAD_OF_TIME` functions into a plain extension module under
   `$XDG_CACHE_HOME/multilift/aot` (`~/.cache/multilift/aot`), its file named by a hash of the
   module's source, Python and numpy, so a changed source is never served stale code. It loads
@@ -43,7 +41,7 @@ _cache_home = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
 os.environ.setdefault('NUMBA_CACHE_DIR', str(Path(_cache_home) / 'multilift' / 'numba'))
 
 VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), aot, jit or python: see the docstring
-PHYSICS = 'multilift_sim._numba_kernel'  # this kernel's compiled module
+PHYSICS = 'multilift_sim.physics.formation_dae'  # the physics' compiled module (the DAE)
 MODES = ('auto', 'aot', 'jit', 'python')
 AHEAD_OF_TIME_DIR = Path(_cache_home) / 'multilift' / 'aot'
 _BUILD_FORMAT = 2  # of the files build_ahead_of_time writes: part of their names
@@ -60,9 +58,17 @@ def mode() -> str:
 
 
 def enabled() -> bool:
-    """Whether the compiled kernel is to be used (built or numba importable, not switched
+    """Whether the compiled physics is to be used (built or numba importable, not switched
     off)."""
     return compiled_module(PHYSICS) is not None
+
+
+def runnable(function: Callable) -> Callable:
+    """A compiled function of a module of compiled functions (a numba dispatcher, or a plain
+    function where numba does not import), as MULTILIFT_KERNEL says: its module's compiled
+    function (`compiled_module`), else its uncompiled run (`uncompiled`)."""
+    module = compiled_module(function.__module__)
+    return uncompiled(function) if module is None else getattr(module, function.__name__)
 
 
 def compiled_module(name: str) -> Any:
@@ -248,28 +254,3 @@ def _import_numba_quietly() -> None:
         for name in hidden:
             if sys.modules.get(name, False) is None:
                 del sys.modules[name]
-
-
-def model_constants(model) -> tuple:
-    """The arrays and scalars the kernel reads from a FormationModel (float kernel)."""
-    params = model.params
-    uavs = np.array(model._uav_constants, dtype=float).reshape(-1, 8)
-    gusts = np.array([(*g.center, *g.direction, g.gradient_distance, g.reference_speed)
-                      for g in params.gusts], dtype=float).reshape(-1, 7)
-    return (uavs, gusts, float(model.payload_mass), float(model._inv_payload_mass),
-            float(model.gravity), float(model._two_alpha), float(model._beta_sq),
-            bool(model._has_drag), float(params.payload_drag_coefficient))
-
-
-def integrator() -> Callable:
-    """The compiled `integrate_period`, for one caller to keep (each keeps its own checked
-    function: `_AheadOfTimeModule`); after `enabled()` said yes."""
-    return compiled_module(PHYSICS).integrate_period
-
-
-def integrate(kernel: Callable, constants: tuple, x: np.ndarray, wrenches: np.ndarray,
-              dt: float, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """`steps` RK4 steps of dt [s] from x with `kernel` (`integrator()`) and the model's
-    `constants` (`model_constants`): (state, multipliers at x, g, g_dot at the end)."""
-    return kernel(*constants, np.ascontiguousarray(x, dtype=np.float64),
-                  np.ascontiguousarray(wrenches, dtype=np.float64), float(dt), int(steps))

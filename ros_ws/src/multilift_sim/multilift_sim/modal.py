@@ -271,7 +271,7 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
     # still air, exact index-reduced DAE: drag (zero slope at rest) and gusts out, no Baumgarte
     still = dataclasses.replace(params, gusts=(), payload_drag_coefficient=0.0,
                                 baumgarte_alpha=0.0, baumgarte_beta=0.0)
-    model = FormationModel(still, kernel='numpy')
+    model = FormationModel(still)
     layout = model.layout
     x_e = np.asarray(equilibrium.state, dtype=float)
     size = layout.n_coordinates

@@ -1,0 +1,284 @@
+"""The formation DAE (seed Eq. 2.41-2.70) on one formation's arrays: the payload's drag and
+gusts, the solve for q_ddot and the cable multipliers, RK4 over a control period, the
+constraint residuals. World frame (z up), SI units; the array slots are `physics.layout`'s.
+
+Arguments shared by the functions: ``x`` the state (2 (6n + 3),); ``wrenches`` (n,
+WRENCH_COLUMNS) the body wrenches (u_T [N], tau [N m], FLU), held; ``uavs`` (n, UAV_COLUMNS),
+``gusts`` (k, GUST_COLUMNS) and ``formation`` (FORMATION_SCALARS,) the constants;
+``taut`` (n,) bool: which cables are constraints (a slack cable has multiplier 0 and leaves
+UAV i and the payload free of each other); ``cables`` (n, CABLE_COLUMNS) and ``work``
+(WORK_ROWS, 2 (6n + 3)) scratch.
+
+The equations (dynamics.py's docstring): with f the unconstrained forces,
+``Lambda = (G M^-1 G^T)^-1 (G M^-1 f + G_dot q_dot + 2 alpha_f g_dot + beta_f^2 g)`` and
+``q_ddot = M^-1 (f - G^T Lambda)`` (Eq. 2.60/2.70 with the signs gathered), never forming
+the (6n+3)^2 matrices: each UAV's attitude on its own, and the n x n cable system by the
+Woodbury identity (`cable_multipliers`).
+"""
+import math
+
+import numpy as np
+
+from multilift_sim.physics._jit import jit
+from multilift_sim.physics.layout import (
+    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST, EULER,
+    FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
+    FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, GUST_CENTER, GUST_DIRECTION,
+    GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, PAYLOAD_COORDINATES, POSITION, UAV_GYRO,
+    UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS, UAV_COORDINATES, WORK_ACC, WORK_K1, WORK_K2,
+    WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE, WRENCH_THRUST, WRENCH_TORQUE)
+
+
+@jit
+def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
+    """Drag (gusts included) on the payload over m_p [m/s^2], world, gravity excluded: at
+    payload position (px, py, pz) [m] and velocity (pvx, pvy, pvz) [m/s]. (The numpy form
+    is disturbances.payload_drag and gust_velocity; tests hold them equal.)"""
+    drag = formation[FORMATION_DRAG]
+    if drag <= 0.0:
+        return 0.0, 0.0, 0.0
+    air_x = air_y = air_z = 0.0
+    for k in range(gusts.shape[0]):
+        # 1-cosine gust (Eq. 2.55): r the horizontal distance from its centre
+        radius = math.hypot(px - gusts[k, GUST_CENTER], py - gusts[k, GUST_CENTER + 1])
+        h = gusts[k, GUST_GRADIENT_DISTANCE]
+        if radius > h:
+            speed = 0.0
+        else:
+            speed = 0.5 * gusts[k, GUST_REFERENCE_SPEED] * (1.0 + math.cos(math.pi * radius / h))
+        if speed != 0.0:
+            air_x += speed * gusts[k, GUST_DIRECTION]
+            air_y += speed * gusts[k, GUST_DIRECTION + 1]
+            air_z += speed * gusts[k, GUST_DIRECTION + 2]
+    rel_x, rel_y, rel_z = pvx - air_x, pvy - air_y, pvz - air_z
+    # Eq. 2.53 on the air-relative velocity: -c_pd v_rel |v_rel| / m_p
+    scale = (-drag * formation[FORMATION_INV_PAYLOAD_MASS]
+             * math.sqrt(rel_x * rel_x + rel_y * rel_y + rel_z * rel_z))
+    return scale * rel_x, scale * rel_y, scale * rel_z
+
+
+@jit
+def cable_multipliers(cables, payload_mass, taut, out):
+    """Solve ``A_TT z = b_T`` over the taut cables T, z = 0 on the others, into out (n,):
+    A = G M^-1 G^T (Eq. 2.60) from each cable's row of `cables` (CABLE_OFFSET d_i [m],
+    CABLE_INV_DELTA, CABLE_RHS b_i), payload_mass m_p [kg].
+
+    The Woodbury identity on ``A = Delta + 4 D D^T / m_p`` with ``Delta = diag(delta_i)``,
+    ``delta_i = 4 |d_i|^2 / m_i``: ``A^-1 b = Delta^-1 (b - D y)`` where
+    ``S y = D^T Delta^-1 b`` and ``S = m_p/4 I + sum_i d_i d_i^T / delta_i``
+    = ``(m_p I + sum_i m_i e_i e_i^T) / 4`` (e_i the cable directions): a 3 x 3 system, the
+    payload's effective mass, always invertible (m_p / 4 I with every cable slack)."""
+    n = cables.shape[0]
+    # S (symmetric, entries s_jk) and its right-hand side D^T Delta^-1 b (sb_j)
+    s00 = s11 = s22 = 0.25 * payload_mass
+    s01 = s02 = s12 = sb0 = sb1 = sb2 = 0.0
+    for i in range(n):
+        if not taut[i]:
+            continue
+        dx, dy, dz = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
+            cables[i, CABLE_OFFSET + 2]
+        inv_delta = cables[i, CABLE_INV_DELTA]
+        s00 += dx * dx * inv_delta
+        s01 += dx * dy * inv_delta
+        s02 += dx * dz * inv_delta
+        s11 += dy * dy * inv_delta
+        s12 += dy * dz * inv_delta
+        s22 += dz * dz * inv_delta
+        weighted_rhs = cables[i, CABLE_RHS] * inv_delta
+        sb0 += dx * weighted_rhs
+        sb1 += dy * weighted_rhs
+        sb2 += dz * weighted_rhs
+    # y = S^-1 sb by the adjugate of the symmetric 3 x 3 S
+    c00 = s11 * s22 - s12 * s12
+    c01 = s02 * s12 - s01 * s22
+    c02 = s01 * s12 - s02 * s11
+    c11 = s00 * s22 - s02 * s02
+    c12 = s01 * s02 - s00 * s12
+    c22 = s00 * s11 - s01 * s01
+    inv_det = 1.0 / (s00 * c00 + s01 * c01 + s02 * c02)
+    y0 = (c00 * sb0 + c01 * sb1 + c02 * sb2) * inv_det
+    y1 = (c01 * sb0 + c11 * sb1 + c12 * sb2) * inv_det
+    y2 = (c02 * sb0 + c12 * sb1 + c22 * sb2) * inv_det
+    for i in range(n):
+        if taut[i]:
+            out[i] = (cables[i, CABLE_RHS] - cables[i, CABLE_OFFSET] * y0
+                      - cables[i, CABLE_OFFSET + 1] * y1
+                      - cables[i, CABLE_OFFSET + 2] * y2) * cables[i, CABLE_INV_DELTA]
+        else:
+            out[i] = 0.0
+
+
+@jit
+def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
+    """q_ddot into acc (6n + 3,) [m/s^2, rad/s^2] and the cable multipliers Lambda into
+    multipliers (n,) [N/m] at state x (seed Eq. 2.60, 2.70), only the `taut` cables
+    constrained. Rotor speeds enter as the held body wrenches."""
+    n = uavs.shape[0]
+    p = UAV_COORDINATES * n
+    nq = p + PAYLOAD_COORDINATES
+    px, py, pz = x[p], x[p + 1], x[p + 2]
+    pvx, pvy, pvz = x[nq + p], x[nq + p + 1], x[nq + p + 2]
+    drag_ax, drag_ay, drag_az = payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts,
+                                                       formation)
+    two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
+    gravity = formation[FORMATION_GRAVITY]
+    for i in range(n):
+        mass, length_sq = uavs[i, UAV_MASS], uavs[i, UAV_LENGTH_SQ]
+        inv_ixx, inv_iyy = uavs[i, UAV_INV_INERTIA], uavs[i, UAV_INV_INERTIA + 1]
+        inv_izz = uavs[i, UAV_INV_INERTIA + 2]
+        gyro_x, gyro_y, gyro_z = uavs[i, UAV_GYRO], uavs[i, UAV_GYRO + 1], uavs[i, UAV_GYRO + 2]
+        r = UAV_COORDINATES * i + POSITION
+        e = UAV_COORDINATES * i + EULER
+        rx, ry, rz = x[r], x[r + 1], x[r + 2]
+        phi, theta, psi = x[e], x[e + 1], x[e + 2]
+        vx, vy, vz = x[nq + r], x[nq + r + 1], x[nq + r + 2]
+        phi_dot, theta_dot, psi_dot = x[nq + e], x[nq + e + 1], x[nq + e + 2]
+        thrust = wrenches[i, WRENCH_THRUST]
+        torque_x, torque_y = wrenches[i, WRENCH_TORQUE], wrenches[i, WRENCH_TORQUE + 1]
+        torque_z = wrenches[i, WRENCH_TORQUE + 2]
+        s_phi, c_phi = math.sin(phi), math.cos(phi)
+        s_theta, c_theta = math.sin(theta), math.cos(theta)
+        s_psi, c_psi = math.sin(psi), math.cos(psi)
+
+        # Attitude: omega = W eta_dot (Eq. 2.7), Euler's equation J omega_dot = tau - omega x
+        # J omega per axis (omega_dot_x = tau_x / I_xx - (I_zz - I_yy) / I_xx omega_y omega_z,
+        # cyclically), then eta_ddot = W^-1 (omega_dot - W_dot eta_dot) (Eq. 2.8) -- the same
+        # as M_eta^-1 (W^T tau - C_eta eta_dot), see multirotor.py; W_dot from
+        # kinematics.euler_rate_matrix_dot.
+        c_theta_psi_dot = c_theta * psi_dot
+        omega_x = phi_dot - s_theta * psi_dot
+        omega_y = c_phi * theta_dot + s_phi * c_theta_psi_dot
+        omega_z = c_phi * c_theta_psi_dot - s_phi * theta_dot
+        s_theta_theta_psi_dot = s_theta * theta_dot * psi_dot
+        w_eta_ddot_x = (torque_x * inv_ixx - gyro_x * omega_y * omega_z
+                        + c_theta_psi_dot * theta_dot)
+        w_eta_ddot_y = (torque_y * inv_iyy - gyro_y * omega_z * omega_x
+                        - phi_dot * omega_z + s_phi * s_theta_theta_psi_dot)
+        w_eta_ddot_z = (torque_z * inv_izz - gyro_z * omega_x * omega_y
+                        + phi_dot * omega_y + c_phi * s_theta_theta_psi_dot)
+        yaw_part = s_phi * w_eta_ddot_y + c_phi * w_eta_ddot_z         # W^-1 of Eq. 2.8
+        acc[e] = w_eta_ddot_x + s_theta / c_theta * yaw_part
+        acc[e + 1] = c_phi * w_eta_ddot_y - s_phi * w_eta_ddot_z
+        acc[e + 2] = yaw_part / c_theta
+
+        # Unconstrained translational acceleration: thrust along R e_z (Eq. 2.6, 2.20).
+        # Gravity is common to every body, so it cancels in a_p - a_i; it is added at the end.
+        thrust_per_mass = thrust / mass
+        s_theta_c_phi = s_theta * c_phi
+        thrust_ax = (c_psi * s_theta_c_phi + s_psi * s_phi) * thrust_per_mass
+        thrust_ay = (s_psi * s_theta_c_phi - c_psi * s_phi) * thrust_per_mass
+        thrust_az = c_theta * c_phi * thrust_per_mass
+
+        # cable i: d = r_p - r_i, its rate, and row i of the multiplier equation (Eq. 2.60)
+        dx, dy, dz = px - rx, py - ry, pz - rz
+        dvx, dvy, dvz = pvx - vx, pvy - vy, pvz - vz
+        offset_sq = dx * dx + dy * dy + dz * dz
+        cables[i, CABLE_RHS] = (
+            2.0 * (dx * (drag_ax - thrust_ax) + dy * (drag_ay - thrust_ay)
+                   + dz * (drag_az - thrust_az))                       # G M^-1 f
+            + 2.0 * (dvx * dvx + dvy * dvy + dvz * dvz)                # G_dot q_dot
+            + two_alpha * 2.0 * (dx * dvx + dy * dvy + dz * dvz)       # 2 alpha_f g_dot
+            + beta_sq * (offset_sq - length_sq))                       # beta_f^2 g
+        # G M^-1 G^T = diag(4 |d_i|^2 / m_i) + 4 D D^T / m_p: 1 / delta_i of the diagonal
+        cables[i, CABLE_INV_DELTA] = 0.25 * mass / offset_sq
+        cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], cables[i, CABLE_OFFSET + 2] = \
+            dx, dy, dz
+        cables[i, CABLE_THRUST], cables[i, CABLE_THRUST + 1], cables[i, CABLE_THRUST + 2] = \
+            thrust_ax, thrust_ay, thrust_az
+    cable_multipliers(cables, formation[FORMATION_PAYLOAD_MASS], taut, multipliers)
+    # q_ddot = M^-1 (f - G^T Lambda): UAV i gets +2 lambda_i d_i / m_i, the payload
+    # -2 sum_i lambda_i d_i / m_p.
+    sum_x = sum_y = sum_z = 0.0
+    for i in range(n):
+        dx, dy, dz = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
+            cables[i, CABLE_OFFSET + 2]
+        multiplier = multipliers[i]
+        pull = 2.0 * multiplier / uavs[i, UAV_MASS]
+        r = UAV_COORDINATES * i + POSITION
+        acc[r] = cables[i, CABLE_THRUST] + pull * dx
+        acc[r + 1] = cables[i, CABLE_THRUST + 1] + pull * dy
+        acc[r + 2] = cables[i, CABLE_THRUST + 2] + pull * dz - gravity
+        sum_x += multiplier * dx
+        sum_y += multiplier * dy
+        sum_z += multiplier * dz
+    pull = 2.0 * formation[FORMATION_INV_PAYLOAD_MASS]
+    acc[p] = drag_ax - pull * sum_x
+    acc[p + 1] = drag_ay - pull * sum_y
+    acc[p + 2] = drag_az - pull * sum_z - gravity
+
+
+@jit
+def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, work, cables):
+    """One classic RK4 step of h [s] from x with the wrenches held, into out (which may be
+    x); the multipliers [N/m] of its first stage (at x) into multipliers (n,)."""
+    n = uavs.shape[0]
+    nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
+    size = 2 * nq
+    half, sixth = 0.5 * h, h / 6.0
+    k1, k2, k3, k4 = work[WORK_K1], work[WORK_K2], work[WORK_K3], work[WORK_K4]
+    stage, acc = work[WORK_STAGE], work[WORK_ACC]
+    later = work[WORK_MULTIPLIERS, :n]
+    solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
+    for j in range(nq):  # k = (q_dot, q_ddot): the state derivative
+        k1[j] = x[nq + j]
+        k1[nq + j] = acc[j]
+    for j in range(size):
+        stage[j] = x[j] + half * k1[j]
+    solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
+    for j in range(nq):
+        k2[j] = stage[nq + j]
+        k2[nq + j] = acc[j]
+    for j in range(size):
+        stage[j] = x[j] + half * k2[j]
+    solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
+    for j in range(nq):
+        k3[j] = stage[nq + j]
+        k3[nq + j] = acc[j]
+    for j in range(size):
+        stage[j] = x[j] + h * k3[j]
+    solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
+    for j in range(nq):
+        k4[j] = stage[nq + j]
+        k4[nq + j] = acc[j]
+    for j in range(size):
+        out[j] = x[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
+
+
+@jit
+def residuals(x, uavs, g, g_dot):
+    """g_i = |r_p - r_i|^2 - l_i^2 [m^2] (Eq. 2.42) into g (n,) and g_dot_i =
+    2 (r_p - r_i) . (v_p - v_i) [m^2/s] (Eq. 2.56) into g_dot (n,), at state x."""
+    n = uavs.shape[0]
+    p = UAV_COORDINATES * n
+    nq = p + PAYLOAD_COORDINATES
+    for i in range(n):
+        b = UAV_COORDINATES * i + POSITION
+        dx = x[p] - x[b]
+        dy = x[p + 1] - x[b + 1]
+        dz = x[p + 2] - x[b + 2]
+        dvx = x[nq + p] - x[nq + b]
+        dvy = x[nq + p + 1] - x[nq + b + 1]
+        dvz = x[nq + p + 2] - x[nq + b + 2]
+        g[i] = dx * dx + dy * dy + dz * dz - uavs[i, UAV_LENGTH_SQ]
+        g_dot[i] = 2.0 * (dx * dvx + dy * dvy + dz * dvz)
+
+
+@jit
+def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
+    """`steps` RK4 steps of dt [s] from x with the wrenches held (one control period of seed
+    Algorithm 1), the `taut` cables constrained: (the state at the end, the multipliers
+    [N/m] at x, g [m^2] and g_dot [m^2/s] at the end). x is not written."""
+    n = uavs.shape[0]
+    size = 2 * (UAV_COORDINATES * n + PAYLOAD_COORDINATES)
+    work = np.empty((WORK_ROWS, size))
+    cables = np.empty((n, CABLE_COLUMNS))
+    first = np.empty(n)
+    later = np.empty(n)
+    state = x.copy()
+    for step in range(steps):
+        rk4_step(state, wrenches, uavs, gusts, formation, taut, dt, state,
+                 first if step == 0 else later, work, cables)
+    g = np.empty(n)
+    g_dot = np.empty(n)
+    residuals(state, uavs, g, g_dot)
+    return state, first, g, g_dot

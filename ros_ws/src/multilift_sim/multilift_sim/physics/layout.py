@@ -1,0 +1,87 @@
+"""The slots of every packed array the physics functions read or write: the one place they are
+named (numba freezes these module-level integers into the compiled code).
+
+- the formation state ``x = (q_f, q_f_dot)`` (docs/conventions.md): per UAV i a block of
+  UAV_COORDINATES at ``UAV_COORDINATES * i`` (POSITION: r_i [m], EULER: eta_i [rad], ZYX roll,
+  pitch, yaw; world frame, z up), then the payload's r_p [m] at PAYLOAD; the rates follow
+  at the same offsets from n_coordinates(n) ([m/s], [rad/s]);
+- a UAV's constants row (UAV_*, UAV_COLUMNS columns, one row per UAV);
+- a gust's row (GUST_*, seed Eq. 2.55);
+- the formation's scalars (FORMATION_*);
+- the scratch of a solve per cable (CABLE_*) and of an RK4 step (WORK_*).
+"""
+from __future__ import annotations
+
+# -- the state x -----------------------------------------------------------------------------
+UAV_COORDINATES = 6         # coordinates of one UAV in q_f: r_i (3), eta_i (3)
+POSITION = 0                # r_i [m] within a UAV's block
+EULER = 3                   # eta_i = (phi, theta, psi) [rad] within a UAV's block
+PAYLOAD_COORDINATES = 3     # r_p [m]
+
+
+def payload_slot(n_uavs: int) -> int:
+    """Offset of r_p in q_f (and of v_p in q_f_dot) for n UAVs."""
+    return UAV_COORDINATES * n_uavs
+
+
+def n_coordinates(n_uavs: int) -> int:
+    """Length of q_f: 6n + 3 (the rates q_f_dot start there in x)."""
+    return UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES
+
+
+# -- a UAV's constants (one row per UAV) ------------------------------------------------------
+UAV_MASS = 0                # m_i [kg]
+UAV_LENGTH_SQ = 1           # l_i^2 [m^2], its cable's length squared
+UAV_INV_INERTIA = 2         # 1/I_xx, 1/I_yy, 1/I_zz [1/(kg m^2)], body FLU axes (3 slots)
+UAV_GYRO = 5                # (I_zz - I_yy)/I_xx, (I_xx - I_zz)/I_yy, (I_yy - I_xx)/I_zz (3)
+UAV_COLUMNS = 8
+
+# -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
+WRENCH_THRUST = 0           # u_T [N], along the body z axis
+WRENCH_TORQUE = 1           # tau_x, tau_y, tau_z [N m], body FLU (3 slots)
+WRENCH_COLUMNS = 4
+
+# -- a gust (seed Eq. 2.55; disturbances.Gust) ------------------------------------------------
+GUST_CENTER = 0             # (x, y) of its centre [m], world (2 slots)
+GUST_DIRECTION = 2          # unit direction, world (3 slots)
+GUST_GRADIENT_DISTANCE = 5  # h [m]
+GUST_REFERENCE_SPEED = 6    # U_ref [m/s]
+GUST_COLUMNS = 7
+
+# -- the formation's scalars ------------------------------------------------------------------
+FORMATION_PAYLOAD_MASS = 0      # m_p [kg]
+FORMATION_INV_PAYLOAD_MASS = 1  # 1/m_p [1/kg]
+FORMATION_GRAVITY = 2           # g [m/s^2], along -z of the world
+FORMATION_TWO_ALPHA = 3         # 2 alpha_f [1/s] (seed Eq. 2.59)
+FORMATION_BETA_SQ = 4           # beta_f^2 [1/s^2] (seed Eq. 2.59)
+FORMATION_DRAG = 5              # c_pd [N s^2/m^2] (seed Eq. 2.53); 0: no drag
+FORMATION_SCALARS = 6
+
+# -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
+CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots)
+CABLE_RHS = 3               # row i of the right-hand side of the multiplier equation
+CABLE_INV_DELTA = 4         # 1 / delta_i = m_i / (4 |d_i|^2) [kg/m^2]
+CABLE_THRUST = 5            # UAV i's thrust acceleration u_T R e_z / m_i [m/s^2] (3 slots)
+CABLE_COLUMNS = 8
+
+# -- an RK4 step's scratch (rows of a (WORK_ROWS, 2 (6n + 3)) array) ---------------------------
+WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives
+WORK_STAGE = 4              # the stage's state
+WORK_ACC = 5                # q_ddot of the stage (its first 6n + 3 entries)
+WORK_MULTIPLIERS = 6        # Lambda of the later stages (its first n entries)
+WORK_ROWS = 7
+
+# -- a slack step's scratch: states (rows of (SLACK_STATES, 2 (6n + 3))), per cable values
+# (rows of (SLACK_CABLE_ROWS, n)) and flags (rows of a bool (SLACK_FLAGS, n)) ------------------
+SLACK_END = 0               # the state at the end of the (rest of the) step
+SLACK_EVENT = 1             # the state at the located event (the last guard evaluated)
+SLACK_BRACKET = 2           # the state at the bracket's upper end
+SLACK_STATES = 3
+SLACK_G_END, SLACK_G_DOT_END = 0, 1     # g [m^2], g_dot [m^2/s] at the end
+SLACK_VALUE, SLACK_VALUE_BRACKET = 2, 3     # g / l^2 at the event's and bracket's states
+SLACK_TARGET = 4            # the g each taut cable is projected to [m^2]
+SLACK_SOLUTION = 5          # the solution of a solve in the mass metric
+SLACK_MULTIPLIERS = 6       # Lambda of a taut set's update
+SLACK_CABLE_ROWS = 7
+SLACK_WATCHED, SLACK_CROSSING, SLACK_SNAPPING = 0, 1, 2
+SLACK_FLAGS = 3

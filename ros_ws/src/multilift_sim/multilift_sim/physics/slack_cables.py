@@ -1,0 +1,383 @@
+"""Cables that pull but never push (`cable_model: slack`, slack.SlackCableModel) on one
+formation's arrays: the taut set, the snap (positions projected onto the cable's length, an
+inelastic impulse in the mass metric) and the taut event located within the RK4 step.
+Not in the seed (slack.py's docstring has the model and its references). World frame, SI;
+arguments as in formation_dae, the slots `physics.layout`'s.
+
+The rigid model is this one with every cable taut and none allowed to slacken: the same
+`formation_dae.solve`, whose slack cables have multiplier 0.
+"""
+import math
+
+import numpy as np
+
+from multilift_sim.physics._jit import jit
+from multilift_sim.physics.formation_dae import cable_multipliers, residuals, rk4_step, solve
+from multilift_sim.physics.layout import (
+    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, FORMATION_INV_PAYLOAD_MASS,
+    FORMATION_PAYLOAD_MASS, PAYLOAD_COORDINATES, POSITION, SLACK_BRACKET, SLACK_CABLE_ROWS,
+    SLACK_CROSSING, SLACK_END, SLACK_EVENT, SLACK_FLAGS, SLACK_G_DOT_END, SLACK_G_END,
+    SLACK_MULTIPLIERS, SLACK_SNAPPING, SLACK_SOLUTION, SLACK_STATES, SLACK_TARGET, SLACK_VALUE,
+    SLACK_VALUE_BRACKET, SLACK_WATCHED, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS, WORK_ACC,
+    WORK_ROWS)
+
+# The taut event is located to |g_i| <= EVENT_TOLERANCE l_i^2 (|r_p - r_i| within 5e-13 l_i of
+# l_i), in at most EVENT_ITERATIONS RK4 sub-steps (one or two in practice).
+EVENT_TOLERANCE = 1e-12
+EVENT_ITERATIONS = 40
+
+
+# ---------------------------------------------------------------- solves in the mass metric
+@jit
+def mass_metric_solve(x, uavs, formation, taut, rhs, out, cables):
+    """z = (G M^-1 G^T)_TT^-1 rhs_T over the taut cables T (0 on the others) into out (n,),
+    at the positions of x; leaves each cable's d_i = r_p - r_i [m] in `cables`."""
+    n = uavs.shape[0]
+    p = UAV_COORDINATES * n
+    for i in range(n):
+        r = UAV_COORDINATES * i + POSITION
+        dx, dy, dz = x[p] - x[r], x[p + 1] - x[r + 1], x[p + 2] - x[r + 2]
+        cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], cables[i, CABLE_OFFSET + 2] = \
+            dx, dy, dz
+        cables[i, CABLE_INV_DELTA] = 0.25 * uavs[i, UAV_MASS] / (dx * dx + dy * dy + dz * dz)
+        cables[i, CABLE_RHS] = rhs[i]
+    cable_multipliers(cables, formation[FORMATION_PAYLOAD_MASS], taut, out)
+
+
+@jit
+def move_along_cables(x, uavs, formation, z, start, cables):
+    """x[start:] moved by -M^-1 G^T z on the translations: UAV i by +2 z_i d_i / m_i, the
+    payload by -2 sum_i z_i d_i / m_p (d_i from `cables`). start = 0 moves the positions
+    [m], start = 6n + 3 the velocities [m/s]."""
+    n = uavs.shape[0]
+    p = start + UAV_COORDINATES * n
+    inv_payload_mass = formation[FORMATION_INV_PAYLOAD_MASS]
+    for i in range(n):
+        r = start + UAV_COORDINATES * i + POSITION
+        for k in range(3):
+            pull = 2.0 * z[i] * cables[i, CABLE_OFFSET + k]  # G^T z of this body
+            x[r + k] += pull / uavs[i, UAV_MASS]
+            x[p + k] -= pull * inv_payload_mass
+
+
+@jit
+def snap_velocities(x, uavs, formation, taut, g, g_dot, impulses, cables):
+    """x's translational velocities projected so that every `taut` cable has g_dot = 0:
+    v+ = v - M^-1 G^T (G M^-1 G^T)^-1 G v, an inelastic impulse along the cables (total
+    momentum kept, kinetic energy not increased). Writes x; g, g_dot, impulses (n,) scratch."""
+    residuals(x, uavs, g, g_dot)
+    mass_metric_solve(x, uavs, formation, taut, g_dot, impulses, cables)
+    nq = UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES
+    move_along_cables(x, uavs, formation, impulses, nq, cables)
+
+
+@jit
+def project_lengths(x, uavs, formation, taut, snapping, g, g_dot, target, shifts, cables):
+    """x's positions moved, in the mass metric (the centre of mass stays), until the
+    `snapping` cables have g = 0 while the other taut ones keep their g: Newton steps
+    dq = -M^-1 G^T (G M^-1 G^T)^-1 (g - g_target) over the taut set. At a located event the
+    residual is ~1e-12 l^2, so the first step already leaves rounding. Writes x."""
+    n = uavs.shape[0]
+    residuals(x, uavs, g, g_dot)
+    for i in range(n):
+        target[i] = 0.0 if snapping[i] else g[i]
+    for _ in range(2):
+        residuals(x, uavs, g, g_dot)
+        for i in range(n):
+            g[i] -= target[i]
+        mass_metric_solve(x, uavs, formation, taut, g, shifts, cables)
+        move_along_cables(x, uavs, formation, shifts, 0, cables)
+
+
+@jit
+def snap(x, uavs, formation, taut, snapping, values, cables):
+    """The `snapping` (slack) cables become taut at x (taut updated): positions projected
+    onto their length, then the inelastic, momentum-conserving velocity jump. Writes x;
+    values (SLACK_CABLE_ROWS, n) scratch."""
+    for i in range(uavs.shape[0]):
+        taut[i] = taut[i] or snapping[i]
+    g, g_dot = values[SLACK_G_END], values[SLACK_G_DOT_END]
+    project_lengths(x, uavs, formation, taut, snapping, g, g_dot, values[SLACK_TARGET],
+                    values[SLACK_SOLUTION], cables)
+    snap_velocities(x, uavs, formation, taut, g, g_dot, values[SLACK_SOLUTION], cables)
+
+
+@jit
+def update_taut_set(x, wrenches, uavs, gusts, formation, taut, multipliers, acc, cables):
+    """Drop taut cables whose multiplier would push (lambda_i < 0), most negative first,
+    until none does; their multipliers [N/m] at x into multipliers (n,)."""
+    while True:
+        solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
+        worst, lowest = -1, 0.0
+        for i in range(uavs.shape[0]):
+            if taut[i] and multipliers[i] < lowest:
+                worst, lowest = i, multipliers[i]
+        if worst < 0:
+            return
+        taut[worst] = False
+
+
+# --------------------------------------------------------------------- the taut event
+# Event location for hybrid systems: integrate, test the guard (here g_i = |r_p - r_i|^2
+# - l_i^2 of each slack cable) at the step's ends, and when it changed sign find its
+# zero in the step on the integrator's own map, apply the jump there and restart (Shampine
+# & Thompson, "Event location for ordinary differential equations", Comput. Math. Appl. 39,
+# 2000). RotorTM, this model's reference, does the same with its ODE solver's event
+# function (|x_L - x_Q| - l, terminal, direction +1: slackToTaut / cooperativeGuard passed
+# as ode45's Events, arplaboratory/RotorTM), then applies its inelastic collision map.
+@jit
+def hermite_polynomial(h, p0, m0, p1, m1, s):
+    """The cubic Hermite interpolant of values p0, p1 and slopes m0, m1 at t = 0, h, at
+    s = t / h."""
+    a = 2.0 * (p0 - p1) + h * (m0 + m1)
+    b = 3.0 * (p1 - p0) - h * (2.0 * m0 + m1)
+    return ((a * s + b) * s + h * m0) * s + p0
+
+
+@jit
+def hermite_root(h, p0, m0, p1, m1):
+    """The first t in (0, h] where the interpolant (p0 < 0) reaches 0 (h if none): bisection
+    on the first of its monotone pieces (split at its stationary points) that ends >= 0."""
+    a = 2.0 * (p0 - p1) + h * (m0 + m1)
+    b = 3.0 * (p1 - p0) - h * (2.0 * m0 + m1)
+    first, second = stationary_points(a, b, h * m0)
+    ends = (min(first, second), max(first, second), 1.0)
+    lo = 0.0
+    for hi in ends:
+        if not lo < hi <= 1.0:
+            continue
+        if hermite_polynomial(h, p0, m0, p1, m1, hi) >= 0.0:
+            for _ in range(200):
+                middle = 0.5 * (lo + hi)
+                if not lo < middle < hi:
+                    break
+                if hermite_polynomial(h, p0, m0, p1, m1, middle) >= 0.0:
+                    hi = middle
+                else:
+                    lo = middle
+            return h * hi
+        lo = hi
+    return h
+
+
+@jit
+def stationary_points(a, b, c):
+    """The real roots in (0, 1) of 3 a s^2 + 2 b s + c (the slope of a s^3 + b s^2 + c s + d),
+    -1.0 for each missing one."""
+    first = second = -1.0
+    if a == 0.0:
+        if b != 0.0:
+            first = -c / (2.0 * b)
+    else:
+        discriminant = b * b - 3.0 * a * c
+        if discriminant >= 0.0:
+            root = math.sqrt(discriminant)
+            first, second = (-b - root) / (3.0 * a), (-b + root) / (3.0 * a)
+    if not 0.0 < first < 1.0:
+        first = -1.0
+    if not 0.0 < second < 1.0:
+        second = -1.0
+    return first, second
+
+
+@jit
+def hermite_peak(h, p0, m0, p1, m1):
+    """(t, value) of the interpolant's highest point in (0, h) (slope + at 0, - at h)."""
+    a = 2.0 * (p0 - p1) + h * (m0 + m1)
+    b = 3.0 * (p1 - p0) - h * (2.0 * m0 + m1)
+    first, second = stationary_points(a, b, h * m0)
+    best, value = -1.0, -math.inf
+    for s in (first, second):
+        if s > 0.0:
+            here = hermite_polynomial(h, p0, m0, p1, m1, s)
+            if here > value:
+                best, value = s, here
+    if best < 0.0:
+        return 0.5 * h, hermite_polynomial(h, p0, m0, p1, m1, 0.5)
+    return h * best, value
+
+
+@jit
+def guard(x, wrenches, uavs, gusts, formation, taut, tau, watched, out, value, work, cables,
+          multipliers):
+    """f(tau) = max_i g_i(RK4(x, tau)) / l_i^2 over the `watched` cables; the RK4 state into
+    out, every g_i / l_i^2 into value."""
+    rk4_step(x, wrenches, uavs, gusts, formation, taut, tau, out, multipliers, work, cables)
+    residuals(out, uavs, value, multipliers)
+    f = -math.inf
+    for i in range(uavs.shape[0]):
+        value[i] /= uavs[i, UAV_LENGTH_SQ]
+        if watched[i] and value[i] > f:
+            f = value[i]
+    return f
+
+
+@jit
+def taut_event(x, wrenches, uavs, gusts, formation, taut, h, g, g_dot, states, values, flags,
+               work, cables):
+    """The first time tau in (0, h] at which a slack cable, shorter than l_i at x, reaches
+    l_i on the RK4 sub-step from x, or -1.0: the state there into states[SLACK_EVENT], which
+    cables snap into flags[SLACK_SNAPPING]. g, g_dot (n,) at x; states[SLACK_END] and
+    values[SLACK_G_END], values[SLACK_G_DOT_END] the RK4 step of h and its residuals.
+
+    The guard is f(tau) = max_i g_i(RK4(x, tau)) / l_i^2 over those cables. A crossing is
+    bracketed by the step's ends, or, for a cable that goes out and back within the step,
+    by the peak of the cubic Hermite interpolant of g_i (from g_i, g_dot_i at both ends).
+    The first iterate is the interpolant's root, then Illinois regula falsi (Dowell &
+    Jarratt, BIT 11, 1971) on the RK4 map until |f| <= EVENT_TOLERANCE."""
+    n = uavs.shape[0]
+    watched, crossing = flags[SLACK_WATCHED], flags[SLACK_CROSSING]
+    g1, g_dot1 = values[SLACK_G_END], values[SLACK_G_DOT_END]
+    x_tau, x_hi = states[SLACK_EVENT], states[SLACK_BRACKET]
+    value, value_hi = values[SLACK_VALUE], values[SLACK_VALUE_BRACKET]
+    multipliers = values[SLACK_MULTIPLIERS]
+    any_watched = any_crossing = False
+    f_lo = f_hi = -math.inf
+    for i in range(n):
+        scale = uavs[i, UAV_LENGTH_SQ]
+        watched[i] = not taut[i] and g[i] / scale < 0.0
+        crossing[i] = watched[i] and g1[i] / scale >= 0.0
+        any_watched = any_watched or watched[i]
+        any_crossing = any_crossing or crossing[i]
+        if watched[i]:
+            f_lo = max(f_lo, g[i] / scale)
+            f_hi = max(f_hi, g1[i] / scale)
+    if not any_watched:
+        return -1.0
+    if any_crossing:
+        hi = h
+        x_hi[:] = states[SLACK_END]
+        for i in range(n):
+            value_hi[i] = g1[i] / uavs[i, UAV_LENGTH_SQ]
+    else:  # out and back within the step: the interpolant's peak
+        hi = math.inf
+        for i in range(n):
+            scale = uavs[i, UAV_LENGTH_SQ]
+            crossing[i] = watched[i] and g_dot[i] / scale > 0.0 and g_dot1[i] / scale < 0.0
+            if crossing[i]:
+                t, peak = hermite_peak(h, g[i] / scale, g_dot[i] / scale, g1[i] / scale,
+                                       g_dot1[i] / scale)
+                if peak >= 0.0:
+                    hi = min(hi, t)
+        if hi == math.inf:
+            return -1.0
+        f_hi = guard(x, wrenches, uavs, gusts, formation, taut, hi, watched, x_hi, value_hi,
+                     work, cables, multipliers)
+        if f_hi < 0.0:
+            return -1.0
+    guess = math.inf
+    for i in range(n):
+        if crossing[i]:
+            scale = uavs[i, UAV_LENGTH_SQ]
+            guess = min(guess, hermite_root(h, g[i] / scale, g_dot[i] / scale, g1[i] / scale,
+                                            g_dot1[i] / scale))
+    lo = 0.0
+    tau, f_tau = hi, f_hi
+    x_tau[:] = x_hi
+    value[:] = value_hi
+    side = 0
+    for k in range(EVENT_ITERATIONS):
+        if abs(f_tau) <= EVENT_TOLERANCE or hi - lo <= 1e-15 * h:
+            break
+        if k == 0 and lo < guess < hi:
+            tau = guess
+        else:
+            tau = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        f_tau = guard(x, wrenches, uavs, gusts, formation, taut, tau, watched, x_tau, value,
+                      work, cables, multipliers)
+        if f_tau >= 0.0:  # the crossing is in [lo, tau]
+            hi, f_hi = tau, f_tau
+            x_hi[:] = x_tau
+            value_hi[:] = value
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+        else:
+            lo, f_lo = tau, f_tau
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+    if abs(f_tau) > EVENT_TOLERANCE:  # not converged (not seen): the bracket's far end
+        tau = hi
+        x_tau[:] = x_hi
+        value[:] = value_hi
+    snapping = flags[SLACK_SNAPPING]
+    for i in range(n):
+        snapping[i] = watched[i] and value[i] >= -EVENT_TOLERANCE
+    return tau
+
+
+@jit
+def slack_step(state, wrenches, uavs, gusts, formation, taut, dt, g, g_dot, states, values,
+               flags, work, cables):
+    """One RK4 step of dt [s] from state (whose residuals are g, g_dot), cut at each taut
+    event: the state at its end into state, its g [m^2], g_dot [m^2/s] into g, g_dot."""
+    n = uavs.shape[0]
+    end = states[SLACK_END]
+    g_end, g_dot_end = values[SLACK_G_END], values[SLACK_G_DOT_END]
+    snapping = flags[SLACK_SNAPPING]
+    left, events = dt, 0
+    while True:
+        rk4_step(state, wrenches, uavs, gusts, formation, taut, left, end,
+                 values[SLACK_MULTIPLIERS], work, cables)
+        residuals(end, uavs, g_end, g_dot_end)
+        if taut.all():
+            state[:] = end
+            g[:] = g_end
+            g_dot[:] = g_dot_end
+            return
+        # an event makes a cable taut: a few per step at most (a bound against cycling)
+        tau = taut_event(state, wrenches, uavs, gusts, formation, taut, left, g, g_dot, states,
+                         values, flags, work, cables) if events <= 2 * n else -1.0
+        if tau < 0.0:
+            break
+        events += 1
+        state[:] = states[SLACK_EVENT]
+        snap(state, uavs, formation, taut, snapping, values, cables)
+        # a new taut cable may not hold (it would push)
+        update_taut_set(state, wrenches, uavs, gusts, formation, taut,
+                        values[SLACK_MULTIPLIERS], work[WORK_ACC], cables)
+        residuals(state, uavs, g, g_dot)
+        left -= tau
+        if left <= 0.0:
+            return
+    # no crossing located: a cable already at its length when it went slack (g_i >= 0 at
+    # the step's start, so no sign change) that separates at the end snaps there
+    state[:] = end
+    any_snapping = False
+    for i in range(n):
+        snapping[i] = not taut[i] and g_end[i] >= 0.0 and g_dot_end[i] > 0.0
+        any_snapping = any_snapping or snapping[i]
+    g[:] = g_end
+    g_dot[:] = g_dot_end
+    if any_snapping:
+        snap(state, uavs, formation, taut, snapping, values, cables)
+        residuals(state, uavs, g, g_dot)
+
+
+@jit
+def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
+    """`steps` RK4 steps of dt [s] from x with the wrenches held, cables going slack (at each
+    step's start, when their multiplier would push) and snapping taut (at the located event):
+    (the state at the end, the multipliers [N/m] at x after the taut set's update there,
+    g [m^2] and g_dot [m^2/s] at the end). taut (n,) bool is updated; x is not written."""
+    n = uavs.shape[0]
+    size = 2 * (UAV_COORDINATES * n + PAYLOAD_COORDINATES)
+    work = np.empty((WORK_ROWS, size))
+    states = np.empty((SLACK_STATES, size))
+    values = np.empty((SLACK_CABLE_ROWS, n))
+    flags = np.zeros((SLACK_FLAGS, n), dtype=np.bool_)
+    cables = np.empty((n, CABLE_COLUMNS))
+    first = np.empty(n)
+    g = np.empty(n)
+    g_dot = np.empty(n)
+    state = x.copy()
+    update_taut_set(state, wrenches, uavs, gusts, formation, taut, first, work[WORK_ACC], cables)
+    residuals(state, uavs, g, g_dot)
+    for step in range(steps):
+        if step:
+            update_taut_set(state, wrenches, uavs, gusts, formation, taut,
+                            values[SLACK_MULTIPLIERS], work[WORK_ACC], cables)
+        slack_step(state, wrenches, uavs, gusts, formation, taut, dt, g, g_dot, states, values,
+                   flags, work, cables)
+    return state, first, g, g_dot

@@ -1,17 +1,19 @@
-"""Formation DAE for n >= 1: the structured solve against the dense Lagrange-multiplier system
-of seed Eq. 2.59, RK4, parameter validation, and a three-UAV formation's invariants."""
+"""Formation DAE for n >= 1: the structured solve (multilift_sim.physics.formation_dae, every
+cable or only the taut ones) against the dense Lagrange-multiplier system of seed Eq. 2.59
+formed here with numpy (the oracle), RK4, parameter validation, and a three-UAV formation's
+invariants."""
 import math
 
 import numpy as np
 import pytest
 
-from multilift_sim import kernels
 from multilift_sim.constraints import (cable_residual_rates, cable_residuals,
                                        constraint_jacobian, constraint_jacobian_rate_term)
 from multilift_sim.disturbances import Gust, gust_velocity, payload_drag
 from multilift_sim.dynamics import FormationModel, FormationParams, StateLayout
 from multilift_sim.kinematics import euler_rate_matrix, rotation_matrix
 from multilift_sim.multirotor import MultirotorParams, euler_mass_matrix, euler_velocity_term
+from multilift_sim.slack import SlackCableModel
 
 GRAVITY = 9.81
 
@@ -31,9 +33,10 @@ def params(uav_list, lengths, **overrides) -> FormationParams:
     return FormationParams(**values)
 
 
-def dense_reference(formation: FormationModel, x: np.ndarray, rotor_speeds):
+def dense_reference(formation: FormationModel, x: np.ndarray, rotor_speeds, taut=None):
     """q_ddot and Lambda from the full (7n+3)-square system of seed Eq. 2.59, assembled from
-    the seed's matrices (Eq. 2.47-2.52) with dense numpy algebra."""
+    the seed's matrices (Eq. 2.47-2.52) with dense numpy algebra; with `taut` (n,) bool only
+    those cables' rows (the others' Lambda 0)."""
     p = formation.params
     layout = formation.layout
     n = p.n_uavs
@@ -60,11 +63,16 @@ def dense_reference(formation: FormationModel, x: np.ndarray, rotor_speeds):
     jacobian = constraint_jacobian(positions, payload_position)
     g = cable_residuals(positions, payload_position, p.cable_lengths)
     g_dot = cable_residual_rates(positions, velocities, payload_position, payload_velocity)
-    kkt = np.block([[mass, jacobian.T], [jacobian, np.zeros((n, n))]])
-    rhs = np.concatenate((force, -constraint_jacobian_rate_term(velocities, payload_velocity)
-                          - 2 * p.baumgarte_alpha * g_dot - p.baumgarte_beta ** 2 * g))
+    taut = np.ones(n, bool) if taut is None else np.asarray(taut)
+    rows, m = jacobian[taut], int(taut.sum())
+    kkt = np.block([[mass, rows.T], [rows, np.zeros((m, m))]])
+    rhs = np.concatenate((force, (-constraint_jacobian_rate_term(velocities, payload_velocity)
+                                  - 2 * p.baumgarte_alpha * g_dot
+                                  - p.baumgarte_beta ** 2 * g)[taut]))
     solution = np.linalg.solve(kkt, rhs)
-    return solution[:size], solution[size:]
+    multipliers = np.zeros(n)
+    multipliers[taut] = solution[size:]
+    return solution[:size], multipliers
 
 
 def random_state(layout: StateLayout, lengths, rng) -> np.ndarray:
@@ -79,10 +87,10 @@ def random_state(layout: StateLayout, lengths, rng) -> np.ndarray:
                        rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), rng.normal(size=3))
 
 
-@pytest.mark.parametrize('n, kernel', [(1, 'auto'), (2, 'auto'), (3, 'auto'), (25, 'auto'),
-                                       (1, 'numpy'), (3, 'numpy'), (25, 'numpy'),
-                                       (25, 'float')])
-def test_structured_solve_matches_the_dense_seed_system(n, kernel):
+@pytest.mark.parametrize('n, kernel', [(1, 'jit'), (2, 'jit'), (3, 'jit'), (25, 'jit'),
+                                       (3, 'python')])
+def test_structured_solve_matches_the_dense_seed_system(n, kernel, monkeypatch):
+    monkeypatch.setenv('MULTILIFT_KERNEL', kernel)
     rng = np.random.default_rng(n)
     frames = ['quad_x', 'hexa_plus', 'octo_x', 'quad_plus']
     uavs = [vehicle(frames[i % 4] if n == 2 else 'quad_x', mass=2.0 + 0.2 * i) for i in range(n)]
@@ -90,11 +98,7 @@ def test_structured_solve_matches_the_dense_seed_system(n, kernel):
     gusts = (Gust(center=(0.0, 0.0), direction=(0.0, 0.6, 0.8), gradient_distance=8.0,
                   reference_speed=3.0),)
     formation = FormationModel(params(uavs, lengths, payload_drag_coefficient=0.12,
-                                      gusts=gusts, baumgarte_alpha=7.0, baumgarte_beta=5.0),
-                               kernel=kernel)
-    # auto: the float kernel up to 20 UAVs, and at any n where it runs compiled
-    assert formation.uses_float_kernel == (kernel == 'float' or (
-        kernel == 'auto' and (n < 20 or kernels.enabled())))
+                                      gusts=gusts, baumgarte_alpha=7.0, baumgarte_beta=5.0))
     x = random_state(formation.layout, lengths, rng)
     speeds = [rng.uniform(1200.0, 2000.0, uav.n_rotors) for uav in uavs]
     q_ddot, multipliers = formation.accelerations(0.0, x, speeds)
@@ -102,13 +106,37 @@ def test_structured_solve_matches_the_dense_seed_system(n, kernel):
     assert np.allclose(q_ddot, expected_q_ddot, rtol=1e-9, atol=1e-9)
     assert np.allclose(multipliers, expected_multipliers, rtol=1e-9, atol=1e-9)
     assert np.allclose(formation.cable_tension(0.0, x, speeds), 2 * lengths * multipliers)
+    assert np.any(np.abs(expected_multipliers) > 1.0)  # a solve with tensions to match
 
 
-@pytest.mark.parametrize('n, kernel', [(2, 'float'), (2, 'numpy')])
-def test_step_is_classic_rk4(n, kernel):
+@pytest.mark.parametrize('n', [2, 3, 7])
+def test_a_solve_over_the_taut_cables_matches_the_dense_seed_system_of_those(n):
+    """The one solve with slack cables (SlackCableModel): multiplier 0 and no constraint row
+    for a slack cable, the Woodbury sum over the taut ones only (none taut: free bodies)."""
+    rng = np.random.default_rng(40 + n)
+    uavs = [vehicle(mass=2.0 + 0.3 * i) for i in range(n)]
+    lengths = rng.uniform(1.5, 3.0, n)
+    model = SlackCableModel(params(uavs, lengths, payload_drag_coefficient=0.12,
+                                   baumgarte_alpha=7.0, baumgarte_beta=5.0))
+    x = random_state(model.layout, lengths, rng)
+    speeds = [rng.uniform(1200.0, 2000.0, 4) for _ in range(n)]
+    for taut in (rng.uniform(size=n) < 0.5, np.zeros(n, bool), np.ones(n, bool)):
+        model.taut = taut
+        q_ddot, multipliers = model.accelerations(0.0, x, speeds)
+        expected_q_ddot, expected_multipliers = dense_reference(model, x, speeds, taut)
+        scale = max(1.0, np.abs(expected_q_ddot).max())
+        assert np.allclose(q_ddot, expected_q_ddot, rtol=1e-9, atol=1e-9 * scale)
+        assert np.allclose(multipliers, expected_multipliers, rtol=1e-9, atol=1e-9)
+        assert np.all(multipliers[~taut] == 0.0)
+
+
+@pytest.mark.parametrize('kernel', ['jit', 'python'])
+def test_step_is_classic_rk4(kernel, monkeypatch):
+    monkeypatch.setenv('MULTILIFT_KERNEL', kernel)
+    n = 2
     rng = np.random.default_rng(10 + n)
     lengths = rng.uniform(1.5, 3.0, n)
-    formation = FormationModel(params([vehicle()] * n, lengths), kernel=kernel)
+    formation = FormationModel(params([vehicle()] * n, lengths))
     x = random_state(formation.layout, lengths, rng)
     speeds = [rng.uniform(1500.0, 2000.0, 4) for _ in range(n)]
     dt = 0.01
@@ -150,9 +178,13 @@ def test_params_validation_names_the_field(field, value, message):
         params([vehicle(), vehicle()], [2.0, 2.0], **{field: value})
 
 
-def test_unknown_kernel_is_rejected():
-    with pytest.raises(ValueError, match="'float' or 'numpy'"):
-        FormationModel(params([vehicle()], [2.0]), kernel='numba')
+def test_arrays_of_the_wrong_shape_are_refused_before_the_compiled_code_reads_them():
+    formation = FormationModel(params([vehicle(), vehicle()], [2.0, 2.0]))
+    x = formation.layout.pack([[0, 0, 2], [1, 0, 2]], np.zeros((2, 3)), [0.5, 0, 0.3])
+    with pytest.raises(ValueError, match=r'wrenches must have shape \(2, 4\), got \(2, 3\)'):
+        formation.accelerations_from_wrenches(x, np.zeros((2, 3)))
+    with pytest.raises(ValueError, match=r'state must have shape \(30,\), got \(18,\)'):
+        formation.constraint_residuals(x[:18])
 
 
 def test_rotor_speeds_must_fit_each_vehicle():

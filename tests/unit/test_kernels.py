@@ -1,42 +1,34 @@
-"""The compiled float kernel (multilift_sim.kernels, numba) against the pure-Python float kernel
-of FormationModel, the reference: a control period from a swinging, tilted state through the
-gusts gives the same numbers (bit for bit here; 1e-12 is what the test demands), and
-MULTILIFT_KERNEL=python switches the compiled one off. Compiled ahead of time (scripts/setup)
-and just in time, the kernel and the control laws give the same bits; the ahead-of-time build
-loads without numba and refuses arguments of the wrong type."""
+"""The physics (multilift_sim.physics), compiled by numba, against its own source run by Python
+(`kernels.uncompiled`): the solve, an RK4 control period through a gust, and the slack path
+with a cable snapping taut within the step give the same bits. MULTILIFT_KERNEL=python runs
+the uncompiled functions, to the same bits; the array slots tile their rows."""
 from __future__ import annotations
 
-import json
+import dataclasses
 
 import numpy as np
 import pytest
 
-from multilift_control.cascade import COMPILED_LAWS
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
+from multilift_sim.physics import layout
 from multilift_sim.simulation import FormationSimulator
+from multilift_sim.slack import SlackCableModel
 
-pytest.importorskip('numba')
+numba = pytest.importorskip('numba')
+
+from multilift_sim.physics.formation_dae import integrate_period, solve  # noqa: E402
+from multilift_sim.physics.slack_cables import integrate_period as slack_period  # noqa: E402
 
 
-def _swinging(name: str, ticks: int = 40):
+def _swinging(name: str, ticks: int = 5):
+    """A simulator of scenario `name` after `ticks` ticks of uneven hover (swinging, tilted),
+    its payload and UAVs then moved into the first gust's centre (drag through a gust)."""
     simulator = FormationSimulator(scenario_io.load(name))
     hover = [np.array([1500.0, 1490.0, 1500.0, 1510.0]) for _ in simulator.scenario.uavs]
     idle = [np.zeros(u.vehicle.n_rotors, bool) for u in simulator.scenario.uavs]
     for _ in range(ticks):
         simulator.advance(hover, idle)
-    return simulator
-
-
-@pytest.mark.parametrize('name', ['twin_lift', 'circle3', 'v5'])
-def test_compiled_equals_pure(name, monkeypatch):
-    simulator = _swinging(name, ticks=5)
-    model = simulator.model
-    assert model.uses_float_kernel
-    rng = np.random.default_rng(3)
-    speeds = [1500.0 + 20.0 * rng.standard_normal(u.vehicle.n_rotors)
-              for u in simulator.scenario.uavs]
-    # through a gust: the payload moved into the first gust's centre
     state = simulator.state.copy()
     if simulator.scenario.gusts:
         n = simulator.n
@@ -44,79 +36,149 @@ def test_compiled_equals_pure(name, monkeypatch):
                       0.0]
         state[:6 * n].reshape(n, 6)[:, :3] += shift
         state[6 * n:6 * n + 3] += shift
-    monkeypatch.setenv('MULTILIFT_KERNEL', 'auto')
-    assert kernels.enabled()
-    compiled = model.integrate(state, speeds, simulator.dt, 10)
-    monkeypatch.setenv('MULTILIFT_KERNEL', 'python')
-    assert not kernels.enabled()
-    pure = model.integrate(state, speeds, simulator.dt, 10)
+    rng = np.random.default_rng(3)
+    speeds = [1500.0 + 20.0 * rng.standard_normal(u.vehicle.n_rotors)
+              for u in simulator.scenario.uavs]
+    return simulator, state, simulator.model.wrenches(speeds)
+
+
+def _constants(model):
+    return model._uavs, model._gusts, model._formation
+
+
+@pytest.mark.parametrize('name', ['twin_lift', 'circle3', 'v5'])
+def test_the_solve_compiled_is_its_source_bit_for_bit(name):
+    simulator, x, wrenches = _swinging(name)
+    model, n = simulator.model, simulator.n
+    for taut in (np.ones(n, bool), np.arange(n) % 2 == 0):  # every cable, then some slack
+        results = []
+        for function in (solve, kernels.uncompiled(solve)):
+            acc, multipliers = np.empty(model.layout.n_coordinates), np.empty(n)
+            function(x, wrenches, *_constants(model), taut, acc, multipliers,
+                     np.empty((n, layout.CABLE_COLUMNS)))
+            results.append((acc, multipliers))
+        (acc, multipliers), (acc_python, multipliers_python) = results
+        assert np.array_equal(acc, acc_python) and np.array_equal(multipliers,
+                                                                  multipliers_python)
+        assert np.all(multipliers[~taut] == 0.0) and np.all(multipliers[taut] != 0.0)
+        assert model._gusts.shape[0] == 0 or np.any(acc != 0.0)
+
+
+@pytest.mark.parametrize('name', ['twin_lift', 'circle3', 'v5'])
+def test_a_control_period_compiled_is_its_source_bit_for_bit(name, monkeypatch):
+    simulator, x, wrenches = _swinging(name)
+    model, taut = simulator.model, np.ones(simulator.n, bool)
+    compiled = integrate_period(x, wrenches, *_constants(model), taut, simulator.dt, 10)
+    python = kernels.uncompiled(integrate_period)(x, wrenches, *_constants(model), taut,
+                                                  simulator.dt, 10)
+    for a, b in zip(compiled, python):
+        assert np.array_equal(a, b)
+    assert np.any(compiled[0] != x)  # it moved
+    # the model's own choice, MULTILIFT_KERNEL: the same bits either way
+    speeds = [np.full(u.vehicle.n_rotors, 1520.0) for u in simulator.scenario.uavs]
+    periods = {}
+    for mode in ('jit', 'python'):
+        monkeypatch.setenv('MULTILIFT_KERNEL', mode)
+        assert kernels.enabled() == (mode == 'jit')
+        periods[mode] = model.integrate(x, speeds, simulator.dt, 3)
     for field in ('state', 'cable_tension', 'constraint', 'constraint_rate'):
-        a, b = getattr(compiled, field), getattr(pure, field)
-        assert a.shape == b.shape
-        assert np.allclose(a, b, rtol=1e-12, atol=1e-12), field
-    assert np.any(compiled.state != state)  # it moved
+        assert np.array_equal(getattr(periods['jit'], field), getattr(periods['python'], field))
 
 
-def test_cache_dir_is_writable_and_under_the_users_cache():
+def _snapping_in_free_space():
+    """A slack single lift, no gravity, rotors off: UAV and payload fly apart and the cable
+    reaches its length 0.4 ms into a 1 ms step. (model, state, wrenches, the snap time)"""
+    scenario = scenario_io.load('single_lift_swing')
+    model = SlackCableModel(dataclasses.replace(scenario.formation_params(), gravity=0.0))
+    length = model.cable_lengths[0]
+    r_uav, v_uav = np.array([0.2, -0.1, 3.0]), np.array([-0.4, 0.3, 0.1])
+    d0, w0 = np.array([0.3, -0.2, -0.5]), np.array([2.4, 0.4, -1.6])
+    a, b, c = w0 @ w0, 2.0 * d0 @ w0, d0 @ d0 - length ** 2   # |d0 + w0 t| = l
+    t_snap = (-b + np.sqrt(b * b - 4.0 * a * c)) / (2.0 * a)
+    start = t_snap - 4e-4                                       # free flight to there
+    x = model.layout.pack([r_uav + v_uav * start], [np.zeros(3)],
+                          r_uav + d0 + (v_uav + w0) * start, [v_uav], None, v_uav + w0)
+    return model, x, model.wrenches([np.zeros(4)]), 4e-4
+
+
+def test_the_slack_path_with_a_snap_in_the_step_compiled_is_its_source_bit_for_bit(
+        monkeypatch):
+    model, x, wrenches, t_snap = _snapping_in_free_space()
+    results = []
+    for function in (slack_period, kernels.uncompiled(slack_period)):
+        taut = np.zeros(1, bool)
+        results.append((function(x, wrenches, *_constants(model), taut, 1e-3, 2), taut))
+    (compiled, taut), (python, taut_python) = results
+    for a, b in zip(compiled, python):
+        assert np.array_equal(a, b)
+    assert taut[0] and taut_python[0]  # it snapped taut
+    state, _, g, g_dot = compiled
+    # on its length (the event located, the positions projected), not separating
+    assert abs(g[0]) < 1e-12 * model.cable_lengths[0] ** 2 and abs(g_dot[0]) < 1e-9
+    # the model under MULTILIFT_KERNEL=python: the same bits
+    monkeypatch.setenv('MULTILIFT_KERNEL', 'python')
+    model.taut = False
+    assert np.array_equal(model.integrate(x, [np.zeros(4)], 1e-3, 2).state, state)
+
+
+def test_uncompiled_runs_the_same_source_in_python_all_the_way_down():
+    """kernels.uncompiled: the reference is the compiled function's own source run by Python,
+    and so are the compiled functions it calls, across modules (no compiled code underneath
+    it); kernels.runnable picks by MULTILIFT_KERNEL."""
+    reference = kernels.uncompiled(slack_period)
+    assert reference.__code__ is slack_period.py_func.__code__
+    step = reference.__globals__['slack_step']
+    rk4 = step.__globals__['rk4_step']
+    inner = rk4.__globals__['solve']
+    assert inner.__code__ is solve.py_func.__code__
+    for function in (step, rk4, inner, inner.__globals__['cable_multipliers']):
+        assert not isinstance(function, numba.core.dispatcher.Dispatcher)
+    # the modules' own functions are untouched
+    assert isinstance(solve, numba.core.dispatcher.Dispatcher)
+
+
+def test_runnable_follows_the_kernel_variable(monkeypatch):
+    monkeypatch.setenv('MULTILIFT_KERNEL', 'jit')
+    assert kernels.runnable(solve) is solve
+    monkeypatch.setenv('MULTILIFT_KERNEL', 'python')
+    python = kernels.runnable(solve)
+    assert python.__code__ is solve.py_func.__code__
+    assert not isinstance(python, numba.core.dispatcher.Dispatcher)
+
+
+@pytest.mark.parametrize('prefix, columns, widths', [
+    ('UAV_', 'UAV_COLUMNS', {'UAV_INV_INERTIA': 3, 'UAV_GYRO': 3}),
+    ('GUST_', 'GUST_COLUMNS', {'GUST_CENTER': 2, 'GUST_DIRECTION': 3}),
+    ('FORMATION_', 'FORMATION_SCALARS', {}),
+    ('CABLE_', 'CABLE_COLUMNS', {'CABLE_OFFSET': 3, 'CABLE_THRUST': 3}),
+    ('WRENCH_', 'WRENCH_COLUMNS', {'WRENCH_TORQUE': 3}),
+    ('WORK_', 'WORK_ROWS', {}),
+])
+def test_layout_slots_tile_their_rows(prefix, columns, widths):
+    """Every slot of a row is named once: the named slots (with their widths) cover
+    0 .. columns - 1 without overlap."""
+    names = [name for name in vars(layout) if name.startswith(prefix) and name != columns
+             and name != 'UAV_COORDINATES' and isinstance(getattr(layout, name), int)]
+    covered = sorted(getattr(layout, name) + k for name in names
+                     for k in range(widths.get(name, 1)))
+    assert covered == list(range(getattr(layout, columns)))
+
+
+def test_the_state_layout_is_the_slots():
+    from multilift_sim.dynamics import StateLayout
+    state = StateLayout(3)
+    x = np.arange(state.size, dtype=float)
+    assert state.n_coordinates == layout.n_coordinates(3) == 21
+    assert state.payload_position(x)[0] == layout.payload_slot(3)
+    assert state.uav_euler(x)[2, 0] == 2 * layout.UAV_COORDINATES + layout.EULER
+    assert state.uav_velocities(x)[1, 0] == 21 + layout.UAV_COORDINATES + layout.POSITION
+
+
+def test_cache_dir_is_under_the_users_cache():
     import os
     from pathlib import Path
     directory = Path(os.environ['NUMBA_CACHE_DIR'])
     assert directory.parts[-2:] == ('multilift', 'numba')
-
-
-AHEAD_OF_TIME = (kernels.PHYSICS, COMPILED_LAWS)
-
-
-@pytest.mark.parametrize('name', ['twin_lift', 'circle3', 'v5'])
-def test_ahead_of_time_equals_just_in_time_bit_for_bit(name, monkeypatch):
-    """The physics over a control period, and a headless run (physics and control laws)."""
-    from multilift_control.headless import run_headless
-    import dataclasses
-    simulator = _swinging(name, ticks=5)
-    speeds = [np.full(u.vehicle.n_rotors, 1520.0) for u in simulator.scenario.uavs]
-    scenario = simulator.scenario
-    short = dataclasses.replace(scenario, simulation=dataclasses.replace(
-        scenario.simulation, duration=3.0))
-    results = {}
-    for mode in ('aot', 'jit'):
-        monkeypatch.setenv('MULTILIFT_KERNEL', mode)
-        assert kernels.enabled()
-        period = simulator.model.integrate(simulator.state, speeds, simulator.dt, 10)
-        run = run_headless(short)
-        summary = run.summary()
-        summary['sim'].pop('wall_time', None)
-        results[mode] = (period.state, period.cable_tension, run.simulator.state,
-                         json.dumps(summary, sort_keys=True, default=str))
-    aot, jit = results['aot'], results['jit']
-    for a, b in zip(aot[:3], jit[:3]):
-        assert np.array_equal(a, b)
-    assert aot[3] == jit[3]
-    assert np.any(results['aot'][2] != simulator.state)  # the run moved
-
-
-def test_an_argument_of_the_wrong_type_is_a_type_error_not_a_crash():
-    compiled = kernels.load_ahead_of_time(kernels.PHYSICS)
-    assert compiled is not None
-    simulator = FormationSimulator(scenario_io.load('twin_lift'))
-    constants = kernels.model_constants(simulator.model)
-    x = np.ascontiguousarray(simulator.state, dtype=np.float64)
-    wrenches = np.zeros((2, 6))
-    state, *_ = compiled.integrate_period(*constants, x, wrenches, 0.001, 2)
-    assert state.shape == x.shape and np.all(np.isfinite(state))
-    wide = np.repeat(x, 2)
-    for bad, words in ((x.astype(np.float32), 'float32'), (wide[::2], 'strided'),
-                       (x.tolist(), 'list')):
-        with pytest.raises(TypeError, match=f'argument 9 must be a C-contiguous 1-d float64 '
-                                            f'array, got .*{words}'):
-            compiled.integrate_period(*constants, bad, wrenches, 0.001, 2)
-    # the laws write their memory: a read-only one is refused
-    laws = kernels.load_ahead_of_time(COMPILED_LAWS)
-    frozen = np.zeros(4)
-    frozen.flags.writeable = False
-    with pytest.raises(TypeError, match='argument 3 must be a C-contiguous writable 1-d '
-                                        'float64 array, got a C-contiguous read-only'):
-        laws.cascade_update(np.zeros(24), np.zeros((4, 4)), np.zeros(4), frozen, 0.0,
-                            *[np.zeros(3)] * 7, 0.0)
 
 
 def test_the_ahead_of_time_build_is_named_by_its_source(tmp_path, monkeypatch):
@@ -130,28 +192,3 @@ def test_the_ahead_of_time_build_is_named_by_its_source(tmp_path, monkeypatch):
     second = kernels.ahead_of_time_files('aot_naming_probe')
     assert first[0] != second[0] and first[1] != second[1]
     assert first[0].parent == kernels.AHEAD_OF_TIME_DIR
-
-
-def test_uncompiled_runs_the_same_source_in_python_all_the_way_down():
-    """kernels.uncompiled: the reference is the compiled function's own source run by Python,
-    and so are the compiled functions it calls (no compiled code underneath it)."""
-    import numba
-
-    from multilift_sim import _numba_kernel
-    reference = kernels.uncompiled(_numba_kernel.integrate_period)
-    assert not hasattr(reference, 'py_func')
-    assert reference.__code__ is _numba_kernel.integrate_period.py_func.__code__
-    solve = reference.__globals__['solve']
-    assert solve.__code__ is _numba_kernel.solve.py_func.__code__
-    assert not isinstance(solve, numba.core.dispatcher.Dispatcher)
-    assert not isinstance(solve.__globals__['force_per_mass'], numba.core.dispatcher.Dispatcher)
-    # the module's own functions are untouched
-    assert isinstance(_numba_kernel.solve, numba.core.dispatcher.Dispatcher)
-    simulator = _swinging('twin_lift', ticks=2)
-    constants = kernels.model_constants(simulator.model)
-    wrenches = simulator.model.wrenches([np.full(4, 1500.0)] * simulator.n)
-    compiled = _numba_kernel.integrate_period(*constants, simulator.state, wrenches,
-                                              simulator.dt, 3)
-    python = reference(*constants, simulator.state, wrenches, simulator.dt, 3)
-    for a, b in zip(compiled, python):
-        assert np.array_equal(a, b)  # the same operations in the same order: the same bits

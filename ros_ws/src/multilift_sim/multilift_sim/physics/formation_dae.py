@@ -222,24 +222,15 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
     for j in range(nq):  # k = (q_dot, q_ddot): the state derivative
         k1[j] = x[nq + j]
         k1[nq + j] = acc[j]
-    for j in range(size):
-        stage[j] = x[j] + half * k1[j]
-    solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
-    for j in range(nq):
-        k2[j] = stage[nq + j]
-        k2[nq + j] = acc[j]
-    for j in range(size):
-        stage[j] = x[j] + half * k2[j]
-    solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
-    for j in range(nq):
-        k3[j] = stage[nq + j]
-        k3[nq + j] = acc[j]
-    for j in range(size):
-        stage[j] = x[j] + h * k3[j]
-    solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
-    for j in range(nq):
-        k4[j] = stage[nq + j]
-        k4[nq + j] = acc[j]
+    for k in (WORK_K2, WORK_K3, WORK_K4):  # stage k from x + (h/2 k1, h/2 k2, h k3)
+        step, previous = (h if k == WORK_K4 else half), work[k - 1]
+        for j in range(size):
+            stage[j] = x[j] + step * previous[j]
+        solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
+        derivative = work[k]
+        for j in range(nq):
+            derivative[j] = stage[nq + j]
+            derivative[nq + j] = acc[j]
     for j in range(size):
         out[j] = x[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
 

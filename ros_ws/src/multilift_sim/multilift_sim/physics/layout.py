@@ -65,7 +65,7 @@ CABLE_THRUST = 5            # UAV i's thrust acceleration u_T R e_z / m_i [m/s^2
 CABLE_COLUMNS = 8
 
 # -- an RK4 step's scratch (rows of a (WORK_ROWS, 2 (6n + 3)) array) ---------------------------
-WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives
+WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives (consecutive rows)
 WORK_STAGE = 4              # the stage's state
 WORK_ACC = 5                # q_ddot of the stage (its first 6n + 3 entries)
 WORK_MULTIPLIERS = 6        # Lambda of the later stages (its first n entries)
@@ -85,3 +85,10 @@ SLACK_MULTIPLIERS = 6       # Lambda of a taut set's update
 SLACK_CABLE_ROWS = 7
 SLACK_WATCHED, SLACK_CROSSING, SLACK_SNAPPING = 0, 1, 2
 SLACK_FLAGS = 3
+
+# -- a UAV's measured state: what the controllers read, one row of (n, MEASURED_COLUMNS) -------
+MEASURED_POSITION = 0       # r_i [m], world (3 slots)
+MEASURED_VELOCITY = 3       # r_i_dot [m/s], world (3)
+MEASURED_EULER = 6          # eta_i = (roll, pitch, yaw) [rad] (3)
+MEASURED_BODY_RATES = 9     # omega_i = W(eta_i) eta_i_dot [rad/s], body FLU (3)
+MEASURED_COLUMNS = 12

@@ -1,7 +1,8 @@
 """The control laws, each written once: numba functions over float arrays (constants, memory,
 states), compiled just in time (`numba.njit(cache=True)`, the cache under NUMBA_CACHE_DIR) or
 run uncompiled (`multilift_sim.kernels.uncompiled`: their own source in Python), as
-MULTILIFT_KERNEL says (`runnable`).
+MULTILIFT_KERNEL says (`runnable`, which is `kernels.runnable`: under aot, "built ahead of time
+or the uncompiled run", the laws run uncompiled, having no ahead-of-time build).
 
 One concern per module: `layout` (the named slots of every array below), `reference` (the
 mission reference and its prefilter), `cascade` (position loop, attitude from force, attitude
@@ -15,10 +16,8 @@ World frame z up, body FLU, ZYX Euler angles [rad], SI units (docs/conventions.m
 """
 from __future__ import annotations
 
-import functools
-from typing import Callable
-
 from multilift_sim import kernels
+from multilift_sim.kernels import runnable  # noqa: F401 - the wrappers' one way to a law
 
 # numba's array code without the scipy and coverage imports it does not need (their cost in
 # every process: kernels._import_numba_quietly)
@@ -27,15 +26,3 @@ import numba  # noqa: E402 - after the quiet import above
 
 # every law: compiled just in time, cached on disk, IEEE arithmetic in the source's order
 jit = numba.njit(cache=True, fastmath=False, nogil=True)
-
-
-def runnable(law: Callable) -> Callable:
-    """`law` as MULTILIFT_KERNEL says: compiled under auto and jit; its uncompiled run under
-    python, and under aot, which means "built ahead of time or the pure reference" and has no
-    ahead-of-time build of the laws (multilift_sim.kernels). A caller keeps what it got."""
-    return law if kernels.mode() in ('auto', 'jit') else _uncompiled(law)
-
-
-@functools.cache
-def _uncompiled(law: Callable) -> Callable:
-    return kernels.uncompiled(law)

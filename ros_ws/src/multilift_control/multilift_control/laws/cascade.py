@@ -81,7 +81,8 @@ def attitude_from_force(force, yaw, max_tilt):
     fx, fy, fz = force[0], force[1], force[2]
     if fz < 1e-6:
         fz = 1e-6
-    horizontal = math.hypot(fx, fy)
+    # not math.hypot: Python's and numba's (the C library's) may round differently
+    horizontal = math.sqrt(fx * fx + fy * fy)
     limit = fz * math.tan(max_tilt)
     if horizontal > limit:
         fx, fy = fx * (limit / horizontal), fy * (limit / horizontal)

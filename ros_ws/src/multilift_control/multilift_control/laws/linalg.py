@@ -21,6 +21,13 @@ def right_singular(matrix):
     p, q = matrix.shape
     columns = matrix.copy()
     basis = np.eye(q)
+    # a column this small (1e-30 of the matrix's norm) is a null direction found: rotating it
+    # further would only divide by its underflowing products
+    negligible = 0.0
+    for k in range(p):
+        for a in range(q):
+            negligible += matrix[k, a] * matrix[k, a]
+    negligible *= 1e-60
     for _ in range(_SWEEPS):
         rotated = False
         for a in range(q - 1):
@@ -30,11 +37,16 @@ def right_singular(matrix):
                     alpha += columns[k, a] * columns[k, a]
                     beta += columns[k, b] * columns[k, b]
                     gamma += columns[k, a] * columns[k, b]
-                if gamma == 0.0 or abs(gamma) <= _ORTHOGONAL * math.sqrt(alpha * beta):
+                if (gamma == 0.0 or alpha <= negligible or beta <= negligible
+                        or abs(gamma) <= _ORTHOGONAL * math.sqrt(alpha * beta)):
                     continue
                 rotated = True
                 zeta = (beta - alpha) / (2.0 * gamma)
-                tangent = math.copysign(1.0, zeta) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                if abs(zeta) < 1e150:
+                    tangent = math.copysign(1.0, zeta) / (abs(zeta)
+                                                          + math.sqrt(1.0 + zeta * zeta))
+                else:  # the same to the last bit, without zeta^2's overflow
+                    tangent = 0.5 / zeta
                 cosine = 1.0 / math.sqrt(1.0 + tangent * tangent)
                 sine = cosine * tangent
                 for k in range(p):

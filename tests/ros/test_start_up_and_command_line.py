@@ -12,10 +12,9 @@ import pytest
 import yaml
 
 from conftest import ROOT, SCENARIOS
-from multilift_control.cascade import COMPILED_LAWS
 from multilift_sim import kernels
 
-AHEAD_OF_TIME = (kernels.PHYSICS, COMPILED_LAWS)
+AHEAD_OF_TIME = (kernels.PHYSICS,)  # the control laws are compiled just in time only
 
 
 # -- the kernels and the control laws in a new process (tests/unit/test_kernels.py,
@@ -51,29 +50,28 @@ def test_setup_built_the_kernels_ahead_of_time_and_they_load_without_numba():
     for name in AHEAD_OF_TIME:
         assert all(path.is_file() for path in kernels.ahead_of_time_files(name)), name
     out = _a_tick_in_a_new_process(
-        'auto', f'law = kernels.compiled_module("{COMPILED_LAWS}").cascade_update\n'
+        'auto', f'law = kernels.compiled_module("{kernels.PHYSICS}").integrate_period\n'
                 'print(kernels.enabled(), isinstance(law, kernels._Checked), sim.t > 0,\n'
                 '      "numba" in sys.modules)\n')
     assert out.split() == ['True', 'True', 'True', 'False']
 
 
-@pytest.mark.parametrize('setting,expected', [(None, 'aot False ahead-of-time'),
-                                              ('jit', 'jit True just-in-time'),
-                                              ('python', 'python False pure')])
-def test_controller_nodes_run_the_laws_built_ahead_of_time_unless_told(setting, expected):
-    """A controller node (`prepare_node_laws`) runs the laws scripts/setup compiled ahead of
-    time, numba unimported, unless MULTILIFT_KERNEL says otherwise: with jit it loads the laws
-    compiled just in time before it answers, with python the pure methods."""
+@pytest.mark.parametrize('setting,expected', [(None, 'aot uncompiled'),
+                                              ('jit', 'jit just-in-time'),
+                                              ('python', 'python uncompiled')])
+def test_controller_nodes_run_the_laws_uncompiled_unless_told(setting, expected):
+    """A controller node (`prepare_node_laws`) runs the laws uncompiled (MULTILIFT_KERNEL=aot:
+    they are not built ahead of time) unless MULTILIFT_KERNEL says otherwise: with jit it
+    loads the laws compiled just in time before it answers."""
     code = ('import os, sys\n'
             'from multilift_control.runtime import ControllerRuntime, prepare_node_laws\n'
             'from multilift_sim import kernels, scenario\n'
             's = scenario.load("twin_lift")\n'
             'prepare_node_laws(s, 1)\n'
-            'law = ControllerRuntime(s, 1).follower._compiled_update\n'
-            'kind = ("pure" if law is None else "ahead-of-time"\n'
-            '        if isinstance(law, kernels._Checked) else\n'
+            'law = ControllerRuntime(s, 1).follower._update\n'
+            'kind = ("uncompiled" if not hasattr(law, "py_func") else\n'
             '        "just-in-time" if len(law.signatures) > 0 else "not loaded")\n'
-            'print(os.environ["MULTILIFT_KERNEL"], "numba" in sys.modules, kind)\n')
+            'print(os.environ["MULTILIFT_KERNEL"], kind)\n')
     env = {k: v for k, v in os.environ.items() if k != 'MULTILIFT_KERNEL'}
     if setting is not None:
         env['MULTILIFT_KERNEL'] = setting

@@ -39,8 +39,11 @@ def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
         return 0.0, 0.0, 0.0
     air_x = air_y = air_z = 0.0
     for k in range(gusts.shape[0]):
-        # 1-cosine gust (Eq. 2.55): r the horizontal distance from its centre
-        radius = math.hypot(px - gusts[k, GUST_CENTER], py - gusts[k, GUST_CENTER + 1])
+        # 1-cosine gust (Eq. 2.55): r the horizontal distance from its centre (a square root,
+        # not math.hypot: Python's and the C library's hypot round differently, and the
+        # uncompiled run must give the compiled one's bits)
+        east, north = px - gusts[k, GUST_CENTER], py - gusts[k, GUST_CENTER + 1]
+        radius = math.sqrt(east * east + north * north)
         h = gusts[k, GUST_GRADIENT_DISTANCE]
         if radius > h:
             speed = 0.0

@@ -21,7 +21,7 @@ from std_msgs.msg import Byte, ByteMultiArray, Int64
 
 from multilift_sim.ros.introspection import message_to_ordered, message_to_yaml
 
-from conftest import ROOT
+from conftest import ROOT, wait_for
 DOMAIN = 75 + os.getpid() % 25
 ENV = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
 LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
@@ -90,11 +90,17 @@ def publishers():
 
 
 def test_list_and_info(publishers):
-    out = multilift('topic', 'list', '-t')
-    assert out.returncode == 0, out.stderr
-    lines = out.stdout.splitlines()
-    assert '/tools_test/rotor_command [multilift_msgs/msg/RotorCommand]' in lines
-    assert '/tools_test/odom [nav_msgs/msg/Odometry]' in lines
+    wanted = {'/tools_test/rotor_command [multilift_msgs/msg/RotorCommand]',
+              '/tools_test/odom [nav_msgs/msg/Odometry]'}
+
+    def listed() -> list[str] | None:
+        # `topic list` ends once the graph settles (as ros2cli's does); on a loaded machine the
+        # publishers' node may be seen a moment before its topics: ask again until they are
+        out = multilift('topic', 'list', '-t')
+        assert out.returncode == 0, out.stderr
+        lines = out.stdout.splitlines()
+        return lines if wanted <= set(lines) else None
+    wait_for(listed, 60, 'the publishers\' topics in `topic list -t`')
     names = multilift('topic', 'list').stdout.splitlines()
     assert '/tools_test/odom' in names and names == sorted(names)
 

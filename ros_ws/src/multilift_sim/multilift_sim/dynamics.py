@@ -236,10 +236,12 @@ class FormationModel:
         self._n = n
         self._nq = self.layout.n_coordinates
         self._allocators = tuple(uav.allocator() for uav in params.uavs)
-        rotor_counts = {a.n_rotors for a in self._allocators}
-        # One (n, 4, n_r) stack when every UAV has the same rotor count, else per-UAV products.
-        self._stacked_allocation = (np.stack([a.matrix for a in self._allocators])
-                                    if len(rotor_counts) == 1 else None)
+        self._rotor_counts = tuple(a.n_rotors for a in self._allocators)
+        # (n, 4, rotors): each UAV's allocation matrix (seed Eq. 2.14), zero-padded to the
+        # largest rotor count (a padded rotor at speed 0 adds nothing)
+        self.allocation = np.zeros((n, 4, max(self._rotor_counts)))
+        for i, allocator in enumerate(self._allocators):
+            self.allocation[i, :, :allocator.n_rotors] = allocator.matrix
         self.uav_masses = np.array([uav.mass for uav in params.uavs])
         self.uav_inertia = np.array([uav.inertia for uav in params.uavs])      # (n, 3)
         self.cable_lengths = np.array(params.cable_lengths)
@@ -254,10 +256,11 @@ class FormationModel:
     # ------------------------------------------------------------------------- physics
     def _physics_functions(self) -> dict[str, Callable]:
         """The physics functions this model calls, by name (numba dispatchers)."""
+        from multilift_sim.physics.allocation import rotor_wrenches
         from multilift_sim.physics.formation_dae import (integrate_period, residuals, rk4_step,
                                                          solve)
         return {'solve': solve, 'rk4_step': rk4_step, 'integrate_period': integrate_period,
-                'residuals': residuals}
+                'residuals': residuals, 'rotor_wrenches': rotor_wrenches}
 
     def _physics(self) -> dict[str, Callable]:
         """_physics_functions as MULTILIFT_KERNEL says, loaded once per mode."""
@@ -285,20 +288,26 @@ class FormationModel:
         """Body wrenches ``u_i = (u_T [N], tau_x, tau_y, tau_z [N m])`` (FLU), shape (n, 4)."""
         if len(rotor_speeds) != self._n:
             raise ValueError(f'rotor_speeds has {len(rotor_speeds)} entries for {self._n} UAVs')
-        if self._stacked_allocation is not None:
+        rotors = self.allocation.shape[2]
+        speeds = None
+        if len(set(self._rotor_counts)) == 1:
             try:
                 speeds = np.asarray(rotor_speeds, dtype=float)
             except ValueError:     # ragged: the loop below names the UAV
                 speeds = None
-            if speeds is not None and speeds.shape == self._stacked_allocation.shape[::2]:
-                return np.einsum('ikr,ir->ik', self._stacked_allocation, speeds * speeds)
-        wrenches = np.empty((self._n, 4))
-        for i, (allocator, speeds) in enumerate(zip(self._allocators, rotor_speeds)):
-            speeds = np.asarray(speeds, dtype=float)
-            if speeds.shape != (allocator.n_rotors,):
-                raise ValueError(f'rotor_speeds[{i}] (uav{i + 1}) must have shape '
-                                 f'({allocator.n_rotors},), got {speeds.shape}')
-            wrenches[i] = allocator.wrench(speeds)
+            if speeds is not None and speeds.shape != (self._n, rotors):
+                speeds = None
+        if speeds is None:
+            speeds = np.zeros((self._n, rotors))
+            for i, (count, own) in enumerate(zip(self._rotor_counts, rotor_speeds)):
+                own = np.asarray(own, dtype=float)
+                if own.shape != (count,):
+                    raise ValueError(f'rotor_speeds[{i}] (uav{i + 1}) must have shape '
+                                     f'({count},), got {own.shape}')
+                speeds[i, :count] = own
+        wrenches = np.empty((self._n, WRENCH_COLUMNS))
+        self._physics()['rotor_wrenches'](self.allocation, np.ascontiguousarray(speeds),
+                                          wrenches)
         return wrenches
 
     # --------------------------------------------------------------------------- dynamics

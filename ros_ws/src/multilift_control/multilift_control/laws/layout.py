@@ -6,13 +6,16 @@ held heading) one small float array it updates in place, NaN standing for "none 
 formation's measured states are one (n, UAV_STATE_SIZE) array, a UAV a row. Units: SI, angles
 [rad], world frame z up, body FLU (docs/conventions.md).
 """
+from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
+                                          MEASURED_POSITION, MEASURED_VELOCITY)
 
-# --- a UAV's measured state: one row of the formation's states (n, UAV_STATE_SIZE) ------------
-UAV_POSITION = 0       # (3) world [m]
-UAV_VELOCITY = 3       # (3) world [m/s]
-UAV_EULER = 6          # (3) roll, pitch, yaw [rad]
-UAV_BODY_RATES = 9     # (3) body angular velocity, FLU [rad/s]
-UAV_STATE_SIZE = 12
+# --- a UAV's measured state: one row of the formation's states (n, UAV_STATE_SIZE), the slots
+# the simulator measures into (multilift_sim.physics.layout MEASURED_*, physics.measurement) ---
+UAV_POSITION = MEASURED_POSITION        # (3) world [m]
+UAV_VELOCITY = MEASURED_VELOCITY        # (3) world [m/s]
+UAV_EULER = MEASURED_EULER              # (3) roll, pitch, yaw [rad]
+UAV_BODY_RATES = MEASURED_BODY_RATES    # (3) body angular velocity, FLU [rad/s]
+UAV_STATE_SIZE = MEASURED_COLUMNS
 
 # --- the mission reference a leader tracks (reference.mission_reference's result) -------------
 REFERENCE_POSITION = 0      # (3) [m]

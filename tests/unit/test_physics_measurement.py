@@ -1,0 +1,57 @@
+"""What the controllers measure (physics.measurement, seed Eq. 2.7) and the rotor wrenches
+(physics.allocation, Eq. 2.14): compiled vs their uncompiled run to the bit, and against
+independent forms (kinematics' W(eta) matrix, each allocator's matrix product)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from multilift_sim import kernels
+from multilift_sim import scenario as scenario_io
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.kinematics import euler_rate_matrix
+from multilift_sim.physics.allocation import rotor_wrenches
+from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
+                                          MEASURED_POSITION, MEASURED_VELOCITY)
+from multilift_sim.physics.measurement import measured_states
+
+
+def _random_state(n: int, rng) -> np.ndarray:
+    x = rng.normal(size=2 * (6 * n + 3))
+    x[:6 * n].reshape(n, 6)[:, 3:5] *= 0.4  # roll and pitch within +-1.2 rad or so
+    return x
+
+
+@pytest.mark.parametrize('n', [1, 2, 5])
+def test_measured_states_compiled_equal_uncompiled_and_w_eta_dot(n):
+    rng = np.random.default_rng(n)
+    x = _random_state(n, rng)
+    compiled, python = np.empty((n, MEASURED_COLUMNS)), np.empty((n, MEASURED_COLUMNS))
+    measured_states(x, n, compiled)
+    kernels.uncompiled(measured_states)(x, n, python)
+    assert np.array_equal(compiled, python)
+    nq = 6 * n + 3
+    for i in range(n):
+        eta, eta_dot = x[6 * i + 3:6 * i + 6], x[nq + 6 * i + 3:nq + 6 * i + 6]
+        row = compiled[i]
+        assert np.array_equal(row[MEASURED_POSITION:MEASURED_POSITION + 3], x[6 * i:6 * i + 3])
+        assert np.array_equal(row[MEASURED_VELOCITY:MEASURED_VELOCITY + 3],
+                              x[nq + 6 * i:nq + 6 * i + 3])
+        assert np.array_equal(row[MEASURED_EULER:MEASURED_EULER + 3], eta)
+        assert np.allclose(row[MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3],
+                           euler_rate_matrix(eta) @ eta_dot, rtol=1e-13, atol=1e-13)
+
+
+def test_rotor_wrenches_are_each_allocation_times_the_squared_speeds():
+    scenario = scenario_io.load('circle3')
+    model = FormationModel(scenario.formation_params())
+    rng = np.random.default_rng(4)
+    speeds = rng.uniform(800.0, 2000.0, size=(scenario.n_uavs, model.allocation.shape[2]))
+    compiled, python = np.empty((scenario.n_uavs, 4)), np.empty((scenario.n_uavs, 4))
+    rotor_wrenches(model.allocation, speeds, compiled)
+    kernels.uncompiled(rotor_wrenches)(model.allocation, speeds, python)
+    assert np.array_equal(compiled, python)
+    for i, uav in enumerate(scenario.uavs):
+        expected = uav.vehicle.allocator().matrix @ speeds[i] ** 2
+        assert np.allclose(compiled[i], expected, rtol=1e-13)
+    assert np.array_equal(model.wrenches(list(speeds)), compiled)

@@ -20,6 +20,7 @@ setup(
         'console_scripts': [
             'leader_node = multilift_control.ros.leader_node:main',
             'follower_node = multilift_control.ros.follower_node:main',
+            'controllers_node = multilift_control.ros.controllers_node:main',
         ],
     },
 )

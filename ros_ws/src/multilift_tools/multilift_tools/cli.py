@@ -1,6 +1,6 @@
 """`scripts/multilift`: the command line of multilift (what ros2cli and launch give elsewhere).
 
-    multilift run SCENARIO [--bag DIR] [--duration S] [--realtime] [--headless]
+    multilift run SCENARIO [--bag DIR] [--duration S] [--realtime] [--headless | --compose]
                            [--external uav1[,uav3,...]]
     multilift node PKG EXECUTABLE [args...]
     multilift topic list | echo TOPIC [--once] | info TOPIC
@@ -162,6 +162,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f'error: --external: {exc}', file=sys.stderr)
         return 2
     if args.headless:
+        if args.compose:
+            print('error: --compose puts the controller nodes in one process; --headless starts '
+                  'no node (nothing to compose)', file=sys.stderr)
+            return 2
         if external:
             print('error: --external needs the ROS graph (not --headless)', file=sys.stderr)
             return 2
@@ -174,9 +178,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     common = {'scenario': scenario_path, 'record': record, 'summary_dir': str(summary_dir)}
     try:
         sim_exe = find_executable('multilift_sim', 'sim_node')
-        leader_exe = find_executable('multilift_control', 'leader_node')
         recorder_exe = find_executable('multilift_sim', 'recorder_node')
-        follower_exe = find_executable('multilift_control', 'follower_node')
+        controllers = _controller_children(scenario, external, args.compose, common, work)
     except FileNotFoundError as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2
@@ -188,18 +191,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.duration is not None:
         sim_params['duration'] = float(args.duration)
     children = [Child('sim_node', [str(sim_exe), *_ros_args(sim_params)],
-                      work / 'sim_node.log', 'sim')]
-    if 1 not in external:
-        children.append(Child('leader_node', [str(leader_exe), *_ros_args(common)],
-                              work / 'leader_node.log', 'controller'))
-    if scenario.n_uavs > 1:
-        for i in range(2, scenario.n_uavs + 1):
-            if i in external:
-                continue
-            argv = [str(follower_exe), *_ros_args(dict(common, uav_index=i)),
-                    '-r', f'__node:=follower{i}']
-            children.append(Child(f'follower_node (uav{i})', argv,
-                                  work / f'follower{i}_node.log', 'controller'))
+                      work / 'sim_node.log', 'sim'), *controllers]
     recorder: Child | None = None
     if record:
         _fresh_bag_dir(bag)
@@ -249,6 +241,44 @@ def cmd_run(args: argparse.Namespace) -> int:
     else:
         shutil.rmtree(work, ignore_errors=True)
     return 0
+
+
+def _controller_children(scenario, external: list[int], compose: bool, common: dict,
+                         work: Path) -> list[Child]:
+    """The processes of the controllers of every UAV but the external ones: a leader_node and
+    a follower_node each, or with `compose` one controllers_node holding them all."""
+    ours = [i for i in range(1, scenario.n_uavs + 1) if i not in external]
+    if compose:
+        if not ours:
+            return []
+        argv = [str(find_executable('multilift_control', 'controllers_node')),
+                common['scenario'], '--summary-dir', common['summary_dir']]
+        argv += (['--record'] if common['record'] else []) + (
+            ['--external', ','.join(f'uav{i}' for i in external)] if external else [])
+        return [Child(f'controllers ({_uav_ranges(ours)})', argv, work / 'controllers_node.log',
+                      'controller')]
+    children = []
+    for i in ours:
+        if i == 1:
+            argv = [str(find_executable('multilift_control', 'leader_node')), *_ros_args(common)]
+            children.append(Child('leader_node', argv, work / 'leader_node.log', 'controller'))
+        else:
+            argv = [str(find_executable('multilift_control', 'follower_node')),
+                    *_ros_args(dict(common, uav_index=i)), '-r', f'__node:=follower{i}']
+            children.append(Child(f'follower_node (uav{i})', argv,
+                                  work / f'follower{i}_node.log', 'controller'))
+    return children
+
+
+def _uav_ranges(indices: list[int]) -> str:
+    """[1, 2, 3, 5] -> 'uav1..uav3, uav5'."""
+    runs: list[list[int]] = []
+    for i in indices:
+        if runs and runs[-1][-1] == i - 1:
+            runs[-1].append(i)
+        else:
+            runs.append([i])
+    return ', '.join(f'uav{r[0]}' + (f'..uav{r[-1]}' if len(r) > 1 else '') for r in runs)
 
 
 def _bag_state(bag: Path, recorder: Child) -> str:
@@ -365,6 +395,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument('--headless', action='store_true',
                      help='no ROS graph: the same physics and control laws in one process, '
                           'the same bag')
+    run.add_argument('--compose', action='store_true',
+                     help='every controller node (leader and followers) in one process, one '
+                          'executor: the same graph and bag, fewer processes')
     run.set_defaults(func=cmd_run)
     node = sub.add_parser('node', help='run one node, like `ros2 run`')
     node.add_argument('package')

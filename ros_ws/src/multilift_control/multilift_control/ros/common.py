@@ -1,11 +1,14 @@
-"""What both controller nodes read from the simulator: `/formation/snapshot` -> model types."""
+"""What both controller nodes share: `/formation/snapshot` -> model types, and their life."""
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
+from rclpy.node import Node
 
 from multilift_control.cascade import FormationStates, UavState
 from multilift_sim import cdr
-from multilift_sim.ros.common import Fatal
+from multilift_sim.ros.common import Fatal, serve_controllers
 from multilift_sim.scenario import Scenario
 from multilift_sim.topics import FORMATION_SNAPSHOT as SNAPSHOT_TOPIC  # noqa: F401 (nodes)
 
@@ -32,3 +35,9 @@ class SnapshotReader:
             position.reshape(-1, 3), velocity.reshape(-1, 3), euler.reshape(-1, 3),
             body_rates.reshape(-1, 3)))
         return t_ns, states, np.split(previous, self._edges) if previous.size else []
+
+
+def serve(nodes: Sequence[Node]) -> None:
+    """Controller nodes' life, in a process of their own or composed (`controllers_node`):
+    `serve_controllers`, each node's summary named and written by its runtime."""
+    serve_controllers(nodes, lambda node: (node.runtime.name, node.runtime.summary()))

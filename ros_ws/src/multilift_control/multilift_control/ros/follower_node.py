@@ -20,18 +20,20 @@ from rclpy.node import Node
 
 from multilift_control.answer_messages import AnswerMessages
 from multilift_control.cascade import UavState
-from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
+from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader, serve
 from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
                                       RawPublishers, controller_peers_missing, ns_from_stamp,
-                                      run_node, serve_controller)
+                                      run_nodes)
 from multilift_sim.topics import uav_topic
 
 
 class FollowerNode(Node):
-    def __init__(self) -> None:
-        super().__init__('follower')  # a run names each one: --ros-args -r __node:=follower2
+    def __init__(self, node_name: str = 'follower', **options) -> None:
+        """A run names each one followerN (`--ros-args -r __node:=follower2`, or `node_name`);
+        `options`: rclpy Node's (parameter_overrides, ...: `controllers_node` composes)."""
+        super().__init__(node_name, **options)
         name = self.declare_parameter('scenario', '').value
         self.index = int(self.declare_parameter('uav_index', 2).value)
         self.record = bool(self.declare_parameter('record', False).value)
@@ -88,8 +90,7 @@ class FollowerNode(Node):
 
 
 def main(args: list[str] | None = None) -> NoReturn:
-    run_node(FollowerNode, lambda node: serve_controller(
-        node, node.runtime.name, node.runtime.summary), args)
+    run_nodes(lambda: [FollowerNode()], serve, args)
 
 
 if __name__ == '__main__':

@@ -15,18 +15,18 @@ from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorComman
 from rclpy.node import Node
 
 from multilift_control.answer_messages import AnswerMessages
-from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader
+from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader, serve
 from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
-                                      RawPublishers, controller_peers_missing, run_node,
-                                      serve_controller)
+                                      RawPublishers, controller_peers_missing, run_nodes)
 from multilift_sim.topics import uav_topic
 
 
 class LeaderNode(Node):
-    def __init__(self) -> None:
-        super().__init__('leader')
+    def __init__(self, **options) -> None:
+        """`options`: rclpy Node's (parameter_overrides, ...: `controllers_node` composes)."""
+        super().__init__('leader', **options)
         name = self.declare_parameter('scenario', '').value
         self.record = bool(self.declare_parameter('record', False).value)
         self.summary_dir = self.declare_parameter('summary_dir', '').value
@@ -57,8 +57,7 @@ class LeaderNode(Node):
 
 
 def main(args: list[str] | None = None) -> NoReturn:
-    run_node(LeaderNode, lambda node: serve_controller(
-        node, node.runtime.name, node.runtime.summary), args)
+    run_nodes(lambda: [LeaderNode()], serve, args)
 
 
 if __name__ == '__main__':

@@ -13,7 +13,7 @@ import threading
 import time
 import traceback
 from pathlib import Path
-from typing import Callable, Iterable, NoReturn
+from typing import Callable, Iterable, NoReturn, Sequence
 
 import numpy as np
 import rclpy
@@ -134,14 +134,23 @@ def controller_peers_missing(node: Node, command_publisher, record: bool) -> str
     return recorder_missing(node, own)
 
 
-def serve_controller(node: Node, summary_name: str, summary: Callable[[], dict]) -> None:
-    """A controller node's life: wait for its peers (`node.missing_peers`), answer states until
-    stopped, then leave `summary()` as `<summary_dir>/<summary_name>.json`."""
-    wait_until(node, node.missing_peers, STARTUP_TIMEOUT)
+def serve_controllers(nodes: Sequence[Node], summary: Callable[[Node], tuple[str, dict]]) -> None:
+    """Controller nodes' life, one node or several composed in one executor: wait for the
+    peers of every one (`node.missing_peers`), answer states until stopped, then leave each
+    node's `summary(node)` (name, figures) as `<summary_dir>/<name>.json`."""
+    def missing() -> str | None:
+        for node in nodes:
+            what = node.missing_peers()
+            if what is not None:
+                return what if len(nodes) == 1 else f'{what} ({node.get_name()})'
+        return None
+
+    wait_until(nodes[0], missing, STARTUP_TIMEOUT)
     try:
-        spin(node)
+        spin(nodes[0])
     finally:
-        write_summary(node.summary_dir, summary_name, summary())
+        for node in nodes:
+            write_summary(node.summary_dir, *summary(node))
 
 
 def wait_until(node: Node, ready: Callable[[], str | None], timeout: float) -> None:
@@ -239,13 +248,6 @@ def wait_for_acknowledgements(publishers: Iterable, timeout: float) -> list[str]
     return unacknowledged
 
 
-def flush_publishers(node: Node, timeout: float = FLUSH_TIMEOUT) -> None:
-    """Wait until every subscriber acknowledged this node's messages. A reliable writer that
-    is destroyed first takes its unacknowledged history with it: a recorder lagging behind
-    would lose the last messages of the run."""
-    wait_for_acknowledgements(node.publishers, timeout)
-
-
 def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
@@ -291,14 +293,24 @@ class TeardownGuard:
 
 def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None = None,
              args: list[str] | None = None) -> NoReturn:
-    """Create, run and shut down a node safely (SIGINT, SIGTERM, external shutdown), then end
-    the process: a node's process entry point.
+    """`run_nodes` of one node: `body(node)`, or the node spun."""
+    run_nodes(lambda: [make_node()], None if body is None else lambda nodes: body(nodes[0]),
+              args)
 
-    The node is added to an executor (`node.executor`). `body(node)` runs the node's own loop
-    if it has one; otherwise the node is spun. Once the node's publishers are flushed, the
-    teardown runs under a `TeardownGuard`, and the process ends with `os._exit`: the
-    interpreter's finalization and the DDS library's static destructors, which would run in
-    threads no watchdog reaches, have nothing left to do.
+
+def run_nodes(make_nodes: Callable[[], Iterable[Node]],
+              body: Callable[[list[Node]], None] | None = None,
+              args: list[str] | None = None, name: str | None = None) -> NoReturn:
+    """Create, run and shut down one node, or several composed in one process (one rclpy
+    context, one executor), safely (SIGINT, SIGTERM, external shutdown), then end the process:
+    a node process's entry point.
+
+    Each node `make_nodes()` yields is added to one executor as it comes (`node.executor`),
+    so a failure half-way tears down those made before it. `body(nodes)` runs the nodes' own
+    loop if they have one; otherwise they are spun. Once every node's publishers are flushed,
+    the teardown runs under a `TeardownGuard` (named `name`, by default the first node's), and
+    the process ends with `os._exit`: the interpreter's finalization and the DDS library's
+    static destructors, which would run in threads no watchdog reaches, have nothing left to do.
     Errors of kind Fatal, StartupError or ScenarioError print one line; exit code 1 (2 for a
     ScenarioError).
     """
@@ -309,19 +321,21 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     signal.signal(signal.SIGINT, _interrupt)
     signal.signal(signal.SIGTERM, _interrupt)
-    node = None
+    nodes: list[Node] = []
     code = 0
     flush_timeout = FLUSH_TIMEOUT
     executor = make_executor()
-    guard = TeardownGuard(sys.argv[0].rsplit('/', 1)[-1] or 'node')
+    guard = TeardownGuard(name or sys.argv[0].rsplit('/', 1)[-1] or 'node')
     try:
-        node = make_node()
-        guard.name = node.get_name()
-        executor.add_node(node)
+        for node in make_nodes():
+            nodes.append(node)
+            executor.add_node(node)
+        if name is None:
+            guard.name = nodes[0].get_name()
         if body is None:
-            spin(node)
+            spin(nodes[0])
         else:
-            body(node)
+            body(nodes)
     except (KeyboardInterrupt, ExternalShutdownException):
         flush_timeout = FLUSH_TIMEOUT_STOPPING
     except (Fatal, StartupError, ScenarioError) as exc:
@@ -338,20 +352,22 @@ def run_node(make_node: Callable[[], Node], body: Callable[[Node], None] | None 
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
         guard.arm(code, flush_timeout + TEARDOWN_LIMIT)
-        if node is not None:
-            flush_publishers(node, flush_timeout)
-        # the executor lets go of the node's callbacks before the node's entities are destroyed
+        # every subscriber acknowledges the nodes' messages first: a reliable writer destroyed
+        # before takes its unacknowledged history with it (a recorder lagging behind would lose
+        # the last messages of the run)
+        wait_for_acknowledgements([p for node in nodes for p in node.publishers], flush_timeout)
+        # the executor lets go of the nodes' callbacks before the nodes' entities are destroyed
         try:
             executor.shutdown(timeout_sec=1.0)
         except Exception:  # noqa: BLE001 - shutting down anyway
             pass
-        if node is not None:
+        for node in nodes:
             try:
                 node.destroy_node()
             except Exception:  # noqa: BLE001 - shutting down anyway
                 pass
         rclpy.try_shutdown()
-        del executor, node
+        del executor, nodes
         guard.disarm()
     sys.stdout.flush()
     sys.stderr.flush()

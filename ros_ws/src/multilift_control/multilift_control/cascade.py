@@ -67,12 +67,7 @@ class FormationStates(tuple):
 
     @functools.cached_property
     def array(self) -> np.ndarray:
-        out = np.empty((len(self), UAV_STATE_SIZE))
-        for row, state in zip(out, self):
-            row[UAV_POSITION:UAV_POSITION + 3] = state.position
-            row[UAV_VELOCITY:UAV_VELOCITY + 3] = state.velocity
-            row[UAV_EULER:UAV_EULER + 3] = state.euler
-            row[UAV_BODY_RATES:UAV_BODY_RATES + 3] = state.body_rates
+        out = np.array([state.row() for state in self]).reshape(len(self), UAV_STATE_SIZE)
         out.flags.writeable = False
         return out
 

@@ -172,6 +172,7 @@ class VirtualConstraints:
         self._rates = laws.runnable(rows_laws.rates)
         self._jacobian_rate_product = laws.runnable(rows_laws.jacobian_rate_product)
         self._free_follower_motions = laws.runnable(rows_laws.free_follower_motions)
+        self._rows_of = laws.runnable(rows_laws.rows_of)
 
     def offsets(self) -> np.ndarray:
         """(n-1, 3) desired r_1 - r_i per follower [m], world (linear and v only)."""
@@ -216,7 +217,7 @@ class VirtualConstraints:
         """Indices of the rows that involve UAV index i (0 = leader)."""
         if not 0 <= i < self.n:
             raise ValueError(f'UAV index {i} outside 0..{self.n - 1}')
-        return [k for k, (a, b) in enumerate(self.pairs) if i in (a, b)]
+        return self._rows_of(self.rows, i).tolist()
 
     def free_follower_motions(self, r: np.ndarray, tol: float = 1e-9) -> np.ndarray:
         """Orthonormal basis (2(n-1), k) of the followers' horizontal motions that leave every

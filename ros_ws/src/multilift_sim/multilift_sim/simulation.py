@@ -16,7 +16,8 @@ from multilift_sim.formation_geometry import (hanging_payload, nominal_positions
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
 from multilift_sim.scenario import Scenario
-from multilift_sim.statistics import RunStatistics, payload_swing_at
+from multilift_sim.statistics import RunStatistics
+from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
 
 
 class SimulationStopped(RuntimeError):
@@ -102,8 +103,9 @@ class FormationSimulator:
         self.payload_gust: np.ndarray = np.zeros(3)
         # how far each cable reaches for the swing's equilibrium place: l_i widened by the
         # constraint tolerance, so cables held within it always meet [m]
-        self._reach = [math.sqrt(u.cable_length ** 2 + sim.constraint_tolerance)
-                       for u in scenario.uavs]
+        self._reach = np.array([math.sqrt(u.cable_length ** 2 + sim.constraint_tolerance)
+                                for u in scenario.uavs])
+        self._all_taut = np.ones(self.n, dtype=bool)  # the cables of a rigid cable model
         # payload swing every tick for one or two UAVs (a closed form); from three on, where
         # rigid cables hold the payload at its equilibrium place, at 10 Hz of a 100 Hz loop
         self._swing_every = 1 if self.n <= 2 else 10
@@ -183,9 +185,7 @@ class FormationSimulator:
     def advance(self, rotor_speeds: list[np.ndarray], saturated: list[np.ndarray]) -> None:
         """Hold `rotor_speeds` over one control period and integrate to the next tick."""
         speeds = self._checked_speeds(rotor_speeds)
-        peaks = np.abs(speeds).max(axis=1) if isinstance(speeds, np.ndarray) \
-            else [float(np.abs(s).max()) for s in speeds]
-        self.stats.add_commands(peaks, saturated, self.period_ns * 1e-9)
+        self.stats.add_commands(speeds, saturated, self.period_ns * 1e-9)
         step = self.model.integrate(self.state, speeds, self.dt, self.steps_per_tick)
         self.state = step.state
         self.last_step = step
@@ -193,7 +193,6 @@ class FormationSimulator:
         if self.scenario.cable_model == 'slack':
             self.stats.add_slack(self.taut, self.period_ns * 1e-9)
         self.tick += 1
-        self.stats.simulated_time = self.t
         self._check(self.t, (step.constraint, step.constraint_rate))
 
     def _checked_speeds(self, rotor_speeds: list[np.ndarray]) -> np.ndarray | list[np.ndarray]:
@@ -228,37 +227,28 @@ class FormationSimulator:
     def _check(self, t: float,
                residuals: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """Algorithm 1, lines 10-13: stop when a cable leaves its tolerance (or the state is
-        no longer finite); `residuals`: (g, g_dot) at this state when already computed."""
-        if not np.isfinite(self.state).all():
-            raise SimulationStopped(f'the formation state became non-finite at t = {t:.3f} s')
+        no longer finite); `residuals`: (g, g_dot) at this state when already computed. The
+        check and the figures it accumulates are `statistics.accumulators.run_check`."""
         g, g_dot = residuals if residuals is not None else \
             self.model.constraint_residuals(self.state)
-        self.residuals = (g, g_dot)
-        # per cable in plain floats (a few cables: numpy's per-call cost would dominate)
-        abs_g, abs_g_dot = [abs(v) for v in g.tolist()], [abs(v) for v in g_dot.tolist()]
         taut = getattr(self.model, 'taut', None)
-        if taut is not None:  # the tolerances hold for taut cables only (cable_model: slack)
-            abs_g = [v if held else 0.0 for v, held in zip(abs_g, taut.tolist())]
-            abs_g_dot = [v if held else 0.0 for v, held in zip(abs_g_dot, taut.tolist())]
-        peak, peak_rate = max(abs_g), max(abs_g_dot)
-        worst, worst_rate = abs_g.index(peak), abs_g_dot.index(peak_rate)  # the first, as argmax
-        stats = self.stats
-        stats.add_constraints(peak, peak_rate)
-        if self.tick % self._swing_every == 0:
-            n, x = self.n, self.state
-            stats.swing.add(payload_swing_at(x[:6 * n].reshape(n, 6)[:, :3],
-                                             x[6 * n:6 * n + 3], self._reach))
+        sim = self.scenario.simulation
+        status, cable = self.stats.check(
+            self.state, g, g_dot, self._all_taut if taut is None else taut,
+            sim.constraint_tolerance, sim.constraint_rate_tolerance, t, self.tick,
+            self._swing_every, self._reach)
+        if status == CHECK_NON_FINITE:
+            raise SimulationStopped(f'the formation state became non-finite at t = {t:.3f} s')
+        self.residuals = (g, g_dot)
         gust = self.payload_gust = self.model.gust_velocity_at_payload(t, self.state)
         if self.scenario.gusts:
-            stats.max_gust_speed = max(stats.max_gust_speed,
-                                       math.sqrt(gust @ gust))  # np.linalg.norm's arithmetic
-        sim = self.scenario.simulation
-        if peak > sim.constraint_tolerance:
+            self.stats.add_gust_speed(math.sqrt(gust @ gust))  # np.linalg.norm's arithmetic
+        if status == CHECK_G:
             raise SimulationStopped(
-                f'cable {worst + 1}: constraint residual |g| = {peak:.3g} m^2 exceeds '
+                f'cable {cable + 1}: constraint residual |g| = {abs(g[cable]):.3g} m^2 exceeds '
                 f'the tolerance {sim.constraint_tolerance:g} m^2 at t = {t:.3f} s '
                 '(Algorithm 1: change the step or the Baumgarte gains)')
-        if peak_rate > sim.constraint_rate_tolerance:
+        if status == CHECK_G_DOT:
             raise SimulationStopped(
-                f'cable {worst_rate + 1}: constraint rate |g_dot| = {peak_rate:.3g} m^2/s '
+                f'cable {cable + 1}: constraint rate |g_dot| = {abs(g_dot[cable]):.3g} m^2/s '
                 f'exceeds the tolerance {sim.constraint_rate_tolerance:g} m^2/s at t = {t:.3f} s')

@@ -1,0 +1,150 @@
+"""The run statistics' per-tick accumulation and seed Algorithm 1's check (lines 10-13),
+compiled: numba functions that update the float accumulator arrays of
+`multilift_sim.statistics.layout` in place. One formation's arrays per call, so a compiled
+tick (or a batch of them) calls them as they are; `multilift_sim.statistics.figures` holds the
+arrays behind the classes the simulator and the controllers use.
+
+Each comparison keeps the semantics of Python's max/min that the figures were defined with: a
+value replaces the figure only when it compares greater (smaller), so NaN never does.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from multilift_sim.physics._jit import jit
+from multilift_sim.physics.layout import POSITION, UAV_COORDINATES
+from multilift_sim.statistics.layout import (
+    CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS, FORMATION_NORM_SUM,
+    FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
+    RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION,
+    RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
+    RUN_UAV_COLUMNS, TRACKING_ERROR)
+from multilift_sim.statistics.swing import swing_at
+
+
+@jit
+def peak_rms_add(acc: np.ndarray, block: int, value: float) -> None:
+    """One sample of a non-negative signal into the peak/rms block at `block` (PEAK_*)."""
+    if value > acc[block + PEAK_MAX]:
+        acc[block + PEAK_MAX] = value
+    acc[block + PEAK_SUM_SQ] += value * value
+    acc[block + PEAK_SAMPLES] += 1.0
+
+
+@jit
+def run_add_commands(run: np.ndarray, rotor_speeds: np.ndarray, saturated: np.ndarray,
+                     period: float) -> None:
+    """One control period [s] of commands: each UAV's rotor speeds, a row of (n, k) [rad/s]
+    (its peak |speed| raises the UAV's max; k = 1: the peak itself; padded with 0), and its
+    saturation flags, a row of (n, m) bool (any set: the period counts as saturated; padded
+    with False)."""
+    for i in range(rotor_speeds.shape[0]):
+        block = RUN_SCALARS + RUN_UAV_COLUMNS * i
+        peak = abs(rotor_speeds[i, 0])
+        for r in range(1, rotor_speeds.shape[1]):
+            if abs(rotor_speeds[i, r]) > peak:
+                peak = abs(rotor_speeds[i, r])
+        if peak > run[block + RUN_MAX_ROTOR_SPEED]:
+            run[block + RUN_MAX_ROTOR_SPEED] = peak
+        for r in range(saturated.shape[1]):
+            if saturated[i, r]:
+                run[block + RUN_SATURATED_TIME] += period
+                break
+
+
+@jit
+def run_add_tensions(run: np.ndarray, tension: np.ndarray) -> None:
+    """The cable tensions T_i (n,) [N] of one tick into the min and max tension."""
+    low, high = tension[0], tension[0]
+    for i in range(1, tension.shape[0]):
+        if tension[i] < low:
+            low = tension[i]
+        if tension[i] > high:
+            high = tension[i]
+    if low < run[RUN_MIN_TENSION]:
+        run[RUN_MIN_TENSION] = low
+    if high > run[RUN_MAX_TENSION]:
+        run[RUN_MAX_TENSION] = high
+
+
+@jit
+def run_add_slack(run: np.ndarray, taut: np.ndarray, period: float) -> None:
+    """A control period [s] ending with these cables taut (n,) bool (cable_model: slack)."""
+    for i in range(taut.shape[0]):
+        if not taut[i]:
+            run[RUN_SCALARS + RUN_UAV_COLUMNS * i + RUN_SLACK_TIME] += period
+
+
+@jit
+def run_add_gust_speed(run: np.ndarray, speed: float) -> None:
+    """The gust speed [m/s] the payload meets at one tick into the peak."""
+    if speed > run[RUN_MAX_GUST_SPEED]:
+        run[RUN_MAX_GUST_SPEED] = speed
+
+
+@jit
+def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarray,
+              taut: np.ndarray, constraint_tolerance: float, rate_tolerance: float, t: float,
+              tick: int, swing_every: int, reach: np.ndarray) -> tuple[int, int]:
+    """Algorithm 1, lines 10-13, at the state x (docs/conventions.md) of time t [s]: the
+    constraint residuals g (n,) [m^2] and g_dot (n,) [m^2/s] of the taut cables (taut (n,)
+    bool: the tolerances hold for those only) into the run's peaks, the payload swing when
+    tick % swing_every == 0 (`swing_at` with the cables' reach (n,) [m]), the simulated time.
+
+    Returns (status, cable): CHECK_NON_FINITE (the state is not finite; nothing accumulated),
+    CHECK_G or CHECK_G_DOT (the first cable of the largest |g| or |g_dot| is over its
+    tolerance; |g| is checked first), else CHECK_OK; cable: that cable (from 0), else -1.
+    """
+    for value in state:
+        if not math.isfinite(value):
+            return CHECK_NON_FINITE, -1
+    peak, worst, peak_rate, worst_rate = -1.0, -1, -1.0, -1
+    for i in range(g.shape[0]):
+        abs_g, abs_g_dot = (abs(g[i]), abs(g_dot[i])) if taut[i] else (0.0, 0.0)
+        if worst < 0 or abs_g > peak:
+            peak, worst = abs_g, i
+        if worst_rate < 0 or abs_g_dot > peak_rate:
+            peak_rate, worst_rate = abs_g_dot, i
+    if peak > run[RUN_MAX_ABS_G]:
+        run[RUN_MAX_ABS_G] = peak
+    if peak_rate > run[RUN_MAX_ABS_G_DOT]:
+        run[RUN_MAX_ABS_G_DOT] = peak_rate
+    if tick % swing_every == 0:
+        n = g.shape[0]
+        uavs = state[:UAV_COORDINATES * n].reshape((n, UAV_COORDINATES))
+        payload = state[UAV_COORDINATES * n:UAV_COORDINATES * n + 3]  # physics.layout.payload_slot
+        peak_rms_add(run, RUN_SWING, swing_at(uavs[:, POSITION:POSITION + 3], payload, reach))
+    run[RUN_SIMULATED_TIME] = t
+    if peak > constraint_tolerance:
+        return CHECK_G, worst
+    if peak_rate > rate_tolerance:
+        return CHECK_G_DOT, worst_rate
+    return CHECK_OK, -1
+
+
+@jit
+def tracking_add(acc: np.ndarray, reference_position: np.ndarray, position: np.ndarray) -> None:
+    """The leader's tracking error |r_ref - r_1| [m] of one tick (world, (3,) each)."""
+    dx = reference_position[0] - position[0]
+    dy = reference_position[1] - position[1]
+    dz = reference_position[2] - position[2]
+    peak_rms_add(acc, TRACKING_ERROR, math.sqrt(dx * dx + dy * dy + dz * dz))
+
+
+@jit
+def formation_error_add(acc: np.ndarray, residual: np.ndarray) -> None:
+    """A follower's virtual-constraint residual g_vc (m,) [m] of one tick: its largest
+    |component| into the peak, its Euclidean norm into the sum."""
+    if residual.shape[0]:
+        largest, sum_sq = abs(residual[0]), 0.0
+        for k in range(residual.shape[0]):
+            value = residual[k]
+            if abs(value) > largest:
+                largest = abs(value)
+            sum_sq += value * value
+        if largest > acc[FORMATION_MAX_ABS]:
+            acc[FORMATION_MAX_ABS] = largest
+        acc[FORMATION_NORM_SUM] += math.sqrt(sum_sq)
+    acc[FORMATION_SAMPLES] += 1.0

@@ -1,0 +1,62 @@
+"""The named slots of the run statistics' accumulator arrays, in one place (numba freezes these
+module-level integers into the compiled code). Every array is float64; counts are kept as
+floats (exact below 2^53).
+
+- a peak/rms block (PEAK_*): the max, the sum of squares and the count of a non-negative
+  signal sampled once per tick; the swing's and the tracking error's;
+- the simulator's run (RUN_*, `run_size(n)` floats): the scalars, then a block of
+  RUN_UAV_COLUMNS per UAV i at `run_uav_slot(i, column)`;
+- a leader's tracking error (TRACKING_*), a follower's formation error (FORMATION_*).
+
+Units: SI, world frame z up (docs/conventions.md).
+"""
+from __future__ import annotations
+
+# -- a peak/rms block: max and root mean square of a signal sampled once per tick ---------------
+PEAK_MAX = 0            # the largest sample
+PEAK_SUM_SQ = 1         # the sum of the squared samples
+PEAK_SAMPLES = 2        # how many samples
+PEAK_SIZE = 3
+
+# -- the simulator's run (RunStatistics) -------------------------------------------------------
+RUN_MAX_ABS_G = 0           # max_i,t |g_i| over taut cables [m^2]
+RUN_MAX_ABS_G_DOT = 1       # max_i,t |g_i_dot| over taut cables [m^2/s]
+RUN_MIN_TENSION = 2         # min over cables and ticks of T_i [N] (+inf: none yet)
+RUN_MAX_TENSION = 3         # max over cables and ticks of T_i [N] (-inf: none yet)
+RUN_SIMULATED_TIME = 4      # the time of the last state checked [s]
+RUN_MAX_GUST_SPEED = 5      # the peak gust speed met by the payload [m/s]
+RUN_SWING = 6               # a peak/rms block (PEAK_*): the payload swing [m]
+RUN_SCALARS = RUN_SWING + PEAK_SIZE
+# a UAV's block, RUN_UAV_COLUMNS floats from run_uav_slot(i, 0)
+RUN_MAX_ROTOR_SPEED = 0     # its peak commanded rotor speed [rad/s]
+RUN_SATURATED_TIME = 1      # time with any rotor at a speed limit [s]
+RUN_SLACK_TIME = 2          # time its cable was slack (cable_model: slack) [s]
+RUN_UAV_COLUMNS = 3
+
+
+def run_size(n_uavs: int) -> int:
+    """Length of a run's accumulator array for n UAVs."""
+    return RUN_SCALARS + RUN_UAV_COLUMNS * n_uavs
+
+
+def run_uav_slot(uav: int, column: int) -> int:
+    """Index of UAV `uav`'s (from 0) `column` (RUN_MAX_ROTOR_SPEED, ...) in a run's array
+    (the compiled functions spell out the same sum: numba cannot call this)."""
+    return RUN_SCALARS + RUN_UAV_COLUMNS * uav + column
+
+
+# -- a leader's tracking error |r_ref - r_1| [m] (TrackingStatistics): one peak/rms block ------
+TRACKING_ERROR = 0
+TRACKING_SIZE = PEAK_SIZE
+
+# -- a follower's virtual-constraint residual g_vc [m] (FormationErrorStatistics) --------------
+FORMATION_MAX_ABS = 0       # max over rows and ticks of |g_vc| [m]
+FORMATION_NORM_SUM = 1      # sum over ticks of |g_vc| (Euclidean) [m]
+FORMATION_SAMPLES = 2       # ticks answered
+FORMATION_SIZE = 3
+
+# -- what the Algorithm-1 check (accumulators.run_check) returns -------------------------------
+CHECK_OK = 0
+CHECK_NON_FINITE = 1        # the formation state is not finite
+CHECK_G = 2                 # a taut cable's |g| exceeds the constraint tolerance
+CHECK_G_DOT = 3             # a taut cable's |g_dot| exceeds the rate tolerance

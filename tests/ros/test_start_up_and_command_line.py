@@ -12,9 +12,6 @@ import pytest
 import yaml
 
 from conftest import ROOT, SCENARIOS
-from multilift_sim import kernels
-
-AHEAD_OF_TIME = (kernels.PHYSICS,)  # the control laws are compiled just in time only
 
 
 # -- the kernels and the control laws in a new process (tests/unit/test_kernels.py,
@@ -46,23 +43,27 @@ def test_loading_the_kernel_leaves_scipy_and_coverage_unimported_and_importable(
     assert out.split('\n')[:2] == ['False False', '[1.0, 1.0] True']
 
 
-def test_setup_built_the_kernels_ahead_of_time_and_they_load_without_numba():
-    for name in AHEAD_OF_TIME:
-        assert all(path.is_file() for path in kernels.ahead_of_time_files(name)), name
+def test_setup_filled_numba_s_cache_so_a_new_process_loads_and_does_not_compile():
+    """scripts/setup compiled the kernels into numba's on-disk cache (the supported way that
+    replaced pycc: multilift_sim.kernels): a new process's tick and engine step load them."""
     out = _a_tick_in_a_new_process(
-        'auto', f'law = kernels.compiled_module("{kernels.PHYSICS}").integrate_period\n'
-                'print(kernels.enabled(), isinstance(law, kernels._Checked), sim.t > 0,\n'
-                '      "numba" in sys.modules)\n')
-    assert out.split() == ['True', 'True', 'True', 'False']
+        'auto', 'from multilift_control.engine import Engine\n'
+                'from multilift_control.engine.tick import run_ticks\n'
+                'law = kernels.compiled_module(kernels.PHYSICS).integrate_period\n'
+                'engine = Engine(scenario.load("twin_lift"))\n'
+                'engine.step(3)\n'
+                'print(kernels.enabled(), sim.t > 0, engine.memory.tick[0],\n'
+                '      [len(f.stats.cache_hits) > 0 and not f.stats.cache_misses\n'
+                '       for f in (law, run_ticks)])\n')
+    assert out.split() == ['True', 'True', '3', '[True,', 'True]']
 
 
-@pytest.mark.parametrize('setting,expected', [(None, 'aot uncompiled'),
+@pytest.mark.parametrize('setting,expected', [(None, 'auto just-in-time'),
                                               ('jit', 'jit just-in-time'),
                                               ('python', 'python uncompiled')])
-def test_controller_nodes_run_the_laws_uncompiled_unless_told(setting, expected):
-    """A controller node (`prepare_node_laws`) runs the laws uncompiled (MULTILIFT_KERNEL=aot:
-    they are not built ahead of time) unless MULTILIFT_KERNEL says otherwise: with jit it
-    loads the laws compiled just in time before it answers."""
+def test_controller_nodes_load_the_compiled_laws_unless_told(setting, expected):
+    """A controller node (`prepare_node_laws`) loads the compiled laws from numba's cache
+    before it answers, unless MULTILIFT_KERNEL=python says to run them uncompiled."""
     code = ('import os, sys\n'
             'from multilift_control.runtime import ControllerRuntime, prepare_node_laws\n'
             'from multilift_sim import kernels, scenario\n'
@@ -71,7 +72,7 @@ def test_controller_nodes_run_the_laws_uncompiled_unless_told(setting, expected)
             'law = ControllerRuntime(s, 1).follower._update\n'
             'kind = ("uncompiled" if not hasattr(law, "py_func") else\n'
             '        "just-in-time" if len(law.signatures) > 0 else "not loaded")\n'
-            'print(os.environ["MULTILIFT_KERNEL"], kind)\n')
+            'print(kernels.mode(), kind)\n')
     env = {k: v for k, v in os.environ.items() if k != 'MULTILIFT_KERNEL'}
     if setting is not None:
         env['MULTILIFT_KERNEL'] = setting

@@ -174,21 +174,24 @@ def test_the_state_layout_is_the_slots():
     assert state.uav_velocities(x)[1, 0] == 21 + layout.UAV_COORDINATES + layout.POSITION
 
 
-def test_cache_dir_is_under_the_users_cache():
+def test_cache_dir_is_under_the_users_cache_and_named_by_the_kernels_sources(tmp_path,
+                                                                           monkeypatch):
+    """numba's cache of these kernels: a folder named by a digest of every kernel package's
+    sources, so an edited kernel (numba compiles callees into their callers, but checks a
+    cached function against its own file only) never serves a caller's stale code."""
     import os
+    import shutil
     from pathlib import Path
+
     directory = Path(os.environ['NUMBA_CACHE_DIR'])
-    assert directory.parts[-2:] == ('multilift', 'numba')
-
-
-def test_the_ahead_of_time_build_is_named_by_its_source(tmp_path, monkeypatch):
-    """A changed source is never served the old build: the files' names hash the source."""
-    module = tmp_path / 'aot_naming_probe.py'
-    module.write_text('A = 1\n')
+    assert directory.parent.parts[-2:] == ('multilift', 'numba')
+    assert directory.name == kernels._sources_digest()
+    # another copy of the sources with one law edited has another digest
+    from multilift_control import laws
+    copy = tmp_path / 'multilift_control'
+    shutil.copytree(Path(laws.__file__).parent.parent, copy)
     monkeypatch.syspath_prepend(str(tmp_path))
-    first = kernels.ahead_of_time_files('aot_naming_probe')
-    assert first == kernels.ahead_of_time_files('aot_naming_probe')
-    module.write_text('A = 2\n')
-    second = kernels.ahead_of_time_files('aot_naming_probe')
-    assert first[0] != second[0] and first[1] != second[1]
-    assert first[0].parent == kernels.AHEAD_OF_TIME_DIR
+    monkeypatch.delitem(__import__('sys').modules, 'multilift_control', raising=False)
+    same = kernels._sources_digest()
+    (copy / 'laws' / 'mixer.py').write_text((copy / 'laws' / 'mixer.py').read_text() + '\n')
+    assert kernels._sources_digest() != same

@@ -11,7 +11,6 @@ compares their bags to 1e-9 m).
 """
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -24,7 +23,6 @@ from multilift_control.formation import FormationFollower
 from multilift_control.laws.follower import lift_vectors
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.mission import Reference
-from multilift_sim import kernels
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
@@ -177,14 +175,11 @@ def prepare_node_laws(scenario: Scenario, index: int) -> None:
     """Choose and load the control laws of a controller node of UAV `index` (from 0), before
     its topics appear (the simulator's `command_timeout` counts from the first state).
 
-    MULTILIFT_KERNEL defaults to `aot` here, so a node runs the laws uncompiled
-    (`laws.runnable`: they are not built ahead of time) unless MULTILIFT_KERNEL says auto or
-    jit, when they are compiled just in time: one throwaway answer to the scenario's start
-    loads them from numba's cache here (or compiles them, seconds). `aot` was the default
-    while scripts/setup built the laws ahead of time (a millisecond to load, where the
-    just-in-time cache costs 0.2 s and numba's import 0.5 s of a process that shares two
-    cores with many: `benchmarks/results.md`)."""
-    os.environ.setdefault(kernels.VARIABLE, 'aot')
+    The laws run compiled unless MULTILIFT_KERNEL=python: one throwaway answer to the
+    scenario's start loads them from numba's cache here (scripts/setup filled it; about 0.2 s,
+    with numba's import 0.5 s, which importing the laws costs anyway). Uncompiled, a follower
+    of a circle of three took 1.8-7 ms a tick against 0.08 ms compiled. Compiled and uncompiled
+    give the same bits (tests/unit/test_compiled_laws.py)."""
     if laws.runnable(collective_thrust) is not collective_thrust:  # uncompiled
         return
     runtime = ControllerRuntime(scenario, index)

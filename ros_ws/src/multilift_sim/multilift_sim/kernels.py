@@ -1,52 +1,79 @@
-"""Loading the numba-compiled functions: the physics (multilift_sim.physics, each function's
-uncompiled run the reference: `uncompiled`, `runnable`) and the control laws
-(multilift_control._numba_laws, their methods the reference). `compiled_module` loads a module
-of compiled functions in one of two forms, under MULTILIFT_KERNEL:
+"""Loading the numba-compiled functions: the physics (`multilift_sim.physics`), the run
+statistics (`multilift_sim.statistics`), the control laws (`multilift_control.laws`) and the
+engine's tick (`multilift_control.engine`), each written once as numba functions over arrays;
+each function's uncompiled run (`uncompiled`: its own source run by Python) is the reference.
 
-- ahead of time (`build_ahead_of_time`, run by scripts/setup for a module with an
-  `AHEAD_OF_TIME` dict; the physics has none yet): numba's pycc compiles the
-  module's `AHEAD_OF_TIME` functions into a plain extension module under
-  `$XDG_CACHE_HOME/multilift/aot` (`~/.cache/multilift/aot`), its file named by a hash of the
-  module's source, Python and numpy, so a changed source is never served stale code. It loads
-  in about a millisecond without numba (whose import costs every process about 0.5 s). Its
-  functions trust their argument types (a wrong one reads wrong memory), so each call is
-  checked first (`_Checked`): a TypeError, never a crash.
-- just in time: `numba.njit(cache=True)`, the cache under NUMBA_CACHE_DIR, by default
-  `~/.cache/multilift/numba`; the first process compiles (1-2 s), later ones load the cache.
+How start-up stays low without numba's pycc (pending deprecation; it was used here until
+issue 19): numba's own on-disk cache, `numba.njit(cache=True)`, the supported way. scripts/setup
+compiles every kernel once into the cache (NUMBA_CACHE_DIR, by default
+`~/.cache/multilift/numba/<digest of the kernels' sources>`), so a process loads them (tenths of a second) instead of compiling
+(seconds); a process that runs no compiled code does not load them, and the controller nodes
+run their laws uncompiled unless told otherwise (`multilift_control.runtime.prepare_node_laws`:
+a lone node's time goes to rclpy; `run --compose` runs every controller in one process, which
+loads the compiled laws once).
 
-MULTILIFT_KERNEL: `auto` (or unset) ahead of time where built, else just in time where numba
-imports, else the pure reference; `aot` ahead of time or the pure reference (controller
-nodes' default: multilift_control.runtime.prepare_node_laws); `jit` just in time or the
-pure reference; `python` the pure reference.
+MULTILIFT_KERNEL: `auto` (or unset) compiled just in time (from the cache) where numba imports,
+else uncompiled; `jit` the same, numba required; `python` uncompiled (the reference).
 """
 from __future__ import annotations
 
 import hashlib
 import importlib
-import importlib.machinery
 import importlib.util
-import json
 import os
 import shutil
 import sys
-import tempfile
+import time
 import types
 from pathlib import Path
-from types import ModuleType
 from typing import Any, Callable
 
-import numpy as np
+# the kernels' packages: numba compiles a kernel together with the kernels it calls from other
+# files, but checks a cached kernel against its own file only
+KERNEL_PACKAGES = ('multilift_sim.physics', 'multilift_sim.statistics', 'multilift_control.laws',
+                   'multilift_control.engine')
+CACHE_ROOT = Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache') / 'multilift' / 'numba'
 
-_cache_home = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
-os.environ.setdefault('NUMBA_CACHE_DIR', str(Path(_cache_home) / 'multilift' / 'numba'))
 
-VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), aot, jit or python: see the docstring
+def _sources_digest() -> str:
+    """A digest of every kernel package's sources (those found: a package is located, not
+    imported)."""
+    digest = hashlib.sha256()
+    for package in KERNEL_PACKAGES:
+        top, _, sub = package.partition('.')
+        spec = importlib.util.find_spec(top)
+        if spec is None or spec.origin is None:
+            continue
+        for path in sorted((Path(spec.origin).parent / sub).glob('*.py')):
+            digest.update(path.name.encode() + b'\0' + path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+# numba's on-disk cache of these sources: a folder named by their digest, so an edited kernel
+# never leaves a caller's cached code stale (`prune_cache` removes the other folders)
+os.environ.setdefault('NUMBA_CACHE_DIR', str(CACHE_ROOT / _sources_digest()))
+
+VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), jit or python: see the docstring
 PHYSICS = 'multilift_sim.physics.formation_dae'  # the physics' compiled module (the DAE)
-MODES = ('auto', 'aot', 'jit', 'python')
-AHEAD_OF_TIME_DIR = Path(_cache_home) / 'multilift' / 'aot'
-_BUILD_FORMAT = 2  # of the files build_ahead_of_time writes: part of their names
-# compiled modules by (name, mode); None: the pure reference
+MODES = ('auto', 'jit', 'python')
+# compiled modules by (name, mode); None: the uncompiled reference
 _modules: dict[tuple[str, str], Any] = {}
+
+
+def prune_cache(days: float = 7.0) -> list[Path]:
+    """Remove the cache folders of other sources (digest-named folders under CACHE_ROOT) that
+    no process has written for `days`; returns them. Folders in use by other checkouts of
+    other sources stay."""
+    current = Path(os.environ['NUMBA_CACHE_DIR'])
+    cutoff = time.time() - days * 86400.0
+    stale = [path for path in CACHE_ROOT.glob('*')
+             if path.is_dir() and path != current and len(path.name) == 16
+             and all(c in '0123456789abcdef' for c in path.name)
+             and max((p.stat().st_mtime for p in path.rglob('*')),
+                     default=path.stat().st_mtime) < cutoff]
+    for path in stale:
+        shutil.rmtree(path, ignore_errors=True)
+    return stale
 
 
 def mode() -> str:
@@ -58,156 +85,33 @@ def mode() -> str:
 
 
 def enabled() -> bool:
-    """Whether the compiled physics is to be used (built or numba importable, not switched
-    off)."""
+    """Whether the compiled physics is to be used (numba importable, not switched off)."""
     return compiled_module(PHYSICS) is not None
 
 
 def runnable(function: Callable) -> Callable:
-    """A compiled function of a module of compiled functions (a numba dispatcher, or a plain
-    function where numba does not import), as MULTILIFT_KERNEL says: its module's compiled
-    function (`compiled_module`), else its uncompiled run (`uncompiled`)."""
+    """A compiled function (a numba dispatcher, or a plain function where numba does not
+    import) as MULTILIFT_KERNEL says: compiled, else its uncompiled run (`uncompiled`)."""
     module = compiled_module(function.__module__)
     return uncompiled(function) if module is None else getattr(module, function.__name__)
 
 
 def compiled_module(name: str) -> Any:
-    """The compiled functions of module `name` (loaded once per mode): ahead of time or just in
-    time as MULTILIFT_KERNEL says, or None when the pure-Python reference is to be used."""
+    """Module `name` of compiled functions (imported once per mode), or None when the
+    uncompiled reference is to be used (MULTILIFT_KERNEL=python, or numba missing under
+    auto)."""
     key = (name, mode())
     if key not in _modules:
         compiled = None
-        if key[1] in ('auto', 'aot'):
-            compiled = load_ahead_of_time(name)
-        if compiled is None and key[1] in ('auto', 'jit'):
+        if key[1] != 'python':
             try:
                 _import_numba_quietly()
                 compiled = importlib.import_module(name)
             except ImportError:
-                compiled = None
+                if key[1] == 'jit':
+                    raise
         _modules[key] = compiled
     return _modules[key]
-
-
-def ahead_of_time_files(name: str) -> tuple[Path, Path]:
-    """(extension module, its argument checks) built from module `name` as it is now."""
-    source = Path(importlib.util.find_spec(name).origin).read_bytes()
-    digest = hashlib.sha256(
-        source + f'|{sys.version}|{np.__version__}|{_BUILD_FORMAT}'.encode()).hexdigest()
-    stem = f'{name}-{digest[:16]}'
-    return (AHEAD_OF_TIME_DIR / f'{stem}{importlib.machinery.EXTENSION_SUFFIXES[0]}',
-            AHEAD_OF_TIME_DIR / f'{stem}.json')
-
-
-def _extension_name(name: str) -> str:
-    return 'aot_' + name.replace('.', '_')
-
-
-class _Checked:
-    """A function compiled ahead of time behind a check of its array arguments: numba's
-    ahead-of-time wrappers do not check them (a float32 or strided array reads wrong memory,
-    or crashes), the just-in-time dispatcher compiles for what it gets.
-
-    An array object that passed is remembered by position and not checked again (a
-    controller's constants and memory come back every tick). That trusts an array not to be
-    reshaped or retyped in place (`a.shape = ...`, `a.dtype = ...`), which no caller does.
-    Each caller gets a checker of its own (`_AheadOfTimeModule`), so what it remembers is that
-    caller's arrays."""
-
-    def __init__(self, function: Callable, arrays: list[tuple[int, str, int, bool]]) -> None:
-        self.function = function
-        self.__name__ = function.__name__
-        self.arrays = [(index, np.dtype(dtype), ndim, writes)
-                       for index, dtype, ndim, writes in arrays]
-        self._passed: dict[int, np.ndarray] = {}
-
-    def __call__(self, *args):
-        passed = self._passed
-        for index, dtype, ndim, writes in self.arrays:
-            value = args[index]
-            if value is passed.get(index):
-                continue
-            if (type(value) is not np.ndarray or value.dtype != dtype or value.ndim != ndim
-                    or not value.flags.c_contiguous or (writes and not value.flags.writeable)):
-                raise TypeError(f'{self.__name__}: argument {index} must be a C-contiguous'
-                                f'{" writable" if writes else ""} {ndim}-d {dtype} array, got '
-                                f'{_describe(value)}')
-            passed[index] = value
-        return self.function(*args)
-
-
-def _describe(value: object) -> str:
-    if isinstance(value, np.ndarray):
-        layout = 'C-contiguous' if value.flags.c_contiguous else 'strided'
-        access = '' if value.flags.writeable else ' read-only'
-        return f'a {layout}{access} {value.ndim}-d {value.dtype} array'
-    return type(value).__name__
-
-
-def load_ahead_of_time(name: str) -> Any:
-    """Module `name`'s functions compiled ahead of time for its current source (checked:
-    `_Checked`), or None when they were not built."""
-    extension_path, checks_path = ahead_of_time_files(name)
-    if not (extension_path.is_file() and checks_path.is_file()):
-        return None
-    extension_name = _extension_name(name)
-    loader = importlib.machinery.ExtensionFileLoader(extension_name, str(extension_path))
-    spec = importlib.util.spec_from_file_location(extension_name, extension_path,
-                                                  loader=loader)
-    try:
-        extension = importlib.util.module_from_spec(spec)
-        loader.exec_module(extension)
-        checks = json.loads(checks_path.read_text())
-    except (ImportError, OSError, ValueError) as error:  # a damaged build: the fallback runs
-        print(f'warning: {extension_path} does not load ({error}); compiling just in time',
-              file=sys.stderr)
-        return None
-    return _AheadOfTimeModule(extension, checks)
-
-
-class _AheadOfTimeModule:
-    """An extension module built ahead of time, seen through its checks: each attribute
-    access gives a fresh `_Checked` function (a controller keeps the one it took)."""
-
-    def __init__(self, extension: ModuleType, checks: dict[str, list]) -> None:
-        self._extension = extension
-        self._checks = checks
-
-    def __getattr__(self, function: str) -> _Checked:
-        if function.startswith('_') or function not in self._checks:
-            raise AttributeError(function)
-        return _Checked(getattr(self._extension, function), self._checks[function])
-
-
-def build_ahead_of_time(name: str) -> Path:
-    """Compile module `name`'s `AHEAD_OF_TIME` functions ({name: numba signature}) into an
-    extension module under AHEAD_OF_TIME_DIR (numba's pycc; a C compiler is needed). Returns
-    its path; the files appear whole (written aside, then renamed)."""
-    from numba.np.numpy_support import as_dtype
-    from numba.pycc import CC
-    from numba.core import types
-    module = importlib.import_module(name)
-    extension_path, checks_path = ahead_of_time_files(name)
-    AHEAD_OF_TIME_DIR.mkdir(parents=True, exist_ok=True)
-    work = Path(tempfile.mkdtemp(prefix='.build-', dir=AHEAD_OF_TIME_DIR))
-    try:
-        compiler = CC(_extension_name(name))
-        compiler.output_dir = str(work)
-        checks = {}
-        for function, signature in module.AHEAD_OF_TIME.items():
-            compiler.export(function, signature)(getattr(module, function).py_func)
-            # (position, dtype, dimensions, whether the compiled code may write it)
-            checks[function] = [(index, as_dtype(arg.dtype).str, arg.ndim, arg.mutable)
-                                for index, arg in enumerate(signature.args)
-                                if isinstance(arg, types.Array)]
-        compiler.compile()
-        built = next(work.glob(f'{_extension_name(name)}*'))
-        (work / 'checks.json').write_text(json.dumps(checks))
-        os.replace(work / 'checks.json', checks_path)
-        os.replace(built, extension_path)
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    return extension_path
 
 
 def uncompiled(function: Callable) -> Callable:

@@ -1,0 +1,209 @@
+"""The arrays of B formations the compiled tick reads and writes, named once (the engine's
+layout). Every field has the batch axis first; the formations of one batch share their shapes
+(n UAVs, rotors per UAV, gusts, mission segments, virtual-constraint rows), not their values.
+
+They are built from each scenario through the objects the per-process runtime uses (the
+physics' `constant_arrays`, `MissionLeader`, `FormationFollower`, `ThrustBook`), so a
+formation's numbers have one source. Units: SI, world frame z up (docs/conventions.md).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from multilift_control.controllers import LEADER_CONTROLLERS, ConstantRotorSpeed, MissionLeader
+from multilift_control.formation import FormationFollower
+from multilift_control.laws.layout import (FOLLOWER_MEMORY_SIZE, FOLLOWER_SIZE, REFERENCE_SIZE,
+                                           ROW_SIZE, UAV_STATE_SIZE)
+from multilift_control.runtime import ThrustBook
+from multilift_sim.dynamics import FormationModel, constant_arrays
+from multilift_sim.physics.layout import UAV_MASS
+from multilift_sim.scenario import Scenario
+from multilift_sim.simulation import initial_state
+
+# A leader's `control.mode` -> its code in `FormationArrays.leader_mode`: the index in the one
+# registry of leader controllers (multilift_control.controllers.LEADER_CONTROLLERS)
+LEADER_MODES = tuple(LEADER_CONTROLLERS)
+MODE_CASCADE = LEADER_MODES.index('cascade')
+MODE_CONSTANT = LEADER_MODES.index('constant_rotor_speed')
+
+# `FormationMemory.status` of a formation
+RUNNING = 0        # ticks left
+FINISHED = 1       # reached its duration (the state at t_max is the last)
+NOT_FINITE = 2     # stopped: the state became non-finite (Algorithm 1)
+OFF_CONSTRAINT = 3  # stopped: a taut cable's |g| left constraint_tolerance (Algorithm 1)
+OFF_RATE = 4       # stopped: a taut cable's |g_dot| left constraint_rate_tolerance
+
+
+class FormationArrays(NamedTuple):
+    """What does not change during a run, for B formations (first axis)."""
+    # physics (multilift_sim.physics.layout slots)
+    uavs: np.ndarray              # (B, n, UAV_COLUMNS)
+    gusts: np.ndarray             # (B, k, GUST_COLUMNS)
+    formation: np.ndarray         # (B, FORMATION_SCALARS)
+    allocation: np.ndarray        # (B, n, 4, rotors): wrench per omega^2 (seed Eq. 2.14)
+    cable_lengths: np.ndarray     # (B, n) [m]
+    slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
+    # time and Algorithm 1's tolerances
+    physics_dt: np.ndarray        # (B,) [s]
+    physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
+    period_ns: np.ndarray         # (B,) int: the control period [ns]
+    tick_count: np.ndarray        # (B,) int: control periods of the run
+    tolerances: np.ndarray        # (B, 2): |g| [m^2], |g_dot| [m^2/s]
+    swing_every: np.ndarray       # (B,) int: the payload swing sampled every this many ticks
+    # the leader (multilift_control.laws.layout slots)
+    leader_mode: np.ndarray       # (B,) int: MODE_*
+    cascade: np.ndarray           # (B, n, CASCADE_SIZE): every UAV's cascade constants
+    mixers: np.ndarray            # (B, n, rotors, MIXER_SIZE)
+    mission: np.ndarray           # (B, MISSION_SIZE)
+    segments: np.ndarray          # (B, s, SEGMENT_SIZE)
+    mission_steps: np.ndarray     # (B, s + 1 or 0, STEP_SIZE)
+    constant_speeds: np.ndarray   # (B, rotors) [rad/s]: MODE_CONSTANT's command
+    constant_saturated: np.ndarray  # (B, rotors) bool
+    # the followers (rows 1..n-1 of the per-UAV fields; row 0 unused)
+    follower: np.ndarray          # (B, n, FOLLOWER_SIZE)
+    masses: np.ndarray            # (B, n): M_f,r [kg]
+    rows: np.ndarray              # (B, m, ROW_SIZE) int: the rows of g_vc
+    targets: np.ndarray           # (B, m)
+    law_p: np.ndarray             # (B, n, 3, m): a linear follower's P (zeros otherwise)
+    law_q: np.ndarray             # (B, n, 3, 3n): its Q
+    own_rows: np.ndarray          # (B, n) int: how many rows of g_vc involve UAV i
+    thrust_coefficients: np.ndarray  # (B, n) [N s^2/rad^2]
+
+
+class FormationMemory(NamedTuple):
+    """What a tick changes, for B formations (first axis)."""
+    state: np.ndarray             # (B, 2(6n + 3)): the formation state at the current tick
+    taut: np.ndarray              # (B, n) bool: which cables are taut
+    tick: np.ndarray              # (B,) int: control periods flown
+    status: np.ndarray            # (B,) int: RUNNING, FINISHED or why it stopped
+    worst_cable: np.ndarray       # (B,) int: the cable of a stop (from 0)
+    worst_value: np.ndarray       # (B,): its |g| or |g_dot|
+    g: np.ndarray                 # (B, n): g at the current tick [m^2]
+    g_dot: np.ndarray             # (B, n): g_dot at the current tick [m^2/s]
+    cascade_memory: np.ndarray    # (B, n, CASCADE_MEMORY_SIZE)
+    follower_memory: np.ndarray   # (B, n, FOLLOWER_MEMORY_SIZE)
+    thrusts: np.ndarray           # (B, n): the thrust book u_T,j [N]
+
+
+class TickRecord(NamedTuple):
+    """What ticks leave for a bag: (ticks, B, ...) each; a tick's row k holds the state at the
+    tick and the answers to it, and the tension of the integration that starts there."""
+    states: np.ndarray            # (ticks, B, 2(6n + 3))
+    measured: np.ndarray          # (ticks, B, n, UAV_STATE_SIZE)
+    speeds: np.ndarray            # (ticks, B, n, rotors) [rad/s]
+    saturated: np.ndarray         # (ticks, B, n, rotors) bool
+    setpoints: np.ndarray         # (ticks, B, n, 3) [rad]
+    thrust: np.ndarray            # (ticks, B, n) [N]
+    reference: np.ndarray         # (ticks, B, REFERENCE_SIZE): NaN without one
+    errors: np.ndarray            # (ticks, B, n, rows): a follower's rows of g_vc, NaN after
+    rates: np.ndarray             # (ticks, B, n, rows)
+    tension: np.ndarray           # (ticks, B, n) [N]
+    g: np.ndarray                 # (ticks, B, n) [m^2]
+    g_dot: np.ndarray             # (ticks, B, n) [m^2/s]
+    taut: np.ndarray              # (ticks, B, n) bool, at the tick's start
+
+
+def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
+    """One formation's (FormationArrays fields, FormationMemory fields), without the batch
+    axis."""
+    n = scenario.n_uavs
+    sim = scenario.simulation
+    rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
+    if len(rotor_counts) != 1:
+        raise ValueError(f'{scenario.name}: the engine needs one rotor count for every UAV, '
+                         f'got {sorted(rotor_counts)}')
+    params = scenario.formation_params()
+    uavs, gusts, formation = constant_arrays(params)
+    # the leader's cascade and path (a constant-speed leader: the ones it would fly, unused)
+    mission_leader = MissionLeader(scenario, 0)
+    path = mission_leader.path
+    constant = ConstantRotorSpeed(scenario, 0).output
+    followers = [FormationFollower.from_scenario(scenario, i) for i in range(1, n)]
+    cascades = [mission_leader.cascade] + [f.cascade for f in followers]
+    rows = followers[0].constraints.rows if followers else np.zeros((0, ROW_SIZE), np.int64)
+    m = rows.shape[0]
+    follower = np.zeros((n, FOLLOWER_SIZE))
+    follower_memory = np.zeros((n, FOLLOWER_MEMORY_SIZE))
+    law_p, law_q = np.zeros((n, 3, m)), np.zeros((n, 3, 3 * n))
+    own_rows = np.zeros(n, dtype=np.int64)
+    for i, f in enumerate(followers, start=1):
+        follower[i], follower_memory[i], own_rows[i] = f.constants, f.memory, len(f.rows)
+        if f.law_p.shape == (3, m):  # linear rows (else the law solves each tick)
+            law_p[i], law_q[i] = f.law_p, f.law_q
+    arrays = dict(
+        uavs=uavs, gusts=gusts, formation=formation,
+        allocation=FormationModel(params).allocation,
+        cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
+        slack=scenario.cable_model == 'slack',
+        physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
+        period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
+        tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),
+        swing_every=1 if n <= 2 else 10,
+        leader_mode=LEADER_MODES.index(scenario.control.mode),
+        cascade=np.stack([c.constants for c in cascades]),
+        mixers=np.stack([c.mixer.rows for c in cascades]),
+        mission=path.mission, segments=path.segments, mission_steps=path.steps,
+        constant_speeds=np.asarray(constant.rotor_speeds, dtype=float),
+        constant_saturated=np.asarray(constant.saturated, dtype=bool),
+        follower=follower,
+        masses=followers[0].masses if followers else np.array([uavs[0, UAV_MASS]]),
+        rows=np.ascontiguousarray(rows, dtype=np.int64),
+        targets=followers[0].constraints.targets if followers else np.zeros(0),
+        law_p=law_p, law_q=law_q, own_rows=own_rows,
+        thrust_coefficients=np.array([u.vehicle.thrust_coefficient for u in scenario.uavs],
+                                     dtype=float))
+    memory = dict(
+        state=initial_state(scenario), taut=np.ones(n, dtype=bool), tick=0, status=RUNNING,
+        worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n),
+        cascade_memory=np.stack([c.memory for c in cascades]),
+        follower_memory=follower_memory,
+        thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float))
+    return arrays, memory
+
+
+def _stacked(name: str, values: list) -> np.ndarray:
+    shapes = {np.shape(v) for v in values}
+    if len(shapes) != 1:
+        raise ValueError(f'the formations of a batch differ in the shape of {name}: '
+                         f'{sorted(shapes)} (one batch: the same n, rotors, gusts, mission '
+                         'segments and formation rows)')
+    return np.ascontiguousarray(np.stack([np.asarray(v) for v in values]))
+
+
+def batch_arrays(scenarios: Sequence[Scenario]) -> tuple[FormationArrays, FormationMemory]:
+    """The arrays of `scenarios` (B >= 1 of the same shape): (constants, initial memory)."""
+    if not scenarios:
+        raise ValueError('a batch needs at least one scenario')
+    fields = [_formation_fields(s) for s in scenarios]
+    arrays = FormationArrays(**{name: _stacked(name, [f[0][name] for f in fields])
+                                for name in FormationArrays._fields})
+    memory = FormationMemory(**{name: _stacked(name, [f[1][name] for f in fields])
+                                for name in FormationMemory._fields})
+    for field in (arrays.physics_dt, arrays.physics_steps, arrays.period_ns):
+        if len(set(field.tolist())) != 1:
+            raise ValueError('the formations of a batch must share control_rate and '
+                             'physics_rate')
+    return arrays, memory
+
+
+def empty_record(arrays: FormationArrays, ticks: int) -> TickRecord:
+    """A TickRecord for `ticks` ticks of the batch (ticks = 0: nothing recorded)."""
+    batch, n, _ = arrays.uavs.shape
+    rotors = arrays.allocation.shape[-1]
+    rows = int(arrays.own_rows.max())
+    size = 2 * (6 * n + 3)
+    return TickRecord(
+        states=np.empty((ticks, batch, size)),
+        measured=np.empty((ticks, batch, n, UAV_STATE_SIZE)),
+        speeds=np.empty((ticks, batch, n, rotors)),
+        saturated=np.empty((ticks, batch, n, rotors), dtype=bool),
+        setpoints=np.empty((ticks, batch, n, 3)), thrust=np.empty((ticks, batch, n)),
+        reference=np.empty((ticks, batch, REFERENCE_SIZE)),
+        errors=np.full((ticks, batch, n, rows), math.nan),
+        rates=np.full((ticks, batch, n, rows), math.nan),
+        tension=np.empty((ticks, batch, n)), g=np.empty((ticks, batch, n)),
+        g_dot=np.empty((ticks, batch, n)), taut=np.empty((ticks, batch, n), dtype=bool))

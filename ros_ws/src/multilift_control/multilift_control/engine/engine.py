@@ -1,0 +1,123 @@
+"""`Engine`: B formations of the same shape stepped together by the compiled tick."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from multilift_control import laws
+from multilift_control.engine import tick as compiled
+from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAINT, OFF_RATE,
+                                             RUNNING, FormationArrays, FormationMemory,
+                                             TickRecord, batch_arrays, empty_record)
+from multilift_sim.dynamics import StateLayout
+from multilift_sim.scenario import Scenario
+
+
+class Engine:
+    """B formations (scenarios of the same n, rotors, gusts, mission segments and formation
+    rows; each with its own values) flown tick by tick, seed Algorithm 1, in one compiled call
+    per `step` (`engine.tick.run_ticks`), or its uncompiled run under MULTILIFT_KERNEL=python.
+
+        engine = Engine(scenario_io.load('twin_lift'), batch=64)   # or Engine([s1, s2, ...])
+        engine.step(1000)            # up to 1000 ticks of each running formation
+        engine.positions             # (B, n, 3) [m], world
+        engine.finished              # (B,) bool
+
+    A formation stops where Algorithm 1 stops it (`stopped`, `stop_reason`) and finishes at its
+    scenario's duration; the others go on.
+    """
+
+    def __init__(self, scenarios: Scenario | Sequence[Scenario], batch: int | None = None):
+        if isinstance(scenarios, Scenario):
+            scenarios = [scenarios] * (1 if batch is None else batch)
+        elif batch is not None and batch != len(scenarios):
+            raise ValueError(f'batch={batch} for {len(scenarios)} scenarios')
+        self.scenarios = tuple(scenarios)
+        if batch is not None and batch < 1:
+            raise ValueError(f'batch must be >= 1, got {batch}')
+        self.arrays: FormationArrays
+        self.memory: FormationMemory
+        self.arrays, self._initial = batch_arrays(self.scenarios)
+        self.n_uavs = self.arrays.uavs.shape[1]
+        self.layout = StateLayout(self.n_uavs)
+        self._run_ticks = laws.runnable(compiled.run_ticks)
+        self._start = laws.runnable(compiled.start)
+        self._no_record = empty_record(self.arrays, 0)
+        self.reset()
+
+    @property
+    def batch(self) -> int:
+        return len(self.scenarios)
+
+    def reset(self) -> None:
+        """Every formation back to its scenario's start (t = 0, controllers' memories empty)."""
+        self.memory = FormationMemory(*(np.array(field, copy=True) for field in self._initial))
+        self._start(self.arrays, self.memory)
+
+    def step(self, ticks: int = 1, record: TickRecord | None = None) -> np.ndarray:
+        """Up to `ticks` control ticks of each running formation; with `record`
+        (`new_record(ticks)`) every tick's state, answers and cable figures kept at its row.
+        Returns the ticks flown per formation (B,)."""
+        if ticks < 0:
+            raise ValueError(f'ticks must be >= 0, got {ticks}')
+        if record is not None and record.speeds.shape[0] < ticks:
+            raise ValueError(f'the record holds {record.speeds.shape[0]} ticks, not {ticks}')
+        return self._run_ticks(self.arrays, self.memory, int(ticks),
+                               self._no_record if record is None else record)
+
+    def new_record(self, ticks: int) -> TickRecord:
+        """Arrays for `ticks` ticks of every formation (`step`'s record)."""
+        return empty_record(self.arrays, ticks)
+
+    # ------------------------------------------------------------------------- state views
+    @property
+    def state(self) -> np.ndarray:
+        """The formation states (B, 2 (6n + 3)) at the current tick (docs/conventions.md)."""
+        return self.memory.state
+
+    @property
+    def t(self) -> np.ndarray:
+        """Simulated time of each formation (B,) [s]."""
+        return self.memory.tick * self.arrays.period_ns * 1e-9
+
+    @property
+    def positions(self) -> np.ndarray:
+        """UAV positions (B, n, 3) [m], world."""
+        n = self.n_uavs
+        return self.memory.state[:, :6 * n].reshape(-1, n, 6)[:, :, :3]
+
+    @property
+    def payload_positions(self) -> np.ndarray:
+        """Payload positions (B, 3) [m], world."""
+        n = self.n_uavs
+        return self.memory.state[:, 6 * n:6 * n + 3]
+
+    @property
+    def running(self) -> np.ndarray:
+        return self.memory.status == RUNNING
+
+    @property
+    def finished(self) -> np.ndarray:
+        return self.memory.status == FINISHED
+
+    @property
+    def stopped(self) -> np.ndarray:
+        """Formations Algorithm 1 stopped (B,) bool."""
+        return self.memory.status > FINISHED
+
+    def stop_reason(self, b: int) -> str | None:
+        """Why formation b stopped, in the simulator's words (None while it has not)."""
+        status, t = int(self.memory.status[b]), float(self.t[b])
+        cable, value = int(self.memory.worst_cable[b]) + 1, float(self.memory.worst_value[b])
+        tolerances = self.arrays.tolerances[b]
+        if status == NOT_FINITE:
+            return f'the formation state became non-finite at t = {t:.3f} s'
+        if status == OFF_CONSTRAINT:
+            return (f'cable {cable}: constraint residual |g| = {value:.3g} m^2 exceeds the '
+                    f'tolerance {tolerances[0]:g} m^2 at t = {t:.3f} s (Algorithm 1: change '
+                    'the step or the Baumgarte gains)')
+        if status == OFF_RATE:
+            return (f'cable {cable}: constraint rate |g_dot| = {value:.3g} m^2/s exceeds the '
+                    f'tolerance {tolerances[1]:g} m^2/s at t = {t:.3f} s')
+        return None

@@ -1,0 +1,177 @@
+"""The compiled control tick of a formation and the loop over ticks and formations.
+
+`formation_tick` is seed Algorithm 1 for one tick of formation b, in the order of the ROS graph
+(`multilift_control.runtime.answer_tick`, then `FormationSimulator.advance`); `run_ticks` runs
+up to `ticks` ticks of each of the B formations in one call. Every equation is a call into the
+laws (`multilift_control.laws`) or the physics (`multilift_sim.physics`); the arrays are
+`engine.arrays`' and their slots the layouts'.
+"""
+import math
+
+import numpy as np
+
+from multilift_control.engine.arrays import (FINISHED, MODE_CASCADE, NOT_FINITE, OFF_CONSTRAINT,
+                                             OFF_RATE, RUNNING)
+from multilift_control.laws import jit
+from multilift_control.laws.cascade import leader_update
+from multilift_control.laws.follower import follower_update, lift_vectors
+from multilift_control.laws.layout import REFERENCE_SIZE
+from multilift_control.laws.mixer import collective_thrust
+from multilift_sim.physics.allocation import rotor_wrenches
+from multilift_sim.physics.formation_dae import integrate_period as rigid_period
+from multilift_sim.physics.formation_dae import residuals
+from multilift_sim.physics.layout import WRENCH_COLUMNS
+from multilift_sim.physics.measurement import measured_states
+from multilift_sim.physics.slack_cables import integrate_period as slack_period
+
+
+@jit
+def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
+                     errors, rates):
+    """Every controller's answer to formation b's measured `states` (n, UAV_STATE_SIZE) at t
+    [s], into speeds, saturated (n, rotors), setpoints (n, 3), thrust (n,), reference
+    (REFERENCE_SIZE,: NaN without one), errors and rates (n, rows: NaN past a follower's own):
+    the leader first, then the thrust book (the leader's thrust to this state, the followers'
+    to the previous one), then the followers, whose thrusts the book then notes."""
+    n = states.shape[0]
+    if a.leader_mode[b] == MODE_CASCADE:
+        s, sat, setpoint, lift, ref = leader_update(
+            a.cascade[b, 0], a.mixers[b, 0], m.cascade_memory[b, 0], a.mission[b],
+            a.segments[b], a.mission_steps[b], t, states[0])
+        for k in range(REFERENCE_SIZE):
+            reference[k] = ref[k]
+    else:  # constant rotor speed: the same command every tick, no reference
+        s, sat = a.constant_speeds[b], a.constant_saturated[b]
+        setpoint = np.zeros(3)
+        lift = collective_thrust(a.thrust_coefficients[b, 0], s)
+        for k in range(REFERENCE_SIZE):
+            reference[k] = math.nan
+    speeds[0, :] = s
+    saturated[0, :] = sat
+    setpoints[0, :] = setpoint
+    thrust[0] = lift
+    thrusts = m.thrusts[b]
+    thrusts[0] = collective_thrust(a.thrust_coefficients[b, 0], speeds[0])
+    vectors = lift_vectors(states, thrusts)
+    for i in range(1, n):
+        s, sat, setpoint, lift, own_errors, own_rates = follower_update(
+            a.follower[b, i], a.masses[b], a.rows[b], a.targets[b], a.law_p[b, i],
+            a.law_q[b, i], i, m.follower_memory[b, i], t, states, vectors, a.cascade[b, i],
+            a.mixers[b, i])
+        speeds[i, :] = s
+        saturated[i, :] = sat
+        setpoints[i, :] = setpoint
+        thrust[i] = lift
+        for k in range(own_errors.shape[0]):
+            errors[i, k] = own_errors[k]
+            rates[i, k] = own_rates[k]
+    for i in range(1, n):
+        thrusts[i] = collective_thrust(a.thrust_coefficients[b, i], speeds[i])
+
+
+@jit
+def check(a, m, b):
+    """Algorithm 1, lines 10-13, at formation b's current state: its status becomes
+    NOT_FINITE, OFF_CONSTRAINT or OFF_RATE (the first worst taut cable in worst_cable, its
+    value in worst_value) when the state is not finite or a taut cable left its tolerance."""
+    x = m.state[b]
+    for j in range(x.shape[0]):
+        if not math.isfinite(x[j]):
+            m.status[b] = NOT_FINITE
+            return
+    peak, peak_rate, worst, worst_rate = 0.0, 0.0, 0, 0
+    for i in range(m.g.shape[1]):
+        if m.taut[b, i]:
+            if abs(m.g[b, i]) > peak:
+                peak, worst = abs(m.g[b, i]), i
+            if abs(m.g_dot[b, i]) > peak_rate:
+                peak_rate, worst_rate = abs(m.g_dot[b, i]), i
+    if peak > a.tolerances[b, 0]:
+        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_CONSTRAINT, worst, peak
+    elif peak_rate > a.tolerances[b, 1]:
+        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_RATE, worst_rate, peak_rate
+
+
+@jit
+def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference, errors,
+                   rates, tension):
+    """One control tick of formation b: measure, answer, hold the speeds over the control
+    period (RK4), then check; the tension T_i = 2 l_i lambda_i [N] at the tick into tension."""
+    n = states.shape[0]
+    t = m.tick[b] * a.period_ns[b] * 1e-9
+    measured_states(m.state[b], n, states)
+    answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
+                     errors, rates)
+    wrenches = np.empty((n, WRENCH_COLUMNS))
+    rotor_wrenches(a.allocation[b], speeds, wrenches)
+    if a.slack[b]:
+        state, multipliers, g, g_dot = slack_period(
+            m.state[b], wrenches, a.uavs[b], a.gusts[b], a.formation[b], m.taut[b],
+            a.physics_dt[b], a.physics_steps[b])
+    else:
+        state, multipliers, g, g_dot = rigid_period(
+            m.state[b], wrenches, a.uavs[b], a.gusts[b], a.formation[b], m.taut[b],
+            a.physics_dt[b], a.physics_steps[b])
+    for i in range(n):
+        tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
+    m.state[b, :] = state
+    m.g[b, :] = g
+    m.g_dot[b, :] = g_dot
+    m.tick[b] += 1
+    check(a, m, b)
+    if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
+        m.status[b] = FINISHED
+
+
+@jit
+def start(a, m):
+    """Every formation's residuals and check at its initial state (before the first tick)."""
+    for b in range(m.state.shape[0]):
+        residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
+        check(a, m, b)
+        if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
+            m.status[b] = FINISHED
+
+
+@jit
+def run_ticks(a, m, ticks, record):
+    """Up to `ticks` ticks of each running formation (fewer where one finishes or stops);
+    `record` (engine.arrays.TickRecord) takes tick k of the call at row k when it has rows.
+    Returns the ticks flown per formation (B,)."""
+    batch = m.state.shape[0]
+    n = a.uavs.shape[1]
+    rotors = a.allocation.shape[3]
+    recording = record.speeds.shape[0] > 0
+    flown = np.zeros(batch, dtype=np.int64)
+    states = np.empty((n, record.measured.shape[3]))
+    speeds = np.empty((n, rotors))
+    saturated = np.empty((n, rotors), dtype=np.bool_)
+    setpoints = np.empty((n, 3))
+    thrust = np.empty(n)
+    reference = np.empty(REFERENCE_SIZE)
+    errors = np.full((n, record.errors.shape[3]), math.nan)
+    rates = np.full((n, record.errors.shape[3]), math.nan)
+    tension = np.empty(n)
+    for b in range(batch):
+        for k in range(ticks):
+            if m.status[b] != RUNNING:
+                break
+            if recording:
+                record.states[k, b, :] = m.state[b]
+                record.g[k, b, :] = m.g[b]
+                record.g_dot[k, b, :] = m.g_dot[b]
+                record.taut[k, b, :] = m.taut[b]
+            formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference,
+                           errors, rates, tension)
+            if recording:
+                record.measured[k, b] = states
+                record.speeds[k, b] = speeds
+                record.saturated[k, b] = saturated
+                record.setpoints[k, b] = setpoints
+                record.thrust[k, b] = thrust
+                record.reference[k, b] = reference
+                record.errors[k, b] = errors
+                record.rates[k, b] = rates
+                record.tension[k, b] = tension
+            flown[b] += 1
+    return flown

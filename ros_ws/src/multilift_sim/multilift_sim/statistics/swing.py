@@ -139,7 +139,6 @@ def lowest_of_two(uavs: np.ndarray, lengths: np.ndarray) -> tuple[float, float, 
         return x1, y1, z1 - l1
     x2, y2, z2, l2 = uavs[1, 0], uavs[1, 1], uavs[1, 2], lengths[1]
     dx, dy, dz = x2 - x1, y2 - y1, z2 - z1
-    d = math.sqrt(dx * dx + dy * dy + dz * dz)
     # a ball's bottom inside the other ball: that cable alone holds the payload
     below, reach = dz + l1, l2 * (1.0 + FEASIBILITY)
     if dx * dx + dy * dy + below * below <= reach * reach:
@@ -147,21 +146,9 @@ def lowest_of_two(uavs: np.ndarray, lengths: np.ndarray) -> tuple[float, float, 
     below, reach = dz - l2, l1 * (1.0 + FEASIBILITY)
     if dx * dx + dy * dy + below * below <= reach * reach:
         return x2, y2, z2 - l2
-    if d < 1e-12 or d > l1 + l2:
-        return math.nan, math.nan, math.nan
-    # lowest point of the circle where the spheres meet (as sphere_pair_lowest)
-    ax, ay, az = dx / d, dy / d, dz / d
-    a = (l1 * l1 - l2 * l2 + d * d) / (2.0 * d)
-    across = l1 * l1 - a * a
-    if 0.0 > across:
-        across = 0.0
-    radius = math.sqrt(across)
-    wx, wy, wz = az * ax, az * ay, az * az - 1.0                # -e_z less its axis part
-    norm = math.sqrt(wx * wx + wy * wy + wz * wz)
-    if norm < 1e-12:
-        return math.nan, math.nan, math.nan
-    k = radius / norm
-    return x1 + a * ax + k * wx, y1 + a * ay + k * wy, z1 + a * az + k * wz
+    # the lowest point of the circle where the spheres meet (NaN where they do not; with one
+    # UAV exactly above the other the circle is level: any of its points)
+    return sphere_pair_lowest(x1, y1, z1, l1, x2, y2, z2, l2)
 
 
 @jit

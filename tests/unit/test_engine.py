@@ -37,6 +37,9 @@ def test_a_mission_equals_the_per_object_run_to_the_bit(name, duration, cables):
     assert flown[0] == scenario.simulation.tick_count and engine.finished[0]
     assert np.array_equal(engine.state[0], run.simulator.state)
     assert np.array_equal(engine.memory.taut[0], run.simulator.taut)
+    expected = run.summary()
+    del expected['sim']['wall_time']
+    assert engine.summary(0) == expected  # every run figure, to the bit
     assert np.abs(engine.state[0] - engine._initial.state[0]).max() > 1e-3  # it flew
 
 

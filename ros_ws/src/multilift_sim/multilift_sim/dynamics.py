@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from multilift_sim import kernels
-from multilift_sim.disturbances import Gust, gust_velocity
+from multilift_sim.disturbances import Gust
 from multilift_sim.frames import seed_to_world_vector
 from multilift_sim.multirotor import MultirotorParams, rotational_kinetic_energy
 from multilift_sim.physics import layout as slots
@@ -257,10 +257,11 @@ class FormationModel:
     def _physics_functions(self) -> dict[str, Callable]:
         """The physics functions this model calls, by name (numba dispatchers)."""
         from multilift_sim.physics.allocation import rotor_wrenches
-        from multilift_sim.physics.formation_dae import (integrate_period, residuals, rk4_step,
-                                                         solve)
+        from multilift_sim.physics.formation_dae import (air_velocity, integrate_period,
+                                                         residuals, rk4_step, solve)
         return {'solve': solve, 'rk4_step': rk4_step, 'integrate_period': integrate_period,
-                'residuals': residuals, 'rotor_wrenches': rotor_wrenches}
+                'residuals': residuals, 'rotor_wrenches': rotor_wrenches,
+                'air_velocity': air_velocity}
 
     def _physics(self) -> dict[str, Callable]:
         """_physics_functions as MULTILIFT_KERNEL says, loaded once per mode."""
@@ -397,7 +398,9 @@ class FormationModel:
     def gust_velocity_at_payload(self, t: float, x: np.ndarray) -> np.ndarray:
         """Gust (air) velocity w at the payload [m/s], world, shape (3,)."""
         del t  # stationary gusts
-        return gust_velocity(self.params.gusts, self.layout.payload_position(np.asarray(x)))
+        position = self.layout.payload_position(np.asarray(x, dtype=float))
+        return np.array(self._physics()['air_velocity'](float(position[0]), float(position[1]),
+                                                        self._gusts))
 
     def payload_air_velocity(self, t: float, x: np.ndarray) -> np.ndarray:
         """Payload velocity relative to the air, ``v_p - w`` [m/s], world, shape (3,)."""

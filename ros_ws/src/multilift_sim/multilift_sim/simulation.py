@@ -42,6 +42,20 @@ class Snapshot:
     payload_velocity: np.ndarray  # world [m/s]
 
 
+def cable_reach(scenario: Scenario) -> np.ndarray:
+    """How far each cable reaches for the swing's equilibrium place [m], (n,): l_i widened by
+    the constraint tolerance, so cables held within it always meet."""
+    tolerance = scenario.simulation.constraint_tolerance
+    return np.array([math.sqrt(u.cable_length ** 2 + tolerance) for u in scenario.uavs])
+
+
+def swing_sampling(n_uavs: int) -> int:
+    """Every how many ticks the payload swing is sampled: every tick for one or two UAVs (a
+    closed form); from three on, where rigid cables hold the payload at its equilibrium place,
+    every 10th (10 Hz of a 100 Hz loop)."""
+    return 1 if n_uavs <= 2 else 10
+
+
 def initial_state(scenario: Scenario) -> np.ndarray:
     """Initial formation state on the constraint manifold, at rest."""
     if scenario.n_uavs == 1:
@@ -101,14 +115,9 @@ class FormationSimulator:
         self.residuals: tuple[np.ndarray, np.ndarray] | None = None
         # the air velocity at the payload in the current state [m/s], world (/payload/gust)
         self.payload_gust: np.ndarray = np.zeros(3)
-        # how far each cable reaches for the swing's equilibrium place: l_i widened by the
-        # constraint tolerance, so cables held within it always meet [m]
-        self._reach = np.array([math.sqrt(u.cable_length ** 2 + sim.constraint_tolerance)
-                                for u in scenario.uavs])
+        self._reach = cable_reach(scenario)
         self._all_taut = np.ones(self.n, dtype=bool)  # the cables of a rigid cable model
-        # payload swing every tick for one or two UAVs (a closed form); from three on, where
-        # rigid cables hold the payload at its equilibrium place, at 10 Hz of a 100 Hz loop
-        self._swing_every = 1 if self.n <= 2 else 10
+        self._swing_every = swing_sampling(self.n)
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
         self._check(0.0)
@@ -242,7 +251,8 @@ class FormationSimulator:
         self.residuals = (g, g_dot)
         gust = self.payload_gust = self.model.gust_velocity_at_payload(t, self.state)
         if self.scenario.gusts:
-            self.stats.add_gust_speed(math.sqrt(gust @ gust))  # np.linalg.norm's arithmetic
+            east, north, up = gust.tolist()  # the engine's arithmetic (engine.tick.check)
+            self.stats.add_gust_speed(math.sqrt(east * east + north * north + up * up))
         if status == CHECK_G:
             raise SimulationStopped(
                 f'cable {cable + 1}: constraint residual |g| = {abs(g[cable]):.3g} m^2 exceeds '

@@ -22,7 +22,9 @@ from multilift_control.runtime import ThrustBook
 from multilift_sim.dynamics import FormationModel, constant_arrays
 from multilift_sim.physics.layout import UAV_MASS
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import initial_state
+from multilift_sim.simulation import cable_reach, initial_state, swing_sampling
+from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
+                                     TrackingStatistics)
 
 # A leader's `control.mode` -> its code in `FormationArrays.leader_mode`: the index in the one
 # registry of leader controllers (multilift_control.controllers.LEADER_CONTROLLERS)
@@ -54,6 +56,7 @@ class FormationArrays(NamedTuple):
     tick_count: np.ndarray        # (B,) int: control periods of the run
     tolerances: np.ndarray        # (B, 2): |g| [m^2], |g_dot| [m^2/s]
     swing_every: np.ndarray       # (B,) int: the payload swing sampled every this many ticks
+    reach: np.ndarray             # (B, n) [m]: each cable's reach for the swing's equilibrium
     # the leader (multilift_control.laws.layout slots)
     leader_mode: np.ndarray       # (B,) int: MODE_*
     cascade: np.ndarray           # (B, n, CASCADE_SIZE): every UAV's cascade constants
@@ -87,6 +90,10 @@ class FormationMemory(NamedTuple):
     cascade_memory: np.ndarray    # (B, n, CASCADE_MEMORY_SIZE)
     follower_memory: np.ndarray   # (B, n, FOLLOWER_MEMORY_SIZE)
     thrusts: np.ndarray           # (B, n): the thrust book u_T,j [N]
+    gust: np.ndarray              # (B, 3): the air velocity at the payload [m/s], world
+    run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
+    tracking: np.ndarray          # (B, TRACKING_SIZE): the leader's tracking error
+    formation_errors: np.ndarray  # (B, n, FORMATION_SIZE): each follower's (row 0 unused)
 
 
 class TickRecord(NamedTuple):
@@ -142,7 +149,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),
-        swing_every=1 if n <= 2 else 10,
+        swing_every=swing_sampling(n), reach=cable_reach(scenario),
         leader_mode=LEADER_MODES.index(scenario.control.mode),
         cascade=np.stack([c.constants for c in cascades]),
         mixers=np.stack([c.mixer.rows for c in cascades]),
@@ -161,7 +168,9 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n),
         cascade_memory=np.stack([c.memory for c in cascades]),
         follower_memory=follower_memory,
-        thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float))
+        thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float), gust=np.zeros(3),
+        run=RunStatistics(n).run, tracking=TrackingStatistics().acc,
+        formation_errors=np.stack([FormationErrorStatistics().acc for _ in range(n)]))
     return arrays, memory
 
 

@@ -12,6 +12,8 @@ from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAIN
                                              TickRecord, batch_arrays, empty_record)
 from multilift_sim.dynamics import StateLayout
 from multilift_sim.scenario import Scenario
+from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
+                                     TrackingStatistics)
 
 
 class Engine:
@@ -121,3 +123,21 @@ class Engine:
             return (f'cable {cable}: constraint rate |g_dot| = {value:.3g} m^2/s exceeds the '
                     f'tolerance {tolerances[1]:g} m^2/s at t = {t:.3f} s')
         return None
+
+    # ----------------------------------------------------------------------------- figures
+    def summary(self, b: int = 0) -> dict:
+        """Formation b's run statistics as a run reports them ({'sim': ..., 'leader': ...,
+        'follower2': ...}: `multilift_control.headless.HeadlessRun.summary`'s keys and
+        definitions, `multilift_sim.statistics`), without the wall time."""
+        run = RunStatistics(self.n_uavs)
+        run.run[:] = self.memory.run[b]
+        leader = TrackingStatistics()
+        leader.acc[:] = self.memory.tracking[b]
+        out = {'sim': dict(run.as_dict(), error=self.stop_reason(b),
+                           scenario=self.scenarios[b].name),
+               'leader': leader.as_dict()}
+        for i in range(1, self.n_uavs):
+            follower = FormationErrorStatistics()
+            follower.acc[:] = self.memory.formation_errors[b, i]
+            out[f'follower{i + 1}'] = follower.as_dict()
+        return out

@@ -15,14 +15,18 @@ from multilift_control.engine.arrays import (FINISHED, MODE_CASCADE, NOT_FINITE,
 from multilift_control.laws import jit
 from multilift_control.laws.cascade import leader_update
 from multilift_control.laws.follower import follower_update, lift_vectors
-from multilift_control.laws.layout import REFERENCE_SIZE
+from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_sim.physics.allocation import rotor_wrenches
+from multilift_sim.physics.formation_dae import air_velocity, residuals
 from multilift_sim.physics.formation_dae import integrate_period as rigid_period
-from multilift_sim.physics.formation_dae import residuals
 from multilift_sim.physics.layout import WRENCH_COLUMNS
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.slack_cables import integrate_period as slack_period
+from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
+                                                   run_add_gust_speed, run_add_slack,
+                                                   run_add_tensions, run_check, tracking_add)
+from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
 
 
 @jit
@@ -40,6 +44,8 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
             a.segments[b], a.mission_steps[b], t, states[0])
         for k in range(REFERENCE_SIZE):
             reference[k] = ref[k]
+        tracking_add(m.tracking[b], ref[REFERENCE_POSITION:REFERENCE_POSITION + 3],
+                     states[0, UAV_POSITION:UAV_POSITION + 3])
     else:  # constant rotor speed: the same command every tick, no reference
         s, sat = a.constant_speeds[b], a.constant_saturated[b]
         setpoint = np.zeros(3)
@@ -65,31 +71,36 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
         for k in range(own_errors.shape[0]):
             errors[i, k] = own_errors[k]
             rates[i, k] = own_rates[k]
+        formation_error_add(m.formation_errors[b, i], own_errors)
     for i in range(1, n):
         thrusts[i] = collective_thrust(a.thrust_coefficients[b, i], speeds[i])
 
 
 @jit
 def check(a, m, b):
-    """Algorithm 1, lines 10-13, at formation b's current state: its status becomes
-    NOT_FINITE, OFF_CONSTRAINT or OFF_RATE (the first worst taut cable in worst_cable, its
-    value in worst_value) when the state is not finite or a taut cable left its tolerance."""
+    """Algorithm 1, lines 10-13, at formation b's current state (its g, g_dot), the run's
+    figures accumulated (`statistics.accumulators.run_check`, then the gust at the payload, as
+    `FormationSimulator._check`): its status becomes NOT_FINITE, OFF_CONSTRAINT or OFF_RATE
+    (the cable in worst_cable, its |g| or |g_dot| in worst_value) when Algorithm 1 stops it."""
+    t = m.tick[b] * a.period_ns[b] * 1e-9
     x = m.state[b]
-    for j in range(x.shape[0]):
-        if not math.isfinite(x[j]):
-            m.status[b] = NOT_FINITE
-            return
-    peak, peak_rate, worst, worst_rate = 0.0, 0.0, 0, 0
-    for i in range(m.g.shape[1]):
-        if m.taut[b, i]:
-            if abs(m.g[b, i]) > peak:
-                peak, worst = abs(m.g[b, i]), i
-            if abs(m.g_dot[b, i]) > peak_rate:
-                peak_rate, worst_rate = abs(m.g_dot[b, i]), i
-    if peak > a.tolerances[b, 0]:
-        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_CONSTRAINT, worst, peak
-    elif peak_rate > a.tolerances[b, 1]:
-        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_RATE, worst_rate, peak_rate
+    status, cable = run_check(m.run[b], x, m.g[b], m.g_dot[b], m.taut[b], a.tolerances[b, 0],
+                              a.tolerances[b, 1], t, m.tick[b], a.swing_every[b], a.reach[b])
+    if status == CHECK_NON_FINITE:
+        m.status[b] = NOT_FINITE
+        return
+    payload = 6 * a.uavs.shape[1]
+    gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
+    m.gust[b, 0], m.gust[b, 1], m.gust[b, 2] = gust_x, gust_y, gust_z
+    if a.gusts.shape[1]:
+        run_add_gust_speed(m.run[b], math.sqrt(gust_x * gust_x + gust_y * gust_y
+                                               + gust_z * gust_z))
+    if status == CHECK_G:
+        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_CONSTRAINT, cable, abs(
+            m.g[b, cable])
+    elif status == CHECK_G_DOT:
+        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_RATE, cable, abs(
+            m.g_dot[b, cable])
 
 
 @jit
@@ -102,6 +113,8 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
     measured_states(m.state[b], n, states)
     answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
                      errors, rates)
+    period = a.period_ns[b] * 1e-9
+    run_add_commands(m.run[b], speeds, saturated, period)
     wrenches = np.empty((n, WRENCH_COLUMNS))
     rotor_wrenches(a.allocation[b], speeds, wrenches)
     if a.slack[b]:
@@ -114,6 +127,9 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
             a.physics_dt[b], a.physics_steps[b])
     for i in range(n):
         tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
+    run_add_tensions(m.run[b], tension)
+    if a.slack[b]:
+        run_add_slack(m.run[b], m.taut[b], period)
     m.state[b, :] = state
     m.g[b, :] = g
     m.g_dot[b, :] = g_dot

@@ -30,18 +30,14 @@ from multilift_sim.physics.layout import (
 
 
 @jit
-def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
-    """Drag (gusts included) on the payload over m_p [m/s^2], world, gravity excluded: at
-    payload position (px, py, pz) [m] and velocity (pvx, pvy, pvz) [m/s]. (The numpy form
-    is disturbances.payload_drag and gust_velocity; tests hold them equal.)"""
-    drag = formation[FORMATION_DRAG]
-    if drag <= 0.0:
-        return 0.0, 0.0, 0.0
+def air_velocity(px, py, gusts):
+    """The air velocity w [m/s], world, at a point (px, py) [m] of the horizontal plane (the
+    height does not matter): the sum of the 1-cosine gusts (Eq. 2.55), each of its speed along
+    its direction, r the horizontal distance from its centre (a square root, not math.hypot:
+    Python's and the C library's hypot round differently, and the uncompiled run must give
+    the compiled one's bits)."""
     air_x = air_y = air_z = 0.0
     for k in range(gusts.shape[0]):
-        # 1-cosine gust (Eq. 2.55): r the horizontal distance from its centre (a square root,
-        # not math.hypot: Python's and the C library's hypot round differently, and the
-        # uncompiled run must give the compiled one's bits)
         east, north = px - gusts[k, GUST_CENTER], py - gusts[k, GUST_CENTER + 1]
         radius = math.sqrt(east * east + north * north)
         h = gusts[k, GUST_GRADIENT_DISTANCE]
@@ -53,6 +49,18 @@ def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
             air_x += speed * gusts[k, GUST_DIRECTION]
             air_y += speed * gusts[k, GUST_DIRECTION + 1]
             air_z += speed * gusts[k, GUST_DIRECTION + 2]
+    return air_x, air_y, air_z
+
+
+@jit
+def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
+    """Drag (gusts included) on the payload over m_p [m/s^2], world, gravity excluded: at
+    payload position (px, py, pz) [m] and velocity (pvx, pvy, pvz) [m/s]. (The numpy form
+    is disturbances.payload_drag and gust_velocity; tests hold them equal.)"""
+    drag = formation[FORMATION_DRAG]
+    if drag <= 0.0:
+        return 0.0, 0.0, 0.0
+    air_x, air_y, air_z = air_velocity(px, py, gusts)
     rel_x, rel_y, rel_z = pvx - air_x, pvy - air_y, pvz - air_z
     # Eq. 2.53 on the air-relative velocity: -c_pd v_rel |v_rel| / m_p
     scale = (-drag * formation[FORMATION_INV_PAYLOAD_MASS]

@@ -137,7 +137,13 @@ def controller_peers_missing(node: Node, command_publisher, record: bool) -> str
 def serve_controllers(nodes: Sequence[Node], summary: Callable[[Node], tuple[str, dict]]) -> None:
     """Controller nodes' life, one node or several composed in one executor: wait for the
     peers of every one (`node.missing_peers`), answer states until stopped, then leave each
-    node's `summary(node)` (name, figures) as `<summary_dir>/<name>.json`."""
+    node's `summary(node)` (name, figures) as `<summary_dir>/<name>.json`.
+
+    No state is answered before: a controller answering while its participant had not yet
+    discovered the recorder sent what the recorder never got (seen: a composed 3 s run whose
+    bag had no controller message, the recorder found only as the run ended). The states
+    that arrive meanwhile wait in the subscriptions (reliable, 1000 deep); the simulator waits
+    `command_timeout` for the first answers."""
     def missing() -> str | None:
         for node in nodes:
             what = node.missing_peers()
@@ -145,7 +151,7 @@ def serve_controllers(nodes: Sequence[Node], summary: Callable[[Node], tuple[str
                 return what if len(nodes) == 1 else f'{what} ({node.get_name()})'
         return None
 
-    wait_until(nodes[0], missing, STARTUP_TIMEOUT)
+    wait_until(nodes[0], missing, STARTUP_TIMEOUT, spin=False)
     try:
         spin(nodes[0])
     finally:
@@ -153,15 +159,21 @@ def serve_controllers(nodes: Sequence[Node], summary: Callable[[Node], tuple[str
             write_summary(node.summary_dir, *summary(node))
 
 
-def wait_until(node: Node, ready: Callable[[], str | None], timeout: float) -> None:
-    """Spin until `ready()` returns None (it returns what is still missing), or raise."""
+def wait_until(node: Node, ready: Callable[[], str | None], timeout: float,
+               spin: bool = True) -> None:
+    """Spin until `ready()` returns None (it returns what is still missing), or raise. With
+    `spin` False the node's callbacks wait too (what arrives waits in its subscriptions): the
+    graph `ready()` reads is kept by rmw's own thread."""
     deadline = time.monotonic() + timeout
     missing = ready()
     while missing is not None:
         if time.monotonic() > deadline:
             raise StartupError(f'{node.get_name()}: gave up after {timeout:.0f} s waiting for '
                                f'{missing}')
-        node.executor.spin_once(timeout_sec=0.05)
+        if spin:
+            node.executor.spin_once(timeout_sec=0.05)
+        else:
+            time.sleep(0.05)
         missing = ready()
 
 

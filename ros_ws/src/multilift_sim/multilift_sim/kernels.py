@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import importlib
-import importlib.util
 import os
 import shutil
 import sys
@@ -28,24 +27,25 @@ import types
 from pathlib import Path
 from typing import Any, Callable
 
-# the kernels' packages: numba compiles a kernel together with the kernels it calls from other
-# files, but checks a cached kernel against its own file only
-KERNEL_PACKAGES = ('multilift_sim.physics', 'multilift_sim.statistics', 'multilift_control.laws',
-                   'multilift_control.engine')
+# the subpackages of numba kernels, in any multilift_* package (physics and statistics here,
+# the laws and the engine's tick above): numba compiles a kernel together with the kernels it
+# calls from other files, but checks a cached kernel against its own file only
+KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine')
 CACHE_ROOT = Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache') / 'multilift' / 'numba'
 
 
 def _sources_digest() -> str:
-    """A digest of every kernel package's sources (those found: a package is located, not
-    imported)."""
+    """A digest of the kernels' sources: every KERNEL_FOLDERS subpackage of the first
+    multilift_* package of each name on sys.path (found, not imported)."""
+    packages: dict[str, Path] = {}
+    for entry in sys.path:
+        for init in Path(entry or '.').glob('multilift_*/__init__.py'):
+            packages.setdefault(init.parent.name, init.parent)
     digest = hashlib.sha256()
-    for package in KERNEL_PACKAGES:
-        top, _, sub = package.partition('.')
-        spec = importlib.util.find_spec(top)
-        if spec is None or spec.origin is None:
-            continue
-        for path in sorted((Path(spec.origin).parent / sub).glob('*.py')):
-            digest.update(path.name.encode() + b'\0' + path.read_bytes())
+    for name in sorted(packages):
+        for folder in KERNEL_FOLDERS:
+            for path in sorted((packages[name] / folder).glob('*.py')):
+                digest.update(f'{name}/{folder}/{path.name}'.encode() + b'\0' + path.read_bytes())
     return digest.hexdigest()[:16]
 
 

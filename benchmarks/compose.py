@@ -65,7 +65,8 @@ def run(args: list[str], env: dict) -> tuple[float, dict, dict[str, float]]:
             except psutil.Error:
                 continue
             name = cpu[process.pid][0] if process.pid in cpu else role(process)
-            cpu[process.pid] = (name, times.user + times.system)
+            if name != '?':  # not yet known (exec under way) or gone: the next sample
+                cpu[process.pid] = (name, times.user + times.system)
         time.sleep(0.1)
     wall = time.monotonic() - start
     out, err = launcher.communicate()

@@ -112,6 +112,7 @@ class TickRecord(NamedTuple):
     g: np.ndarray                 # (ticks, B, n) [m^2]
     g_dot: np.ndarray             # (ticks, B, n) [m^2/s]
     taut: np.ndarray              # (ticks, B, n) bool, at the tick's start
+    gust: np.ndarray              # (ticks, B, 3): the air velocity at the payload [m/s], world
 
 
 def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
@@ -215,4 +216,5 @@ def empty_record(arrays: FormationArrays, ticks: int) -> TickRecord:
         errors=np.full((ticks, batch, n, rows), math.nan),
         rates=np.full((ticks, batch, n, rows), math.nan),
         tension=np.empty((ticks, batch, n)), g=np.empty((ticks, batch, n)),
-        g_dot=np.empty((ticks, batch, n)), taut=np.empty((ticks, batch, n), dtype=bool))
+        g_dot=np.empty((ticks, batch, n)), taut=np.empty((ticks, batch, n), dtype=bool),
+        gust=np.empty((ticks, batch, 3)))

@@ -177,6 +177,7 @@ def run_ticks(a, m, ticks, record):
                 record.g[k, b, :] = m.g[b]
                 record.g_dot[k, b, :] = m.g_dot[b]
                 record.taut[k, b, :] = m.taut[b]
+                record.gust[k, b, :] = m.gust[b]
             formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference,
                            errors, rates, tension)
             if recording:

@@ -173,17 +173,22 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
             check(constraints.jacobian, rows, r)
             check(constraints.jacobian_rate_product, rows, v)
             check(constraints.rows_of, rows, f.index)
+            check(constraints.rows_by_uav, rows, len(r))
             check(constraints.free_follower_motions, rows, r, 1e-9)
             check(follower.virtual_forces, rows, targets, f.masses, 9.81, 4.2, 1.69, r, v, u)
             check(follower.free_mode_correction, f.masses, 4.2, f.index, r, v, u, rows)
+            check(follower.driven_entry, f.masses, 9.81, 4.2, f.index, 2, u[f.index, 2],
+                  v[f.index, 2])
+            terms, _ = check(follower.formation_terms, f.constants, f.masses, rows, targets,
+                             states, u)
             if f.constraints.linear:
-                check(follower.linear_virtual_force, f.constants, f.masses, f.law_p, f.law_q,
-                      f.index, r, v, u, g)
+                check(follower.linear_virtual_force, f.constants, f.law_p, f.law_q, f.index,
+                      terms[3], rng.normal(size=3), g)
             check(follower.lift_vectors, states, rng.uniform(0, 60, size=len(r)))
             args = (f.constants, f.masses, rows, targets, f.law_p, f.law_q, f.index)
-            check(follower.follower_force, *args, memories[id(f)].copy(), t, states, u)
+            check(follower.follower_force, *args, memories[id(f)].copy(), t, u, terms)
             _, after = check(follower.follower_update, *args, memories[id(f)], t, states, u,
-                             f.cascade.constants, f.cascade.mixer.rows)
+                             terms, f.cascade.constants, f.cascade.mixer.rows)
             memories[id(f)] = after[7]
     assert 10 < saturated < 140 and clamped > 0  # both regimes were met
     for f, _ in followers:  # the memories moved: lift, heading, integral

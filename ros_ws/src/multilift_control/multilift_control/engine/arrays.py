@@ -16,7 +16,8 @@ import numpy as np
 
 from multilift_control.controllers import LEADER_CONTROLLERS, ConstantRotorSpeed, MissionLeader
 from multilift_control.formation import FormationFollower
-from multilift_control.laws.layout import (FOLLOWER_MEMORY_SIZE, FOLLOWER_SIZE, REFERENCE_SIZE,
+from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_MEMORY_SIZE,
+                                           FOLLOWER_SIZE, FOLLOWER_TWO_ALPHA, REFERENCE_SIZE,
                                            ROW_SIZE, UAV_STATE_SIZE)
 from multilift_control.runtime import ThrustBook
 from multilift_sim.dynamics import FormationModel, constant_arrays
@@ -131,6 +132,9 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
     path = mission_leader.path
     constant = ConstantRotorSpeed(scenario, 0).output
     followers = [FormationFollower.from_scenario(scenario, i) for i in range(1, n)]
+    if len({(f.constants[FOLLOWER_GRAVITY], f.constants[FOLLOWER_TWO_ALPHA])
+            for f in followers}) > 1:  # the tick computes their shared terms once
+        raise ValueError(f'{scenario.name}: the followers differ in gravity or alpha_vc')
     cascades = [mission_leader.cascade] + [f.cascade for f in followers]
     rows = followers[0].constraints.rows if followers else np.zeros((0, ROW_SIZE), np.int64)
     m = rows.shape[0]
@@ -182,6 +186,22 @@ def _stacked(name: str, values: list) -> np.ndarray:
                          f'{sorted(shapes)} (one batch: the same n, rotors, gusts, mission '
                          'segments and formation rows)')
     return np.ascontiguousarray(np.stack([np.asarray(v) for v in values]))
+
+
+def _shape_key(fields: tuple[dict, dict]) -> tuple:
+    arrays, memory = fields
+    shared = tuple(float(arrays[name]) for name in ('physics_dt', 'physics_steps', 'period_ns'))
+    return (shared, tuple(np.shape(v) for v in arrays.values()),
+            tuple(np.shape(v) for v in memory.values()))
+
+
+def shape_groups(scenarios: Sequence[Scenario]) -> list[list[int]]:
+    """The scenarios' indices grouped into batches the engine can fly together (the same
+    shapes of every array, control and physics rates), in order of first appearance."""
+    groups: dict[tuple, list[int]] = {}
+    for index, scenario in enumerate(scenarios):
+        groups.setdefault(_shape_key(_formation_fields(scenario)), []).append(index)
+    return list(groups.values())
 
 
 def batch_arrays(scenarios: Sequence[Scenario]) -> tuple[FormationArrays, FormationMemory]:

@@ -14,7 +14,7 @@ from multilift_control.engine.arrays import (FINISHED, MODE_CASCADE, NOT_FINITE,
                                              OFF_RATE, RUNNING)
 from multilift_control.laws import jit
 from multilift_control.laws.cascade import leader_update
-from multilift_control.laws.follower import follower_update, lift_vectors
+from multilift_control.laws.follower import follower_update, formation_terms, lift_vectors
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_sim.physics.allocation import rotor_wrenches
@@ -36,7 +36,8 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
     [s], into speeds, saturated (n, rotors), setpoints (n, 3), thrust (n,), reference
     (REFERENCE_SIZE,: NaN without one), errors and rates (n, rows: NaN past a follower's own):
     the leader first, then the thrust book (the leader's thrust to this state, the followers'
-    to the previous one), then the followers, whose thrusts the book then notes."""
+    to the previous one), then the followers (what their laws share, once: `formation_terms`),
+    whose thrusts the book then notes."""
     n = states.shape[0]
     if a.leader_mode[b] == MODE_CASCADE:
         s, sat, setpoint, lift, ref = leader_update(
@@ -59,11 +60,15 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
     thrusts = m.thrusts[b]
     thrusts[0] = collective_thrust(a.thrust_coefficients[b, 0], speeds[0])
     vectors = lift_vectors(states, thrusts)
+    # what every follower's law shares, once (O(n)), then each follower's own step; the
+    # constants of any follower (the last; n = 1: the unused row 0)
+    terms = formation_terms(a.follower[b, n - 1], a.masses[b], a.rows[b], a.targets[b], states,
+                            vectors)
     for i in range(1, n):
         s, sat, setpoint, lift, own_errors, own_rates = follower_update(
             a.follower[b, i], a.masses[b], a.rows[b], a.targets[b], a.law_p[b, i],
-            a.law_q[b, i], i, m.follower_memory[b, i], t, states, vectors, a.cascade[b, i],
-            a.mixers[b, i])
+            a.law_q[b, i], i, m.follower_memory[b, i], t, states, vectors, terms,
+            a.cascade[b, i], a.mixers[b, i])
         speeds[i, :] = s
         saturated[i, :] = sat
         setpoints[i, :] = setpoint

@@ -107,6 +107,31 @@ def rows_of(rows, index):
 
 
 @jit
+def rows_by_uav(rows, n):
+    """Every UAV's rows at once, in O(m + n): (start (n + 1,), index ints): the rows that
+    involve UAV j (0 = the leader), ascending as `rows_of(rows, j)`, are
+    index[start[j]:start[j + 1]]."""
+    start = np.zeros(n + 1, dtype=np.int64)
+    for k in range(rows.shape[0]):
+        i, j = rows[k, ROW_FIRST], rows[k, ROW_SECOND]
+        start[i + 1] += 1
+        if j != i:
+            start[j + 1] += 1
+    for j in range(n):
+        start[j + 1] += start[j]
+    index = np.empty(start[n], dtype=np.int64)
+    filled = start[:n].copy()
+    for k in range(rows.shape[0]):
+        i, j = rows[k, ROW_FIRST], rows[k, ROW_SECOND]
+        index[filled[i]] = k
+        filled[i] += 1
+        if j != i:
+            index[filled[j]] = k
+            filled[j] += 1
+    return start, index
+
+
+@jit
 def free_follower_motions(rows, positions, tol):
     """Orthonormal basis (2(n-1), k) of the followers' horizontal motions that leave every row
     unchanged to first order with the leader held: the null space of J_vc's follower x, y

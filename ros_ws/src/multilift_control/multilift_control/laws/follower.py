@@ -1,7 +1,9 @@
 """Formation control by virtual constraints (seed §3.2, Eq. 3.8-3.13): the force a follower's
 thrust should produce to keep its rows of g_vc (`constraints`) and the leader's altitude, and
-a follower's tick through the cascade (`cascade.command`). The law and its departures from
-the print are told in `multilift_control.formation.FormationFollower`'s docstring.
+a follower's tick through the cascade (`cascade.command`): what every follower of a tick
+shares, once (`formation_terms`), then each follower's own step (`follower_update`), O(n)
+each. The law and its departures from the print are told in
+`multilift_control.formation.FormationFollower`'s docstring.
 
 constants: FOLLOWER_* slots, memory: FOLLOWER_INTEGRAL, _LAST_T, _LIFT, _YAW (layout);
 masses: the m_i of M_f,r (n,) [kg]; rows, targets: the constraint rows; states (n,
@@ -15,7 +17,7 @@ from multilift_control.laws import jit
 from multilift_control.laws.cascade import clipped, command, elapsed, thrust_axis
 from multilift_control.laws.constraints import (free_follower_motions, jacobian,
                                                 jacobian_rate_product, residual, row_rate,
-                                                rows_of)
+                                                rows_by_uav)
 from multilift_control.laws.layout import (CASCADE_THRUST_COEFFICIENT,
                                            FOLLOWER_ALTITUDE_OFFSET, FOLLOWER_BETA_SQ,
                                            FOLLOWER_COMMANDED, FOLLOWER_FREE_MODE_GAIN,
@@ -113,43 +115,24 @@ def free_mode_correction(masses, gain, index, positions, velocities, thrust_vect
 
 
 @jit
-def linear_virtual_force(constants, masses, law_p, law_q, index, positions, velocities, u,
-                         g):
-    """This follower's u_vf,i (3,) [N] for linear (and V) rows, where J_vc and M are constant:
-    u_vf,i = Q (M^-1 (u - f) + 2 alpha v) + beta^2 P g_vc (J_dot = 0), law_p = P (3, m),
-    law_q = Q (3, 3n) (FormationFollower._linear_law_matrices): O(n) per tick instead of the
-    O(n^3) solve of `virtual_forces`. g: g_vc (m,)."""
-    n = positions.shape[0]
-    gravity = constants[FOLLOWER_GRAVITY]
-    driven = np.empty(3 * n)  # M^-1 (u - f) + 2 alpha v
-    for j in range(n):
-        for axis in range(3):
-            weight = masses[j] * gravity if axis == 2 else 0.0  # f_j = m_j g e_z
-            driven[3 * j + axis] = ((1.0 / masses[j]) * (u[j, axis] - weight)
-                                    + constants[FOLLOWER_TWO_ALPHA] * velocities[j, axis])
-    out = np.empty(3)
-    for axis in range(3):
-        pushed = 0.0
-        for c in range(3 * n):
-            pushed += law_q[axis, c] * driven[c]
-        held = 0.0
-        for k in range(g.shape[0]):
-            held += law_p[axis, k] * g[k]
-        out[axis] = pushed + constants[FOLLOWER_BETA_SQ] * held
-    return out
+def driven_entry(masses, gravity, two_alpha, j, axis, force, velocity):
+    """Entry 3 j + axis of M^-1 (u - f) + 2 alpha v, the vector the linear law's Q maps
+    (`linear_virtual_force`): force u_j,axis [N], velocity v_j,axis [m/s], f_j = m_j g e_z."""
+    weight = masses[j] * gravity if axis == 2 else 0.0
+    return (1.0 / masses[j]) * (force - weight) + two_alpha * velocity
 
 
 @jit
-def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory, t, states,
-                   thrust_vectors):
-    """(F world [N] (3,), this follower's rows of g_vc [m or m^2], their rates [m/s or
-    m^2/s]) at t [s]: the force the thrust should produce before Eq. 3.13, and the altitude
-    integral advanced in memory.
-
-    horizontal: F_xy = (u_i + u_vf,i)_xy (+ `free_mode_correction` with FOLLOWER_FREE_MODE_GAIN
-    on and nonlinear rows: linear rows have no free motions), u_i the lift asked at the last
-    tick when FOLLOWER_COMMANDED (memory), else thrust_vectors[i]; vertical: the altitude loop
-    to z_1 + FOLLOWER_ALTITUDE_OFFSET."""
+def formation_terms(constants, masses, rows, targets, states, thrust_vectors):
+    """What the laws of every follower of one tick share, computed once in O(n + m) from the
+    formation's states and thrust_vectors (the thrust book's, the same for every follower):
+    (positions (n, 3) [m], velocities (n, 3) [m/s], g_vc (m,), driven (3n,), row_start
+    (n + 1,), row_index), driven = M^-1 (u - f) + 2 alpha v (`driven_entry`) with
+    u = thrust_vectors (a follower that feeds back its own lift replaces its 3 entries:
+    `follower_force`), the rows of UAV j row_index[row_start[j]:row_start[j + 1]]
+    (`constraints.rows_by_uav`). constants: a follower's of the formation (its followers share
+    FOLLOWER_GRAVITY and FOLLOWER_TWO_ALPHA). A follower's own step (`follower_force`,
+    `follower_update`) then touches its own rows and columns only."""
     n = states.shape[0]
     positions = np.empty((n, 3))
     velocities = np.empty((n, 3))
@@ -157,23 +140,80 @@ def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory
         for axis in range(3):
             positions[j, axis] = states[j, UAV_POSITION + axis]
             velocities[j, axis] = states[j, UAV_VELOCITY + axis]
-    u = thrust_vectors.copy()
+    driven = np.empty(3 * n)
+    for j in range(n):
+        for axis in range(3):
+            driven[3 * j + axis] = driven_entry(
+                masses, constants[FOLLOWER_GRAVITY], constants[FOLLOWER_TWO_ALPHA], j, axis,
+                thrust_vectors[j, axis], velocities[j, axis])
+    row_start, row_index = rows_by_uav(rows, n)
+    return (positions, velocities, residual(rows, targets, positions), driven, row_start,
+            row_index)
+
+
+@jit
+def linear_virtual_force(constants, law_p, law_q, index, driven, own_driven, g):
+    """This follower's u_vf,i (3,) [N] for linear (and V) rows, where J_vc and M are constant:
+    u_vf,i = Q (M^-1 (u - f) + 2 alpha v) + beta^2 P g_vc (J_dot = 0), law_p = P (3, m),
+    law_q = Q (3, 3n) (FormationFollower._linear_law_matrices): O(n) per tick instead of the
+    O(n^3) solve of `virtual_forces`. driven: M^-1 (u - f) + 2 alpha v (3n,) of the tick
+    (`formation_terms`) but for this follower's own 3 entries, own_driven (3,); g: g_vc (m,).
+    The three axes' sums run side by side, each in the order of c and k."""
+    first = 3 * index
+    pushed_x = pushed_y = pushed_z = 0.0
+    for c in range(driven.shape[0]):
+        d = own_driven[c - first] if first <= c < first + 3 else driven[c]
+        pushed_x += law_q[0, c] * d
+        pushed_y += law_q[1, c] * d
+        pushed_z += law_q[2, c] * d
+    held_x = held_y = held_z = 0.0
+    for k in range(g.shape[0]):
+        held_x += law_p[0, k] * g[k]
+        held_y += law_p[1, k] * g[k]
+        held_z += law_p[2, k] * g[k]
+    beta_sq = constants[FOLLOWER_BETA_SQ]
+    out = np.empty(3)
+    out[0] = pushed_x + beta_sq * held_x
+    out[1] = pushed_y + beta_sq * held_y
+    out[2] = pushed_z + beta_sq * held_z
+    return out
+
+
+@jit
+def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory, t,
+                   thrust_vectors, terms):
+    """(F world [N] (3,), this follower's rows of g_vc [m or m^2], their rates [m/s or
+    m^2/s]) at t [s]: the force the thrust should produce before Eq. 3.13, and the altitude
+    integral advanced in memory. terms: the tick's `formation_terms` of these thrust_vectors.
+
+    horizontal: F_xy = (u_i + u_vf,i)_xy (+ `free_mode_correction` with FOLLOWER_FREE_MODE_GAIN
+    on and nonlinear rows: linear rows have no free motions), u_i the lift asked at the last
+    tick when FOLLOWER_COMMANDED (memory), else thrust_vectors[i]; vertical: the altitude loop
+    to z_1 + FOLLOWER_ALTITUDE_OFFSET."""
+    positions, velocities, g, driven, row_start, row_index = terms
+    own = thrust_vectors[index].copy()  # u_i
     if constants[FOLLOWER_COMMANDED] != 0.0 and not math.isnan(memory[FOLLOWER_LIFT]):
         for axis in range(3):
-            u[index, axis] = memory[FOLLOWER_LIFT + axis]
-    g = residual(rows, targets, positions)
+            own[axis] = memory[FOLLOWER_LIFT + axis]
     force = np.empty(3)
     if constants[FOLLOWER_LINEAR] != 0.0:
-        u_vf = linear_virtual_force(constants, masses, law_p, law_q, index, positions,
-                                    velocities, u, g)
+        own_driven = np.empty(3)
+        for axis in range(3):
+            own_driven[axis] = driven_entry(
+                masses, constants[FOLLOWER_GRAVITY], constants[FOLLOWER_TWO_ALPHA], index, axis,
+                own[axis], velocities[index, axis])
+        u_vf = linear_virtual_force(constants, law_p, law_q, index, driven, own_driven, g)
         for axis in range(2):
-            force[axis] = u[index, axis] + u_vf[axis]
+            force[axis] = own[axis] + u_vf[axis]
     else:
+        u = thrust_vectors.copy()
+        for axis in range(3):
+            u[index, axis] = own[axis]
         u_vf_all, _ = virtual_forces(rows, targets, masses, constants[FOLLOWER_GRAVITY],
                                      constants[FOLLOWER_TWO_ALPHA], constants[FOLLOWER_BETA_SQ],
                                      positions, velocities, u)
         for axis in range(2):
-            force[axis] = u[index, axis] + u_vf_all[index, axis]
+            force[axis] = own[axis] + u_vf_all[index, axis]
         gain = constants[FOLLOWER_FREE_MODE_GAIN]
         if not math.isnan(gain):  # not in the seed: see FormationFollower
             correction = free_mode_correction(masses, gain, index, positions, velocities, u,
@@ -193,28 +233,28 @@ def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory
     force[2] = constants[FOLLOWER_HOVER_MASS] * (
         constants[FOLLOWER_GRAVITY] + constants[FOLLOWER_KP_Z] * error
         + constants[FOLLOWER_KD_Z] * error_rate + memory[FOLLOWER_INTEGRAL])
-    own = rows_of(rows, index)
-    errors = np.empty(own.shape[0])
-    rates = np.empty(own.shape[0])
-    for k in range(own.shape[0]):
-        errors[k] = g[own[k]]
-        rates[k] = row_rate(rows, positions, velocities, own[k])
+    first, last = row_start[index], row_start[index + 1]
+    errors = np.empty(last - first)
+    rates = np.empty(last - first)
+    for k in range(first, last):
+        errors[k - first] = g[row_index[k]]
+        rates[k - first] = row_rate(rows, positions, velocities, row_index[k])
     return force, errors, rates
 
 
 @jit
 def follower_update(constants, masses, rows, targets, law_p, law_q, index, memory, t, states,
-                    thrust_vectors, cascade_constants, mixer):
-    """One follower's tick at t [s]: `follower_force`, Eq. 3.13 and the cascade's attitude loop
-    and mixer at the held heading (memory FOLLOWER_YAW: the one measured at the first tick when
-    NaN), and the lift the rotors give after saturation along the thrust axis asked for, kept
-    in memory (FOLLOWER_LIFT). cascade_constants: CASCADE_* slots, mixer: MIXER_* rows.
-    Returns (speeds [rad/s], saturated, setpoint [rad], thrust [N], rows of g_vc, their
-    rates)."""
+                    thrust_vectors, terms, cascade_constants, mixer):
+    """One follower's tick at t [s]: `follower_force` (terms: the tick's `formation_terms`),
+    Eq. 3.13 and the cascade's attitude loop and mixer at the held heading (memory FOLLOWER_YAW:
+    the one measured at the first tick when NaN), and the lift the rotors give after saturation
+    along the thrust axis asked for, kept in memory (FOLLOWER_LIFT). cascade_constants:
+    CASCADE_* slots, mixer: MIXER_* rows. Returns (speeds [rad/s], saturated, setpoint [rad],
+    thrust [N], rows of g_vc, their rates)."""
     if math.isnan(memory[FOLLOWER_YAW]):
         memory[FOLLOWER_YAW] = states[index, UAV_EULER + 2]  # hold the initial heading
     force, errors, rates = follower_force(constants, masses, rows, targets, law_p, law_q,
-                                          index, memory, t, states, thrust_vectors)
+                                          index, memory, t, thrust_vectors, terms)
     speeds, saturated, setpoint, thrust = command(cascade_constants, mixer, states[index],
                                                   force, memory[FOLLOWER_YAW])
     lifted = collective_thrust(cascade_constants[CASCADE_THRUST_COEFFICIENT], speeds)

@@ -3,6 +3,8 @@ as they are and what the headless bag writes, so both carry the same messages (s
 multilift_sim.tick_messages for the simulator's side)."""
 from __future__ import annotations
 
+from typing import Sequence
+
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim import cdr
 from multilift_sim.msgvalues import uav_frame
@@ -28,23 +30,33 @@ class AnswerMessages:
         """/uav{i}/rotor_cmd first (what the simulator waits for), then
         /uav{i}/attitude_setpoint, then the leader's /uav1/reference or a follower's
         /uav{i}/formation_error; all stamped with the answered state's time."""
-        cmd_topic, cmd, setpoint_topic, setpoint, ref_topic, error_topic = \
-            self._uavs[answer.index]
-        t_ns, out = answer.t_ns, answer.output
-        roll, pitch, yaw = out.attitude_setpoint.tolist()
-        messages = [(cmd_topic, cmd.pack(t_ns, out.rotor_speeds.tolist(),
-                                         [bool(s) for s in out.saturated])),
-                    (setpoint_topic, setpoint.pack(t_ns, roll, pitch, yaw, float(out.thrust)))]
-        ref = answer.reference
-        if ref is not None:
-            messages.append((ref_topic, self._reference.pack(
-                t_ns, *ref.position.tolist(), *ref.velocity.tolist(),
-                *ref.acceleration.tolist())))
-        if answer.formation_error is not None:
-            rows = len(answer.formation_error)
+        out, ref, error = answer.output, answer.reference, answer.formation_error
+        return self.answer_of(
+            answer.index, answer.t_ns, out.rotor_speeds.tolist(),
+            [bool(s) for s in out.saturated], out.attitude_setpoint.tolist(), float(out.thrust),
+            None if ref is None else [*ref.position.tolist(), *ref.velocity.tolist(),
+                                      *ref.acceleration.tolist()],
+            None if error is None else error.tolist(),
+            None if error is None else answer.formation_error_rate.tolist())
+
+    def answer_of(self, index: int, t_ns: int, speeds: Sequence[float],
+                  saturated: Sequence[bool], setpoint: Sequence[float], thrust: float,
+                  reference: Sequence[float] | None, errors: Sequence[float] | None,
+                  rates: Sequence[float] | None) -> list[Message]:
+        """`of` from plain numbers (the one packing of both): UAV `index`'s (from 0) rotor
+        speeds [rad/s] and saturation, attitude setpoint (roll, pitch, yaw) [rad] and thrust
+        [N], the leader's reference (position, velocity, acceleration: 9 numbers) or None, a
+        follower's formation errors and their rates or None."""
+        cmd_topic, cmd, setpoint_topic, setpoint_packer, ref_topic, error_topic = \
+            self._uavs[index]
+        messages = [(cmd_topic, cmd.pack(t_ns, speeds, saturated)),
+                    (setpoint_topic, setpoint_packer.pack(t_ns, *setpoint, thrust))]
+        if reference is not None:
+            messages.append((ref_topic, self._reference.pack(t_ns, *reference)))
+        if errors is not None:
+            rows = len(errors)
             packer = self._errors.get(rows)
             if packer is None:
                 packer = self._errors[rows] = cdr.virtual_constraint_error(rows)
-            messages.append((error_topic, packer.pack(t_ns, answer.formation_error.tolist(),
-                                                      answer.formation_error_rate.tolist())))
+            messages.append((error_topic, packer.pack(t_ns, errors, rates)))
         return messages

@@ -115,6 +115,10 @@ class Odometry:
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, *position,
                                  *orientation, *linear, *angular)
 
+    def pack_row(self, t_ns: int, row: Sequence[float]) -> bytes:
+        """From the 13 numbers of `pack`'s four tuples in a row."""
+        return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, *row)
+
 
 class _Stamped:
     """A header then `floats` float64 fields (Vector3Stamped, AttitudeSetpoint,
@@ -237,18 +241,26 @@ class FormationSnapshot:
         for values in (position, velocity, euler, body_rates):
             if len(values) != rows:
                 raise ValueError(f'{len(values)} values for {rows} (3 per UAV)')
-        entry = self._structs.get(len(previous))
-        if entry is None:
-            raise ValueError(f'{len(previous)} previous rotor speeds for rotor counts '
-                             f'{self._counts}')
         # one conversion to Python floats (unpacking numpy arrays element by element is slow)
-        flat = np.concatenate((position, velocity, euler, body_rates, payload_position,
-                               payload_velocity, previous)).tolist()
-        r = rows
-        return entry[1].pack(ENCAPSULATION, *stamp(t_ns), *self._frame, r, *flat[:r],
-                             r, *flat[r:2 * r], r, *flat[2 * r:3 * r], r, *flat[3 * r:4 * r],
-                             *flat[4 * r:4 * r + 6], len(self._counts), *self._counts,
-                             len(previous), *flat[4 * r + 6:])
+        return self.pack_row(t_ns, np.concatenate((position, velocity, euler, body_rates,
+                                                   payload_position, payload_velocity,
+                                                   previous)).tolist(), len(previous))
+
+    def pack_row(self, t_ns: int, row: Sequence[float], previous: int) -> bytes:
+        """`pack` of its numbers in one row (position, velocity, euler, body_rates, payload
+        position, payload velocity, then the `previous` rotor speeds)."""
+        entry = self._structs.get(previous)
+        if entry is None:
+            raise ValueError(f'{previous} previous rotor speeds for rotor counts '
+                             f'{self._counts}')
+        r = rows = self._rows
+        if len(row) != 4 * rows + 6 + previous:
+            raise ValueError(f'{len(row)} values for {rows} per field (3 per UAV), 6 of the '
+                             f'payload and {previous} rotor speeds')
+        return entry[1].pack(ENCAPSULATION, *stamp(t_ns), *self._frame, r, *row[:r],
+                             r, *row[r:2 * r], r, *row[2 * r:3 * r], r, *row[3 * r:4 * r],
+                             *row[4 * r:4 * r + 6], len(self._counts), *self._counts,
+                             previous, *row[4 * r + 6:])
 
     def unpack(self, data: bytes) -> tuple[int, np.ndarray, np.ndarray, np.ndarray,
                                            np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

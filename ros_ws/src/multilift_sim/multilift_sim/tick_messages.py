@@ -9,13 +9,14 @@ World frame, SI units.
 """
 from __future__ import annotations
 
+import math
 from typing import Sequence
 
 import numpy as np
 
 from multilift_sim import cdr
 from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, formation_snapshot, odometry,
-                                     quaternion, uav_frame, vec3)
+                                     uav_frame, vec3)
 from multilift_sim.scenario import Scenario
 from multilift_sim.scene import FormationScene
 from multilift_sim.simulation import Snapshot
@@ -23,6 +24,7 @@ from multilift_sim.topics import (CLOCK, FORMATION_SNAPSHOT, FORMATION_STATE, MA
                                   PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
+_ZERO = (0.0, 0.0, 0.0)
 
 
 class SimulatorMessages:
@@ -48,31 +50,103 @@ class SimulatorMessages:
         up to this tick, None at t = 0; none at the run's `last` tick, which no controller
         answers), then for users, tools and bags every /uav{i}/odom, /payload/odom,
         /payload/gust (`gust`: the air velocity at the payload [m/s]) and /tf."""
-        t_ns = snap.t_ns
+        snapshot = None if last else formation_snapshot(snap, applied)
+        uavs = [[*vec3(position), *orientation, *linear, *angular]
+                for position, orientation, linear, angular in (
+                    odometry(u.position, u.velocity, u.euler, u.rotation, u.body_rates)
+                    for u in snap.uavs)]
+        return self.state_of(
+            snap.t_ns, None if snapshot is None else np.concatenate(snapshot).tolist(),
+            None if snapshot is None else len(snapshot[-1]), uavs,
+            snap.payload_position.tolist(), snap.payload_velocity.tolist(), vec3(gust))
+
+    def state_of(self, t_ns: int, snapshot: list[float] | None, previous: int | None,
+                 uavs: Sequence[Sequence[float]], payload_position: Sequence[float],
+                 payload_velocity: Sequence[float], gust: Sequence[float]) -> list[Message]:
+        """`state` from plain numbers (the one packing of both): `snapshot` the
+        FormationSnapshot's numbers in a row (`cdr.FormationSnapshot.pack_row`; None at the
+        last tick) with `previous` rotor speeds at its end, per UAV its odometry's 13 numbers
+        (position, orientation (x, y, z, w), body-frame velocity, body rates: msgvalues
+        .odometry), the payload's position and velocity and the gust, world [m, m/s]."""
         out = [(CLOCK, self._clock.pack(t_ns))]
-        if not last:
-            out.append((FORMATION_SNAPSHOT,
-                        self._snapshot.pack(t_ns, *formation_snapshot(snap, applied))))
-        for uav, (topic, packer) in zip(snap.uavs, self._odometry):
-            out.append((topic, packer.pack(t_ns, *odometry(uav.position, uav.velocity,
-                                                           uav.euler, uav.rotation,
-                                                           uav.body_rates))))
-        out.append((PAYLOAD_ODOM, self._payload.pack(
-            t_ns, *odometry(snap.payload_position, snap.payload_velocity, None, None, None))))
-        out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *vec3(gust))))
-        out.append((TF, self._tf.pack(
-            t_ns, [vec3(u.position) for u in snap.uavs] + [vec3(snap.payload_position)],
-            [quaternion(u.euler) for u in snap.uavs] + [IDENTITY])))
+        if snapshot is not None:
+            out.append((FORMATION_SNAPSHOT, self._snapshot.pack_row(t_ns, snapshot, previous)))
+        for uav, (topic, packer) in zip(uavs, self._odometry):
+            out.append((topic, packer.pack_row(t_ns, uav)))
+        out.append((PAYLOAD_ODOM, self._payload.pack(t_ns, payload_position, IDENTITY,
+                                                     payload_velocity, _ZERO)))
+        out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *gust)))
+        out.append((TF, self._tf.pack(t_ns, [u[:3] for u in uavs] + [payload_position],
+                                      [u[3:7] for u in uavs] + [IDENTITY])))
         return out
 
     def formation(self, t_ns: int, tension: np.ndarray, g: np.ndarray, g_dot: np.ndarray,
                   taut: np.ndarray) -> Message:
         """/formation/state: per cable the tension [N], g [m^2], g_dot [m^2/s], taut."""
-        return FORMATION_STATE, self._state.pack(t_ns, tension.tolist(), g.tolist(),
-                                                 g_dot.tolist(), taut.tolist())
+        return self.formation_of(t_ns, tension.tolist(), g.tolist(), g_dot.tolist(),
+                                 taut.tolist())
+
+    def formation_of(self, t_ns: int, tension: Sequence[float], g: Sequence[float],
+                     g_dot: Sequence[float], taut: Sequence[bool]) -> Message:
+        """`formation` from plain numbers."""
+        return FORMATION_STATE, self._state.pack(t_ns, tension, g, g_dot, taut)
 
     def markers(self, snap: Snapshot, tension: np.ndarray, taut: np.ndarray) -> Message:
         """/visualization/markers: the formation of `snap` drawn (cables by tension)."""
-        self._scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
-                           snap.payload_position, tension, taut)
-        return MARKERS, self._markers.pack(snap.t_ns)
+        return self.markers_of(snap.t_ns, [u.position for u in snap.uavs],
+                               [u.euler for u in snap.uavs], snap.payload_position, tension,
+                               taut)
+
+    def markers_of(self, t_ns: int, positions: Sequence[Sequence[float]],
+                   euler: Sequence[Sequence[float]], payload_position: Sequence[float],
+                   tension: Sequence[float], taut: Sequence[bool]) -> Message:
+        """`markers` from plain numbers: every UAV's position [m] and ZYX Euler angles [rad],
+        the payload's position [m], the cables' tension [N] and which are taut."""
+        self._scene.update(positions, euler, payload_position, tension, taut)
+        return MARKERS, self._markers.pack(t_ns)
+
+
+def state_rows(states: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The numbers `SimulatorMessages.state_of` takes, for K formation states (K, 2 (6n + 3))
+    of n UAVs at once: (the FormationSnapshot rows (K, 12 n + 6) without the rotor speeds,
+    every UAV's odometry row (K, n, 13)). The same bits as `FormationSimulator.snapshot` and
+    `msgvalues.odometry` give tick by tick (tests/unit/test_headless_bag.py): the same
+    operations in the same order, element by element, the sines and cosines Python's (numpy's
+    own may differ in the last bit), R^T v by the same matrix product."""
+    k, nq = states.shape[0], 6 * n + 3
+    q = states[:, :6 * n].reshape(k, n, 6)
+    q_dot = states[:, nq:nq + 6 * n].reshape(k, n, 6)
+    position, euler, velocity = q[..., :3], q[..., 3:], np.ascontiguousarray(q_dot[..., :3])
+    angles = euler.ravel().tolist()
+    sin = np.array(list(map(math.sin, angles))).reshape(k, n, 3)
+    cos = np.array(list(map(math.cos, angles))).reshape(k, n, 3)
+    s_phi, s_th, s_psi = sin[..., 0], sin[..., 1], sin[..., 2]
+    c_phi, c_th, c_psi = cos[..., 0], cos[..., 1], cos[..., 2]
+    # R = Rz(psi) Ry(theta) Rx(phi), body -> world, as FormationSimulator.snapshot
+    rotation = np.empty((k, n, 3, 3))
+    rotation[..., 0, 0] = c_psi * c_th
+    rotation[..., 0, 1] = c_psi * s_th * s_phi - s_psi * c_phi
+    rotation[..., 0, 2] = c_psi * s_th * c_phi + s_psi * s_phi
+    rotation[..., 1, 0] = s_psi * c_th
+    rotation[..., 1, 1] = s_psi * s_th * s_phi + c_psi * c_phi
+    rotation[..., 1, 2] = s_psi * s_th * c_phi - c_psi * s_phi
+    rotation[..., 2, 0] = -s_th
+    rotation[..., 2, 1] = c_th * s_phi
+    rotation[..., 2, 2] = c_th * c_phi
+    phi_dot, theta_dot, psi_dot = q_dot[..., 3], q_dot[..., 4], q_dot[..., 5]
+    rates = np.stack((phi_dot - s_th * psi_dot,  # omega = W(eta) eta_dot, seed Eq. 2.7
+                      c_phi * theta_dot + s_phi * c_th * psi_dot,
+                      -s_phi * theta_dot + c_phi * c_th * psi_dot), axis=-1)
+    linear = np.matmul(rotation.swapaxes(-1, -2), velocity[..., None])[..., 0]  # world -> body
+    # msgvalues.quaternion of the Euler angles
+    halves = (0.5 * euler).ravel().tolist()
+    sin = np.array(list(map(math.sin, halves))).reshape(k, n, 3)
+    cos = np.array(list(map(math.cos, halves))).reshape(k, n, 3)
+    sr, sp, sy = sin[..., 0], sin[..., 1], sin[..., 2]
+    cr, cp, cy = cos[..., 0], cos[..., 1], cos[..., 2]
+    orientation = np.stack((sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+                            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy), axis=-1)
+    snapshot = np.concatenate((position.reshape(k, 3 * n), velocity.reshape(k, 3 * n),
+                               euler.reshape(k, 3 * n), rates.reshape(k, 3 * n),
+                               states[:, 6 * n:nq], states[:, nq + 6 * n:]), axis=1)
+    return snapshot, np.concatenate((position, orientation, linear, rates), axis=2)

@@ -4,36 +4,156 @@ publish (multilift_sim.tick_messages for the simulator's, multilift_control.answ
 for the controllers'), CDR packed straight from the tick's numbers with the padding zeroed, so
 two runs of a scenario write byte-identical bags.
 
-The tick's work is done once: `/formation/state` and the markers of tick t need the cable
-tension at t under the answers to t, which is what integrating from t computes
-(`Integration.cable_tension`), and g, g_dot at t, which the previous integration (or the
-simulator's start check) computed. So they are written when the next tick arrives (they are
-the last records of tick t, so the order of the bag is unchanged); the last tick, and a tick
-whose integration stopped the run, solve once more.
+`record_headless` flies the run through the engine (`multilift_control.engine`), CHUNK_TICKS
+ticks per compiled call into a `TickRecord`, and packs each tick's messages from the record's
+rows (`EngineBag`): the state at t and every answer to it, then `/formation/state` (the
+tension of the integration that starts at t, g and g_dot at t) and every MARKER_DECIMATION-th
+tick the markers. The state at t_max has no answers; its `/formation/state` is solved under the
+commands held since the tick before, as the simulator node does. A scenario the engine does not
+fly (another integrator, UAVs of different rotor counts) goes tick by tick through the objects
+the nodes use (`HeadlessBag` on `run_headless`), which writes the same bag.
 """
 from __future__ import annotations
 
+import time
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
+
 from multilift_control.answer_messages import AnswerMessages
-from multilift_control.headless import HeadlessRun, run_headless
+from multilift_control.engine import Engine
+from multilift_control.engine.arrays import MODE_CASCADE, TickRecord
+from multilift_control.headless import FlownRun, HeadlessRun, run_headless
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
+from multilift_sim.formulations import make_formulation
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import FormationSimulator, Snapshot, TickCables
-from multilift_sim.tick_messages import SimulatorMessages
+from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
+                                      TickCables)
+from multilift_sim.tick_messages import SimulatorMessages, state_rows
 from multilift_sim.topics import MARKER_DECIMATION, run_topics
 
+# ticks per compiled call (and between two progress reports): 2.5 s of a 100 Hz mission
+CHUNK_TICKS = 250
 
+# progress(t, t_max) [s], as multilift_control.headless.fly takes it
+Progress = Callable[[float, float], None]
+
+
+def _add_topics(scenario: Scenario, writer: BagWriter) -> None:
+    qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
+    for topic, kind in run_topics(scenario.n_uavs):
+        writer.add_topic(topic, kind, qos)
+
+
+class EngineBag:
+    """Writes one engine-flown run's messages to a BagWriter from its TickRecords (see the
+    module docstring): the same messages, in the same order and the same `write_many` groups
+    (a chunk of the MCAP is finished after a group) as `HeadlessBag`."""
+
+    def __init__(self, scenario: Scenario, engine: Engine, writer: BagWriter) -> None:
+        _add_topics(scenario, writer)
+        self._scenario, self._engine, self._write = scenario, engine, writer.write_many
+        self._simulator = SimulatorMessages(scenario)
+        self._answers = AnswerMessages(scenario)
+        self._n = scenario.n_uavs
+        arrays = engine.arrays
+        self._period_ns = int(arrays.period_ns[0])
+        self._own_rows = arrays.own_rows[0].tolist()
+        self._reference = int(arrays.leader_mode[0]) == MODE_CASCADE
+        self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
+
+    def ticks(self, first: int, record: TickRecord, count: int) -> None:
+        """Write ticks first .. first + count - 1 of formation 0 from `record`'s rows."""
+        if count <= 0:
+            return
+        n, period, rows = self._n, self._period_ns, self._own_rows
+        states = record.states[:count, 0]
+        snapshots, odometry = state_rows(states, n)
+        speeds = record.speeds[:count, 0]
+        flat = speeds.reshape(count, -1)
+        if self._held is None:  # from t = 0: no rotor speeds held yet
+            snapshots = [snapshots[0].tolist()] + np.concatenate(
+                (snapshots[1:], flat[:-1]), axis=1).tolist()
+        else:
+            snapshots = np.concatenate(
+                (snapshots, np.concatenate((self._held[None], flat[:-1]))), axis=1).tolist()
+        self._held = flat[-1].copy()
+        previous_count = flat.shape[1]
+        odometry = odometry.tolist()
+        euler = states[:, :6 * n].reshape(count, n, 6)[..., 3:].tolist()
+        payload_position = states[:, 6 * n:6 * n + 3].tolist()
+        payload_velocity = states[:, 12 * n + 3:12 * n + 6].tolist()
+        gusts = record.gust[:count, 0].tolist()
+        speed_lists, saturated = speeds.tolist(), record.saturated[:count, 0].tolist()
+        setpoints, thrusts = record.setpoints[:count, 0].tolist(), record.thrust[:count, 0].tolist()
+        references = record.reference[:count, 0].tolist()
+        errors = [record.errors[:count, 0, i, :rows[i]].tolist() for i in range(n)]
+        rates = [record.rates[:count, 0, i, :rows[i]].tolist() for i in range(n)]
+        tension, g = record.tension[:count, 0].tolist(), record.g[:count, 0].tolist()
+        g_dot, taut = record.g_dot[:count, 0].tolist(), record.taut[:count, 0].tolist()
+        simulator, answer_of, write = self._simulator, self._answers.answer_of, self._write
+        for k in range(count):
+            tick = first + k
+            t_ns = tick * period
+            messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
+                                          odometry[k], payload_position[k],
+                                          payload_velocity[k], gusts[k])
+            for i in range(n):
+                messages += answer_of(i, t_ns, speed_lists[k][i], saturated[k][i],
+                                      setpoints[k][i], thrusts[k][i],
+                                      references[k] if i == 0 and self._reference else None,
+                                      errors[i][k] if i else None, rates[i][k] if i else None)
+            write(messages, t_ns)
+            self._formation(tick, t_ns, tension[k], g[k], g_dot[k], taut[k], odometry[k],
+                            euler[k], payload_position[k])
+
+    def last(self) -> None:
+        """Write the state at t_max (the engine's current state, which nothing answers) and
+        its `/formation/state` under the commands held since the tick before (solved here)."""
+        engine, n = self._engine, self._n
+        memory, tick = engine.memory, int(engine.memory.tick[0])
+        t_ns = tick * self._period_ns
+        state = memory.state[0]
+        _, odometry = state_rows(state[None], n)
+        odometry = odometry[0].tolist()
+        payload_position = state[6 * n:6 * n + 3].tolist()
+        self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
+                                             state[12 * n + 3:12 * n + 6].tolist(),
+                                             memory.gust[0].tolist()), t_ns)
+        scenario = self._scenario
+        model = make_formulation(scenario.simulation.integrator, scenario.formation_params(),
+                                 scenario.cable_model)
+        if scenario.cable_model == 'slack':
+            model.taut = memory.taut[0]
+        held = list(self._held.reshape(n, -1)) if self._held is not None else None
+        tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
+        self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
+                        memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
+                        state[:6 * n].reshape(n, 6)[:, 3:].tolist(), payload_position)
+
+    def _formation(self, tick: int, t_ns: int, tension: list, g: list, g_dot: list,
+                   taut: list, odometry: list, euler: list, payload_position: list) -> None:
+        """`/formation/state` of a tick and, every MARKER_DECIMATION-th, its markers."""
+        messages = [self._simulator.formation_of(t_ns, tension, g, g_dot, taut)]
+        if tick % MARKER_DECIMATION == 0:
+            messages.append(self._simulator.markers_of(
+                t_ns, [u[:3] for u in odometry], euler, payload_position, tension, taut))
+        self._write(messages, t_ns)
 class HeadlessBag:
-    """Writes one run's messages to a BagWriter, tick by tick (see the module docstring)."""
+    """Writes one run's messages to a BagWriter, tick by tick, as a `run_headless` observer.
+
+    The tick's work is done once: `/formation/state` and the markers of tick t need the cable
+    tension at t under the answers to t, which is what integrating from t computes
+    (`Integration.cable_tension`), and g, g_dot at t, which the previous integration (or the
+    simulator's start check) computed. So they are written when the next tick arrives (they
+    are the last records of tick t, so the order of the bag is unchanged); the last tick, and a
+    tick whose integration stopped the run, solve once more."""
 
     def __init__(self, scenario: Scenario, writer: BagWriter) -> None:
-        qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
-        for topic, kind in run_topics(scenario.n_uavs):
-            writer.add_topic(topic, kind, qos)
+        _add_topics(scenario, writer)
         self._write = writer.write_many  # a tick's messages, all stamped with its time
         self._simulator = SimulatorMessages(scenario)
         self._answers = AnswerMessages(scenario)
@@ -68,12 +188,55 @@ class HeadlessBag:
         self._write(messages, snap.t_ns)
 
 
-def record_headless(scenario: Scenario, bag_dir: Path,
-                    on_tick: Callable[[FormationSimulator], None] | None = None,
-                    raise_on_stop: bool = True) -> HeadlessRun:
+def engine_flies(scenario: Scenario) -> bool:
+    """Whether the engine flies `scenario` as FormationSimulator does: the seed's DAE
+    (`simulation.integrator: baumgarte`) and one rotor count for every UAV."""
+    return (scenario.simulation.integrator == 'baumgarte'
+            and len({u.vehicle.n_rotors for u in scenario.uavs}) == 1)
+
+
+def record_headless(scenario: Scenario, bag_dir: Path, progress: Progress | None = None,
+                    raise_on_stop: bool = True) -> FlownRun | HeadlessRun:
     """Fly `scenario` without ROS and write every topic of a ROS run to `bag_dir`: the
-    simulator's state and every controller's answer as the nodes publish them.
-    `raise_on_stop` as for `run_headless`."""
+    simulator's state and every controller's answer as the nodes publish them;
+    `progress(t, t_max)` [s] every CHUNK_TICKS ticks. A simulation that stops itself raises
+    SimulationStopped once its ticks are written, or with raise_on_stop=False ends the run with
+    `error` set (as `multilift_control.headless.fly`)."""
+    if not engine_flies(scenario):
+        return _record_per_object(scenario, bag_dir, progress, raise_on_stop)
+    start = time.monotonic()
+    engine = Engine(scenario)
+    run = FlownRun(scenario, engine)
+    writer = BagWriter(bag_dir)
+    try:
+        if engine.stopped[0]:  # at the start: as FormationSimulator's, whatever raise_on_stop
+            raise SimulationStopped(run.error)
+        bag = EngineBag(scenario, engine, writer)
+        record = engine.new_record(CHUNK_TICKS)
+        t_max = float(engine.arrays.tick_count[0] * engine.arrays.period_ns[0] * 1e-9)
+        while engine.running[0]:
+            first = int(engine.memory.tick[0])
+            flown = int(engine.step(CHUNK_TICKS, record)[0])
+            bag.ticks(first, record, flown)
+            if progress is not None:
+                progress(float(engine.t[0]), t_max)
+        if engine.finished[0]:
+            bag.last()
+    finally:
+        try:
+            writer.close()
+        finally:
+            run.wall_time = time.monotonic() - start
+    if raise_on_stop and engine.stopped[0]:
+        raise SimulationStopped(run.error)
+    return run
+
+
+def _record_per_object(scenario: Scenario, bag_dir: Path, progress: Progress | None = None,
+                       raise_on_stop: bool = True) -> HeadlessRun:
+    """`record_headless` tick by tick through the objects the nodes use (`run_headless`
+    observed by `HeadlessBag`): for what the engine does not fly, and the reference the
+    engine's bag is tested against."""
     writer = BagWriter(bag_dir)
     bag = HeadlessBag(scenario, writer)
     simulator: list[FormationSimulator] = []
@@ -82,8 +245,8 @@ def record_headless(scenario: Scenario, bag_dir: Path,
         if not simulator:
             simulator.append(sim)
         bag.tick(sim, snap, answers)
-        if on_tick is not None:
-            on_tick(sim)
+        if progress is not None and sim.tick % CHUNK_TICKS == 0:
+            progress(sim.t, sim.tick_count * sim.period_ns * 1e-9)
 
     try:
         return run_headless(scenario, tick, raise_on_stop)

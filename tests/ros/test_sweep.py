@@ -526,7 +526,10 @@ SAMPLED = ['single_lift_swing', '--sample', 'payload.mass=uniform(0.3, 0.6)', '-
 
 def test_a_worker_host_killed_mid_campaign_loses_and_doubles_no_row(cluster, tmp_path):
     out = tmp_path / 'killed.parquet'
-    proc = subprocess.Popen([PYTHON, '-m', 'multilift_tools.cli', 'sweep', *SAMPLED,
+    # runs long enough that a task (a chunk of runs flown as one engine batch: tenths of a
+    # second) is still on host_a when it is killed
+    longer = [*SAMPLED[:-1], '60']
+    proc = subprocess.Popen([PYTHON, '-m', 'multilift_tools.cli', 'sweep', *longer,
                              '--scheduler', cluster.address, '--out', str(out)],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     try:
@@ -551,7 +554,7 @@ def test_a_worker_host_killed_mid_campaign_loses_and_doubles_no_row(cluster, tmp
     assert [(r['seed'], r['payload.mass']) for r in rows] == \
         [(run.seed, run.params['payload.mass']) for run in expected.runs]
     assert all(r['status'] == 'ok' for r in rows), [r['message'] for r in rows]
-    assert all(r['simulated_time'] == pytest.approx(1.5) for r in rows)
+    assert all(r['simulated_time'] == pytest.approx(60.0) for r in rows)
     # the scheduler lets the killed host go and keeps the other (a nanny may be restarting
     # its worker at this moment: wait for the settled state, with the logs if it never comes)
     deadline = time.monotonic() + 60

@@ -1,8 +1,14 @@
 """The whole formation without ROS: the simulator core and every controller in one process.
 
-Same physics, same controller runtime, same tick order as the ROS stack (state at t ->
-answers to t -> integrate to the next tick), for studies, sweeps and benchmarks. Loads no
-rclpy.
+Same physics, same control laws, same tick order as the ROS stack (state at t -> answers to t
+-> integrate to the next tick), for studies, sweeps and benchmarks. Loads no rclpy.
+
+- `fly`: through the engine (`multilift_control.engine`), many ticks per compiled call when
+  nothing outside needs each one: `run --headless` without a bag, `sweep`'s rows;
+- `run_headless`: tick by tick through the objects the ROS nodes use (FormationSimulator and
+  the controller runtimes), for an observer of every tick (`on_tick`: the headless bag, the
+  reproduction's recordings). Both give the same states and figures to the bit
+  (tests/unit/test_engine.py).
 """
 from __future__ import annotations
 
@@ -13,6 +19,8 @@ from typing import Callable
 import numpy as np
 
 from multilift_control.cascade import balancing_rotor_speed
+from multilift_control.engine import Engine
+from multilift_control.engine.arrays import engine_flies
 from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answer_tick,
                                        formation_runtimes, uav_states)
 from multilift_sim.scenario import Scenario
@@ -67,6 +75,73 @@ def run_headless(scenario: Scenario, on_tick: TickObserver | None = None,
     finally:
         run.wall_time = time.monotonic() - start
     return run
+
+
+@dataclass
+class FlownRun:
+    """A run flown by the engine (`fly`, `fly_batch`: formation `index` of `engine`); its
+    summary is HeadlessRun's."""
+    scenario: Scenario
+    engine: Engine
+    index: int = 0
+    wall_time: float = 0.0          # [s]
+
+    @property
+    def error(self) -> str | None:
+        """Why the simulation stopped itself, or None."""
+        return self.engine.stop_reason(self.index)
+
+    def summary(self) -> dict:
+        return self.engine.summary(self.index, self.wall_time)
+
+
+# ticks per compiled call between two progress reports (half a second of a 100 Hz mission)
+PROGRESS_TICKS = 50
+
+
+def _ticker(progress: Callable[[float, float], None]) -> TickObserver:
+    """An on_tick calling `progress(t, t_max)` every PROGRESS_TICKS ticks."""
+    def on_tick(sim: FormationSimulator, *_) -> None:
+        if sim.tick % PROGRESS_TICKS == 0:
+            progress(sim.t, sim.tick_count * sim.period_ns * 1e-9)
+    return on_tick
+
+
+def fly(scenario: Scenario, progress: Callable[[float, float], None] | None = None,
+        raise_on_stop: bool = True) -> FlownRun | HeadlessRun:
+    """Fly `scenario` to t_max through the engine: the whole mission in one compiled call, or
+    PROGRESS_TICKS at a time with `progress(t, t_max)` [s] after each (what the engine does not
+    fly, `engine.arrays.not_flown`, goes tick by tick: `run_headless`). A simulation that stops
+    itself raises SimulationStopped (its message the simulator's), or with raise_on_stop=False
+    ends the run with `error` set."""
+    if not engine_flies(scenario):  # tick by tick: the same tick, another integrator
+        return run_headless(scenario, None if progress is None else _ticker(progress),
+                            raise_on_stop)
+    start = time.monotonic()
+    engine = Engine(scenario)
+    run = FlownRun(scenario, engine)
+    t_max = float(engine.arrays.tick_count[0] * engine.arrays.period_ns[0] * 1e-9)
+    try:
+        while engine.running[0]:
+            engine.step(PROGRESS_TICKS if progress is not None else int(engine.arrays.tick_count[0]))
+            if progress is not None:
+                progress(float(engine.t[0]), t_max)
+    finally:
+        run.wall_time = time.monotonic() - start
+    if raise_on_stop and engine.stopped[0]:
+        raise SimulationStopped(run.error)
+    return run
+
+
+def fly_batch(scenarios: list[Scenario]) -> list[FlownRun]:
+    """Fly scenarios of one shape (`engine.arrays.shape_groups`) to their t_max together, one
+    engine batch, each to the numbers it gets alone (tests/unit/test_engine.py); a run Algorithm
+    1 stops has `error` set. Each run's wall time is its share of the batch's."""
+    start = time.monotonic()
+    engine = Engine(scenarios)
+    engine.step(int(engine.arrays.tick_count.max()))
+    share = (time.monotonic() - start) / len(scenarios)
+    return [FlownRun(s, engine, b, share) for b, s in enumerate(scenarios)]
 
 
 def hover_speeds(scenario: Scenario) -> list[np.ndarray]:

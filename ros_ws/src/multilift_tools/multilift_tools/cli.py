@@ -302,26 +302,24 @@ def _bag_state(bag: Path, recorder: Child) -> str:
 def _run_headless(scenario, bag: Path | None) -> int:
     """The same scenario, physics and control laws in this process, no ROS graph."""
     # no rclpy and no message types here unless a bag is written (tests/unit/test_architecture.py)
-    from multilift_control.headless import run_headless
+    from multilift_control.headless import fly
     from multilift_sim.simulation import SimulationStopped
     progress = Progress(None, sys.stdout.isatty())
     start = time.monotonic()
 
-    def on_tick(sim, *_) -> None:
-        if sim.tick % 50 == 0:
-            progress.show(sim.t, sim.tick_count * sim.period_ns * 1e-9,
-                          time.monotonic() - start)
+    def on_progress(t: float, t_max: float) -> None:
+        progress.show(t, t_max, time.monotonic() - start)
 
     print(f'multilift run {scenario.name} --headless: {scenario.n_uavs} UAV(s), '
           f'{scenario.simulation.duration:g} s', flush=True)
     if bag is not None:
         _fresh_bag_dir(bag)
     try:
-        if bag is None:
-            run = run_headless(scenario, on_tick)
+        if bag is None:  # the engine: many ticks per compiled call
+            run = fly(scenario, on_progress)
         else:
             from multilift_tools.headless_bag import record_headless
-            run = record_headless(scenario, bag, on_tick)
+            run = record_headless(scenario, bag, on_progress)
     except SimulationStopped as exc:
         progress.close()
         print(f'error: {exc}', file=sys.stderr)

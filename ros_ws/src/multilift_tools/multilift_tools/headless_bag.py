@@ -23,7 +23,7 @@ import numpy as np
 
 from multilift_control.answer_messages import AnswerMessages
 from multilift_control.engine import Engine
-from multilift_control.engine.arrays import MODE_CASCADE, TickRecord
+from multilift_control.engine.arrays import MODE_CASCADE, TickRecord, engine_flies
 from multilift_control.headless import FlownRun, HeadlessRun, run_headless
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
@@ -186,13 +186,6 @@ class HeadlessBag:
         if held.tick % MARKER_DECIMATION == 0:
             messages.append(self._simulator.markers(snap, tension, held.taut))
         self._write(messages, snap.t_ns)
-
-
-def engine_flies(scenario: Scenario) -> bool:
-    """Whether the engine flies `scenario` as FormationSimulator does: the seed's DAE
-    (`simulation.integrator: baumgarte`) and one rotor count for every UAV."""
-    return (scenario.simulation.integrator == 'baumgarte'
-            and len({u.vehicle.n_rotors for u in scenario.uavs}) == 1)
 
 
 def record_headless(scenario: Scenario, bag_dir: Path, progress: Progress | None = None,

@@ -140,9 +140,19 @@ class Progress:
             self.bar.close()
 
 
+CHUNK_MAX = 64  # runs per task at most
+
+
+def chunk_size(runs: int, workers: int) -> int:
+    """Runs per task: about four tasks per worker (the last ones balance the load), at most
+    CHUNK_MAX runs (one engine batch each: multilift_control.engine)."""
+    return max(1, min(CHUNK_MAX, math.ceil(runs / (4 * max(workers, 1)))))
+
+
 def run_campaign(client, campaign: cp.Campaign, duration: float | None, bags: Path | None,
                  progress: Progress, rows: dict[int, dict]) -> None:
-    """Submit every run to `client` and put each row in `rows` (index -> row) as its run
+    """Submit the runs to `client` in chunks (`chunk_size`; `campaign.run_chunk` flies a
+    chunk's runs as engine batches) and put each row in `rows` (index -> row) as its chunk
     finishes (a KeyboardInterrupt leaves the finished ones there)."""
     from concurrent.futures import CancelledError
 
@@ -153,31 +163,37 @@ def run_campaign(client, campaign: cp.Campaign, duration: float | None, bags: Pa
     specs = {}
     futures = []
     tag = f'{os.getpid()}-{time.time_ns()}'
-    for run in campaign.runs:
-        bag = str(bags / f'run_{run.index:05d}') if bags is not None else None
-        future = client.submit(cp.run_one, campaign.source, campaign.base,
-                               campaign.edits(run), duration, bag,
-                               key=f'multilift-run-{tag}-{run.index}', pure=False)
-        specs[future.key] = run
+    runs = list(campaign.runs)
+    size = chunk_size(len(runs), len(client.scheduler_info().get('workers', {})))
+    for first in range(0, len(runs), size):
+        chunk = runs[first:first + size]
+        work = [(campaign.edits(run),
+                 str(bags / f'run_{run.index:05d}') if bags is not None else None)
+                for run in chunk]
+        future = client.submit(cp.run_chunk, campaign.source, campaign.base, work, duration,
+                               key=f'multilift-runs-{tag}-{chunk[0].index}', pure=False)
+        specs[future.key] = chunk
         futures.append(future)
     pending = as_completed(futures)
-    progress.note(f'[sweep] {len(futures)} run(s) submitted')
+    progress.note(f'[sweep] {len(runs)} run(s) submitted in {len(futures)} task(s)')
     progress.start = time.monotonic()   # the ETA counts from here, not the cluster's start
     del futures  # as_completed holds the only reference: a read result is released below
     for future in pending:
-        run = specs.pop(future.key)
+        chunk = specs.pop(future.key)
         try:
-            result = future.result()
-        except CancelledError as exc:   # not the run's fault: no row, stop the campaign
-            raise ClusterLost(f'run {run.index} was cancelled: {exc}') from None
+            results = future.result()
+        except CancelledError as exc:   # not the runs' fault: no row, stop the campaign
+            raise ClusterLost(f'runs {chunk[0].index}..{chunk[-1].index} were cancelled: '
+                              f'{exc}') from None
         except Exception as exc:  # noqa: BLE001 - KilledWorker, a result that cannot unpickle
-            result = {'status': 'error', 'message': cp.error_message(exc),
-                      **dict.fromkeys(cp.STATISTICS), 'wall_time': None,
-                      'bag': None}
+            results = [{'status': 'error', 'message': cp.error_message(exc),
+                        **dict.fromkeys(cp.STATISTICS), 'wall_time': None, 'bag': None}
+                       for _ in chunk]
         future.release()
-        if run.index not in rows:
-            rows[run.index] = cp.make_row(run, result)
-            progress.update(result['status'])
+        for run, result in zip(chunk, results):
+            if run.index not in rows:
+                rows[run.index] = cp.make_row(run, result)
+                progress.update(result['status'])
 
 
 def _probe(scheduler: str) -> None:

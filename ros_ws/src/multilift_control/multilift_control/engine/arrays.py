@@ -116,15 +116,31 @@ class TickRecord(NamedTuple):
     gust: np.ndarray              # (ticks, B, 3): the air velocity at the payload [m/s], world
 
 
+def not_flown(scenario: Scenario) -> str | None:
+    """Why the engine does not fly `scenario` as FormationSimulator does, or None: it flies the
+    seed's DAE (`simulation.integrator: baumgarte`, rigid or slack cables) with one rotor
+    count for every UAV (the others go tick by tick: `headless.run_headless`)."""
+    if scenario.simulation.integrator != 'baumgarte':
+        return f'simulation.integrator is {scenario.simulation.integrator!r}, not baumgarte'
+    rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
+    if len(rotor_counts) != 1:
+        return f'UAVs of {len(rotor_counts)} rotor counts {sorted(rotor_counts)}'
+    return None
+
+
+def engine_flies(scenario: Scenario) -> bool:
+    """Whether the engine flies `scenario` (`not_flown`)."""
+    return not_flown(scenario) is None
+
+
 def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
     """One formation's (FormationArrays fields, FormationMemory fields), without the batch
     axis."""
     n = scenario.n_uavs
     sim = scenario.simulation
-    rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
-    if len(rotor_counts) != 1:
-        raise ValueError(f'{scenario.name}: the engine needs one rotor count for every UAV, '
-                         f'got {sorted(rotor_counts)}')
+    why = not_flown(scenario)
+    if why is not None:
+        raise ValueError(f'{scenario.name}: the engine does not fly it: {why}')
     params = scenario.formation_params()
     uavs, gusts, formation = constant_arrays(params)
     # the leader's cascade and path (a constant-speed leader: the ones it would fly, unused)
@@ -200,7 +216,11 @@ def shape_groups(scenarios: Sequence[Scenario]) -> list[list[int]]:
     shapes of every array, control and physics rates), in order of first appearance."""
     groups: dict[tuple, list[int]] = {}
     for index, scenario in enumerate(scenarios):
-        groups.setdefault(_shape_key(_formation_fields(scenario)), []).append(index)
+        try:
+            key = _shape_key(_formation_fields(scenario))
+        except Exception:  # noqa: BLE001 - a batch of its own, whose flight says what failed
+            key = ('alone', index)
+        groups.setdefault(key, []).append(index)
     return list(groups.values())
 
 

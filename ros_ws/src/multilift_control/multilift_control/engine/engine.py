@@ -125,16 +125,18 @@ class Engine:
         return None
 
     # ----------------------------------------------------------------------------- figures
-    def summary(self, b: int = 0) -> dict:
+    def summary(self, b: int = 0, wall_time: float | None = None) -> dict:
         """Formation b's run statistics as a run reports them ({'sim': ..., 'leader': ...,
-        'follower2': ...}: `multilift_control.headless.HeadlessRun.summary`'s keys and
-        definitions, `multilift_sim.statistics`), without the wall time."""
+        'follower2': ...}: `multilift_control.headless.HeadlessRun.summary`'s keys, order and
+        definitions, `multilift_sim.statistics`); the wall time [s] given or left out."""
         run = RunStatistics(self.n_uavs)
         run.run[:] = self.memory.run[b]
         leader = TrackingStatistics()
         leader.acc[:] = self.memory.tracking[b]
-        out = {'sim': dict(run.as_dict(), error=self.stop_reason(b),
-                           scenario=self.scenarios[b].name),
+        sim = run.as_dict()
+        if wall_time is not None:
+            sim['wall_time'] = wall_time
+        out = {'sim': dict(sim, error=self.stop_reason(b), scenario=self.scenarios[b].name),
                'leader': leader.as_dict()}
         for i in range(1, self.n_uavs):
             follower = FormationErrorStatistics()

@@ -187,9 +187,12 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
             check(follower.lift_vectors, states, rng.uniform(0, 60, size=len(r)))
             args = (f.constants, f.masses, rows, targets, f.law_p, f.law_q, f.index)
             check(follower.follower_force, *args, memories[id(f)].copy(), t, u, terms)
-            _, after = check(follower.follower_update, *args, memories[id(f)], t, states, u,
-                             terms, f.cascade.constants, f.cascade.mixer.rows)
+            ticked, _ = check(follower.follower_tick, *args, memories[id(f)].copy(), t, states,
+                              u, f.cascade.constants, f.cascade.mixer.rows)
+            updated, after = check(follower.follower_update, *args, memories[id(f)], t,
+                                   states, u, terms, f.cascade.constants, f.cascade.mixer.rows)
             memories[id(f)] = after[7]
+            assert _equal(ticked, updated)  # the terms and the step in one call: the same
     assert 10 < saturated < 140 and clamped > 0  # both regimes were met
     for f, _ in followers:  # the memories moved: lift, heading, integral
         assert not np.isnan(memories[id(f)]).any()

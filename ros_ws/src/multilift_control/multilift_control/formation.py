@@ -20,7 +20,7 @@ from multilift_control import laws
 from multilift_control.cascade import (CascadeController, ControlOutput, FormationStates,
                                        UavState)
 from multilift_control.laws import constraints as rows_laws
-from multilift_control.laws.follower import follower_force, follower_update, formation_terms
+from multilift_control.laws.follower import follower_force, follower_tick, formation_terms
 from multilift_control.laws.follower import virtual_forces as virtual_forces_law
 from multilift_control.laws.layout import (FOLLOWER_ALTITUDE_OFFSET, FOLLOWER_BETA_SQ,
                                            FOLLOWER_COMMANDED, FOLLOWER_FREE_MODE_GAIN,
@@ -373,7 +373,7 @@ class FormationFollower:
         self.memory[FOLLOWER_INTEGRAL] = 0.0
         self.memory[FOLLOWER_YAW] = math.nan if yaw is None else yaw
         self._terms = laws.runnable(formation_terms)
-        self._update = laws.runnable(follower_update)
+        self._tick = laws.runnable(follower_tick)
         self._force = laws.runnable(follower_force)
 
     @property
@@ -441,41 +441,33 @@ class FormationFollower:
             array.flags.writeable = False
         return p, q
 
-    def _formation_terms(self, states: Sequence[UavState], thrust_vectors: np.ndarray
-                         ) -> tuple[np.ndarray, np.ndarray, tuple]:
-        """(states (n, UAV_STATE_SIZE), thrust_vectors (n, 3), the tick's
-        `laws.follower.formation_terms`): what every follower of the tick shares, computed
-        here for this one (the engine computes it once for all, `engine.tick`)."""
-        array = FormationStates.of(states).array
-        vectors = np.asarray(thrust_vectors, dtype=float)
-        return array, vectors, self._terms(self.constants, self.masses, self.constraints.rows,
-                                           self.constraints.targets, array, vectors)
-
     def desired_force(self, t: float, states: Sequence[UavState], thrust_vectors: np.ndarray
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(F world [N], errors g_vc[rows_of(i)], error rates J r_dot[rows_of(i)]).
 
         The force the thrust should produce (the law of the class docstring) before Eq. 3.13;
-        advances the altitude integral to t [s]. `update` calls it once per tick.
+        advances the altitude integral to t [s]. `update` computes it once per tick.
         """
-        _, vectors, terms = self._formation_terms(states, thrust_vectors)
+        vectors = np.asarray(thrust_vectors, dtype=float)
+        terms = self._terms(self.constants, self.masses, self.constraints.rows,
+                            self.constraints.targets, FormationStates.of(states).array, vectors)
         return self._force(self.constants, self.masses, self.constraints.rows,
                            self.constraints.targets, self.law_p, self.law_q, self.index,
                            self.memory, float(t), vectors, terms)
 
     def update(self, t: float, states: Sequence[UavState], thrust_vectors: np.ndarray
                ) -> tuple[ControlOutput, np.ndarray, np.ndarray]:
-        """One control tick at simulated time t [s]: the tick's shared terms, then this
-        follower's step (`laws.follower.formation_terms`, `follower_update`).
+        """One control tick at simulated time t [s] (`laws.follower.follower_tick`: what the
+        followers of the tick share, then this follower's step, in one call).
 
         states: all n UAVs at the same tick; thrust_vectors (n, 3): each UAV's current lift
         R_i e_z u_T,i, world [N]. Returns (ControlOutput, the follower's rows of g_vc [m or
         m^2], their rates [m/s or m^2/s]).
         """
         c = self.cascade
-        array, vectors, terms = self._formation_terms(states, thrust_vectors)
-        speeds, saturated, setpoint, thrust, errors, rates = self._update(
+        speeds, saturated, setpoint, thrust, errors, rates = self._tick(
             self.constants, self.masses, self.constraints.rows, self.constraints.targets,
-            self.law_p, self.law_q, self.index, self.memory, float(t), array, vectors, terms,
+            self.law_p, self.law_q, self.index, self.memory, float(t),
+            FormationStates.of(states).array, np.asarray(thrust_vectors, dtype=float),
             c.constants, c.mixer.rows)
         return ControlOutput(speeds, saturated, setpoint, thrust), errors, rates

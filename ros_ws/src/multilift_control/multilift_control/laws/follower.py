@@ -265,6 +265,18 @@ def follower_update(constants, masses, rows, targets, law_p, law_q, index, memor
 
 
 @jit
+def follower_tick(constants, masses, rows, targets, law_p, law_q, index, memory, t, states,
+                  thrust_vectors, cascade_constants, mixer):
+    """One follower's tick at t [s] where it is the only one to answer the formation's states
+    and thrust_vectors (a follower node, `FormationFollower.update`), in one call: the tick's
+    `formation_terms`, then its `follower_update` (the engine computes the terms once for every
+    follower, `engine.tick.answer_formation`). Returns `follower_update`'s result."""
+    terms = formation_terms(constants, masses, rows, targets, states, thrust_vectors)
+    return follower_update(constants, masses, rows, targets, law_p, law_q, index, memory, t,
+                           states, thrust_vectors, terms, cascade_constants, mixer)
+
+
+@jit
 def lift_vectors(states, thrusts):
     """Every UAV's lift R_j e_z u_T,j, world [N] (n, 3), of the states' attitudes and the
     collective thrusts u_T,j [N] (n,): the thrust vectors u_f,r of Eq. 3.9-3.12."""

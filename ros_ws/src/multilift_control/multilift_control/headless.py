@@ -123,7 +123,8 @@ def fly(scenario: Scenario, progress: Callable[[float, float], None] | None = No
     t_max = float(engine.arrays.tick_count[0] * engine.arrays.period_ns[0] * 1e-9)
     try:
         while engine.running[0]:
-            engine.step(PROGRESS_TICKS if progress is not None else int(engine.arrays.tick_count[0]))
+            engine.step(PROGRESS_TICKS if progress is not None
+                        else int(engine.arrays.tick_count[0]))
             if progress is not None:
                 progress(float(engine.t[0]), t_max)
     finally:

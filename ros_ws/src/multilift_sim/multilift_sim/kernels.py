@@ -4,13 +4,11 @@ engine's tick (`multilift_control.engine`), each written once as numba functions
 each function's uncompiled run (`uncompiled`: its own source run by Python) is the reference.
 
 How start-up stays low without numba's pycc (pending deprecation; it was used here until
-issue 19): numba's own on-disk cache, `numba.njit(cache=True)`, the supported way. scripts/setup
-compiles every kernel once into the cache (NUMBA_CACHE_DIR, by default
-`~/.cache/multilift/numba/<digest of the kernels' sources>`), so a process loads them (tenths of a second) instead of compiling
-(seconds); a process that runs no compiled code does not load them, and the controller nodes
-run their laws uncompiled unless told otherwise (`multilift_control.runtime.prepare_node_laws`:
-a lone node's time goes to rclpy; `run --compose` runs every controller in one process, which
-loads the compiled laws once).
+issue 19): numba's own on-disk cache, `numba.njit(cache=True)`, the supported way.
+scripts/setup compiles every kernel once into the cache (NUMBA_CACHE_DIR, by default
+`~/.cache/multilift/numba/<digest of the kernels' sources>`), so a process loads them (tenths
+of a second) instead of compiling (seconds); a process that runs no compiled code does not load
+them, and `run --compose` runs every controller in one process, which loads them once.
 
 MULTILIFT_KERNEL: `auto` (or unset) compiled just in time (from the cache) where numba imports,
 else uncompiled; `jit` the same, numba required; `python` uncompiled (the reference).
@@ -31,7 +29,8 @@ from typing import Any, Callable
 # the laws and the engine's tick above): numba compiles a kernel together with the kernels it
 # calls from other files, but checks a cached kernel against its own file only
 KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine')
-CACHE_ROOT = Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache') / 'multilift' / 'numba'
+CACHE_ROOT = (Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache')
+              / 'multilift' / 'numba')
 
 
 def _sources_digest() -> str:

@@ -142,6 +142,8 @@ class EngineBag:
             messages.append(self._simulator.markers_of(
                 t_ns, [u[:3] for u in odometry], euler, payload_position, tension, taut))
         self._write(messages, t_ns)
+
+
 class HeadlessBag:
     """Writes one run's messages to a BagWriter, tick by tick, as a `run_headless` observer.
 

@@ -1,19 +1,23 @@
-"""What the controllers measure (physics.measurement, seed Eq. 2.7) and the rotor wrenches
-(physics.allocation, Eq. 2.14): compiled vs their uncompiled run to the bit, and against
-independent forms (kinematics' W(eta) matrix, each allocator's matrix product)."""
+"""What the controllers measure (physics.measurement, seed Eq. 2.7), the odometry rows the
+messages carry (R, R^T v, the quaternion) and the rotor wrenches (physics.allocation,
+Eq. 2.14): compiled vs their uncompiled run to the bit, and against independent forms
+(kinematics' W(eta), R and quaternion, msgvalues.quaternion, each allocator's matrix
+product)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from multilift_sim import kernels
+from multilift_sim import kernels, msgvalues
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
-from multilift_sim.kinematics import euler_rate_matrix
+from multilift_sim.kinematics import euler_rate_matrix, quaternion_from_euler, rotation_matrix
 from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
-                                          MEASURED_POSITION, MEASURED_VELOCITY)
-from multilift_sim.physics.measurement import measured_states
+                                          MEASURED_POSITION, MEASURED_VELOCITY,
+                                          ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
+                                          ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
+from multilift_sim.physics.measurement import measured_states, odometry_states
 
 
 def _random_state(n: int, rng) -> np.ndarray:
@@ -40,6 +44,35 @@ def test_measured_states_compiled_equal_uncompiled_and_w_eta_dot(n):
         assert np.array_equal(row[MEASURED_EULER:MEASURED_EULER + 3], eta)
         assert np.allclose(row[MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3],
                            euler_rate_matrix(eta) @ eta_dot, rtol=1e-13, atol=1e-13)
+
+
+@pytest.mark.parametrize('n', [1, 2, 5])
+def test_odometry_states_compiled_equal_uncompiled_and_the_oracles(n):
+    rng = np.random.default_rng(10 + n)
+    states = np.stack([_random_state(n, rng) for _ in range(4)])
+    compiled, python = np.empty((4, n, ODOMETRY_COLUMNS)), np.empty((4, n, ODOMETRY_COLUMNS))
+    odometry_states(states, n, compiled)
+    kernels.uncompiled(odometry_states)(states, n, python)
+    assert np.array_equal(compiled, python)
+    for k, x in enumerate(states):
+        measured = np.empty((n, MEASURED_COLUMNS))
+        measured_states(x, n, measured)
+        assert np.array_equal(compiled[k, :, :MEASURED_COLUMNS], measured)
+        euler = measured[:, MEASURED_EULER:MEASURED_EULER + 3]
+        velocity = measured[:, MEASURED_VELOCITY:MEASURED_VELOCITY + 3]
+        rotation = compiled[k, :, ODOMETRY_ROTATION:ODOMETRY_ROTATION + 9].reshape(n, 3, 3)
+        assert np.allclose(rotation, rotation_matrix(euler), rtol=0.0, atol=1e-15)
+        assert np.allclose(rotation @ rotation.swapaxes(1, 2), np.eye(3), rtol=0, atol=1e-15)
+        body = compiled[k, :, ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3]
+        assert np.allclose(body, np.einsum('nji,nj->ni', rotation, velocity), rtol=1e-15,
+                           atol=1e-15)
+        # each element the sum (R_0j v_x + R_1j v_y) + R_2j v_z, no fused multiply-add
+        assert np.array_equal(body, (rotation[:, 0] * velocity[:, :1]
+                                     + rotation[:, 1] * velocity[:, 1:2])
+                              + rotation[:, 2] * velocity[:, 2:])
+        quaternion = compiled[k, :, ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4]
+        assert quaternion.tolist() == [list(msgvalues.quaternion(e)) for e in euler]
+        assert np.allclose(quaternion, quaternion_from_euler(euler), rtol=0.0, atol=1e-15)
 
 
 def test_rotor_wrenches_are_each_allocation_times_the_squared_speeds():

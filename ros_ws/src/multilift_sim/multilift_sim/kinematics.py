@@ -24,7 +24,8 @@ def rotation_matrix(eta: ArrayLike) -> np.ndarray:
     """Rotation matrix ``R = Rz(psi) Ry(theta) Rx(phi)`` mapping body to world (seed Eq. 2.6).
 
     eta: Euler angles [rad], shape (..., 3). Returns shape (..., 3, 3); a body-frame vector
-    ``v_b`` is ``R @ v_b`` in the world frame.
+    ``v_b`` is ``R @ v_b`` in the world frame. The numpy form for analysis and the tests' oracle;
+    the R (and quaternion) the simulator reports each tick is physics.measurement.odometry_states.
     """
     angles = _angles(eta)
     s_phi, s_theta, s_psi = np.moveaxis(np.sin(angles), -1, 0)
@@ -116,7 +117,8 @@ def quaternion_from_euler(eta: ArrayLike) -> np.ndarray:
     """Unit quaternion (x, y, z, w) of ``R = Rz(psi) Ry(theta) Rx(phi)`` (body -> world).
 
     eta: Euler angles (roll, pitch, yaw) [rad], shape (..., 3). Returns shape (..., 4), scalar
-    part last as geometry_msgs/Quaternion orders it.
+    part last as geometry_msgs/Quaternion orders it. The numpy form (see `rotation_matrix` for
+    the per-tick one).
     """
     half = 0.5 * _angles(eta)
     s, c = np.sin(half), np.cos(half)

@@ -8,7 +8,9 @@ named (numba freezes these module-level integers into the compiled code).
 - a UAV's constants row (UAV_*, UAV_COLUMNS columns, one row per UAV);
 - a gust's row (GUST_*, seed Eq. 2.55);
 - the formation's scalars (FORMATION_*);
-- the scratch of a solve per cable (CABLE_*) and of an RK4 step (WORK_*).
+- the scratch of a solve per cable (CABLE_*) and of an RK4 step (WORK_*);
+- a UAV's measured state (MEASURED_*) and its odometry row (ODOMETRY_*: the measured state,
+  then its attitude and body-frame velocity as the messages carry them).
 """
 from __future__ import annotations
 
@@ -92,3 +94,10 @@ MEASURED_VELOCITY = 3       # r_i_dot [m/s], world (3)
 MEASURED_EULER = 6          # eta_i = (roll, pitch, yaw) [rad] (3)
 MEASURED_BODY_RATES = 9     # omega_i = W(eta_i) eta_i_dot [rad/s], body FLU (3)
 MEASURED_COLUMNS = 12
+
+# -- a UAV's odometry: its measured state (the MEASURED_* slots), then the rest of what its
+# messages carry (/formation/snapshot, /uav{i}/odom, /tf), one row of (n, ODOMETRY_COLUMNS) ---
+ODOMETRY_ROTATION = 12      # R = Rz(psi) Ry(theta) Rx(phi), body -> world, row by row (9)
+ODOMETRY_BODY_VELOCITY = 21  # R^T r_i_dot [m/s], body FLU (3)
+ODOMETRY_QUATERNION = 24    # (x, y, z, w) of R, scalar last as geometry_msgs orders it (4)
+ODOMETRY_COLUMNS = 28

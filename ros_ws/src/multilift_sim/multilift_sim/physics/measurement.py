@@ -1,17 +1,24 @@
-"""What the controllers measure of each UAV, from the formation state (seed Eq. 2.7)."""
+"""What the controllers measure of each UAV, from the formation state (seed Eq. 2.7), and the
+rest of what the simulator's messages carry of it (its attitude as R and as a quaternion, its
+body-frame velocity): the one run-time place of these equations (kinematics.rotation_matrix
+and .quaternion_from_euler, msgvalues.quaternion are the numpy and float forms the tests hold
+them to, and what plots and markers use)."""
 import math
 
 from multilift_sim.physics._jit import jit
 from multilift_sim.physics.layout import (EULER, MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
-                                          PAYLOAD_COORDINATES, POSITION, UAV_COORDINATES)
+                                          ODOMETRY_BODY_VELOCITY, ODOMETRY_QUATERNION,
+                                          ODOMETRY_ROTATION, PAYLOAD_COORDINATES, POSITION,
+                                          UAV_COORDINATES)
 
 
 @jit
 def measured_states(x, n, out):
-    """Every UAV's measured state into out (n, MEASURED_COLUMNS) from the formation state x
-    (2 (6n + 3),): position [m] and velocity [m/s] (world), ZYX Euler angles [rad] and the body
-    rates omega = W(eta) eta_dot [rad/s] (Eq. 2.7, body FLU)."""
+    """Every UAV's measured state into out (n, MEASURED_COLUMNS or more; only the MEASURED_*
+    slots are written) from the formation state x (2 (6n + 3),): position [m] and velocity
+    [m/s] (world), ZYX Euler angles [rad] and the body rates omega = W(eta) eta_dot [rad/s]
+    (Eq. 2.7, body FLU)."""
     nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
     for i in range(n):
         base = UAV_COORDINATES * i
@@ -30,3 +37,49 @@ def measured_states(x, n, out):
         out[i, MEASURED_BODY_RATES] = phi_dot - s_theta * psi_dot
         out[i, MEASURED_BODY_RATES + 1] = c_phi * theta_dot + s_phi * c_theta * psi_dot
         out[i, MEASURED_BODY_RATES + 2] = -s_phi * theta_dot + c_phi * c_theta * psi_dot
+
+
+@jit
+def odometry_states(states, n, out):
+    """Every UAV's odometry row into out (K, n, ODOMETRY_COLUMNS) for K formation states
+    (K, 2 (6n + 3)) (FormationSimulator.snapshot: K = 1; the headless bag: a chunk's ticks):
+    its measured state (`measured_states`), then
+    - R = Rz(psi) Ry(theta) Rx(phi), body -> world (seed Eq. 2.6), row by row;
+    - its velocity in the body frame R^T r_i_dot [m/s] (what nav_msgs/Odometry's twist holds),
+      each element the sum (R_0j v_x + R_1j v_y) + R_2j v_z;
+    - the unit quaternion (x, y, z, w) of R from the half angles."""
+    for k in range(states.shape[0]):
+        rows = out[k]
+        measured_states(states[k], n, rows)
+        for i in range(n):
+            phi = rows[i, MEASURED_EULER]
+            theta = rows[i, MEASURED_EULER + 1]
+            psi = rows[i, MEASURED_EULER + 2]
+            s_phi, c_phi = math.sin(phi), math.cos(phi)
+            s_th, c_th = math.sin(theta), math.cos(theta)
+            s_psi, c_psi = math.sin(psi), math.cos(psi)
+            r = ODOMETRY_ROTATION
+            rows[i, r] = c_psi * c_th
+            rows[i, r + 1] = c_psi * s_th * s_phi - s_psi * c_phi
+            rows[i, r + 2] = c_psi * s_th * c_phi + s_psi * s_phi
+            rows[i, r + 3] = s_psi * c_th
+            rows[i, r + 4] = s_psi * s_th * s_phi + c_psi * c_phi
+            rows[i, r + 5] = s_psi * s_th * c_phi - c_psi * s_phi
+            rows[i, r + 6] = -s_th
+            rows[i, r + 7] = c_th * s_phi
+            rows[i, r + 8] = c_th * c_phi
+            vx = rows[i, MEASURED_VELOCITY]
+            vy = rows[i, MEASURED_VELOCITY + 1]
+            vz = rows[i, MEASURED_VELOCITY + 2]
+            for axis in range(3):  # column `axis` of R: row `axis` of R^T
+                rows[i, ODOMETRY_BODY_VELOCITY + axis] = (
+                    rows[i, r + axis] * vx + rows[i, r + 3 + axis] * vy
+                    + rows[i, r + 6 + axis] * vz)
+            half_roll, half_pitch, half_yaw = 0.5 * phi, 0.5 * theta, 0.5 * psi
+            sr, cr = math.sin(half_roll), math.cos(half_roll)
+            sp, cp = math.sin(half_pitch), math.cos(half_pitch)
+            sy, cy = math.sin(half_yaw), math.cos(half_yaw)
+            rows[i, ODOMETRY_QUATERNION] = sr * cp * cy - cr * sp * sy
+            rows[i, ODOMETRY_QUATERNION + 1] = cr * sp * cy + sr * cp * sy
+            rows[i, ODOMETRY_QUATERNION + 2] = cr * cp * sy - sr * sp * cy
+            rows[i, ODOMETRY_QUATERNION + 3] = cr * cp * cy + sr * sp * sy

@@ -87,8 +87,8 @@ def test_uav_and_payload_odometry(twin, typestore):
     _, snap = twin
     uav = snap.uavs[1]
     packer = cdr.Odometry(msgvalues.uav_frame(2))
-    values = msgvalues.odometry(uav.position, uav.velocity, uav.euler, uav.rotation,
-                                uav.body_rates)
+    values = msgvalues.odometry(uav.position, uav.velocity, uav.orientation,
+                                uav.body_velocity, uav.body_rates)
     check(packer.pack(T_NS, *values), packer, messages.uav_odometry(T_NS, 2, uav), typestore)
     packer = cdr.Odometry(msgvalues.PAYLOAD_FRAME)
     values = msgvalues.odometry(snap.payload_position, snap.payload_velocity, None, None, None)

@@ -69,7 +69,9 @@ def test_state_rows_are_the_snapshots_numbers():
     snapshot, odometry = state_rows(sim.state[None], scenario.n_uavs)
     snap = sim.snapshot()
     for i, uav in enumerate(snap.uavs):
-        assert odometry[0, i, 7:10].tolist() == (uav.rotation.T @ uav.velocity).tolist()
+        assert odometry[0, i, :3].tolist() == uav.position.tolist()
+        assert odometry[0, i, 3:7].tolist() == uav.orientation.tolist()
+        assert odometry[0, i, 7:10].tolist() == uav.body_velocity.tolist()
         assert odometry[0, i, 10:].tolist() == uav.body_rates.tolist()
     n = scenario.n_uavs
     assert snapshot[0, 9 * n:12 * n].tolist() == np.concatenate(

@@ -32,7 +32,9 @@ def stamp(t_ns: int) -> tuple[int, int]:
 
 def quaternion(euler: Sequence[float]) -> Quat:
     """(x, y, z, w) of ZYX Euler angles [rad]: kinematics.quaternion_from_euler's arithmetic in
-    plain floats (one attitude per message: numpy's per-call cost would be most of it)."""
+    plain floats (one attitude per message: numpy's per-call cost would be most of it), for the
+    markers (scene.py) and as the tests' oracle; a UAV's odometry quaternion is computed by
+    physics.measurement.odometry_states."""
     roll, pitch, yaw = (0.5 * float(a) for a in euler)
     sr, cr = math.sin(roll), math.cos(roll)
     sp, cp = math.sin(pitch), math.cos(pitch)
@@ -46,19 +48,23 @@ def vec3(values: Sequence[float]) -> Vec3:
 
 
 def odometry(position: Sequence[float], velocity_world: Sequence[float],
-             euler: Sequence[float] | None, rotation: np.ndarray | None,
+             orientation: Sequence[float] | None, body_velocity: Sequence[float] | None,
              body_rates: Sequence[float] | None) -> tuple[Vec3, Quat, Vec3, Vec3]:
     """(position, orientation, linear twist, angular twist) of a nav_msgs/Odometry in `world`:
-    the twist is in the child frame as nav_msgs/Odometry specifies (world velocity rotated by
-    R^T); without an attitude (`euler` None) the orientation is the identity and the twist the
-    world velocity."""
-    if euler is None:
+    the twist is in the child frame as nav_msgs/Odometry specifies. A UAV's `orientation`
+    (x, y, z, w), `body_velocity` R^T v and `body_rates` are its simulation.UavSnapshot's
+    (physics.measurement.odometry_states computes them); without an orientation (the payload)
+    the orientation is the identity and the twist the world velocity."""
+    if orientation is None:
         orientation, linear = IDENTITY, vec3(velocity_world)
     else:
-        orientation = quaternion(euler)
-        linear = vec3(rotation.T @ velocity_world)  # world -> body
+        orientation, linear = _quat(orientation), vec3(body_velocity)
     angular = (0.0, 0.0, 0.0) if body_rates is None else vec3(body_rates)
     return vec3(position), orientation, linear, angular
+
+
+def _quat(values: Sequence[float]) -> Quat:
+    return float(values[0]), float(values[1]), float(values[2]), float(values[3])
 
 
 def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | None

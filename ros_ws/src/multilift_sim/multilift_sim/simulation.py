@@ -15,6 +15,11 @@ from multilift_sim.dynamics import Integration, StateLayout, initial_state_singl
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
+from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
+                                          MEASURED_POSITION, MEASURED_VELOCITY,
+                                          ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
+                                          ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
+from multilift_sim.physics.measurement import odometry_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import RunStatistics
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
@@ -29,8 +34,10 @@ class UavSnapshot:
     position: np.ndarray     # world [m]
     velocity: np.ndarray     # world [m/s]
     euler: np.ndarray        # ZYX (roll, pitch, yaw) [rad]
-    rotation: np.ndarray     # body -> world
+    rotation: np.ndarray     # R, body -> world (3, 3)
     body_rates: np.ndarray   # FLU [rad/s]
+    body_velocity: np.ndarray  # R^T velocity, FLU [m/s]
+    orientation: np.ndarray  # quaternion (x, y, z, w) of R
 
 
 @dataclass(frozen=True)
@@ -40,6 +47,7 @@ class Snapshot:
     uavs: tuple[UavSnapshot, ...]
     payload_position: np.ndarray  # world [m]
     payload_velocity: np.ndarray  # world [m/s]
+    odometry: np.ndarray  # every UAV's row (n, ODOMETRY_COLUMNS), physics.layout ODOMETRY_*
 
 
 def cable_reach(scenario: Scenario) -> np.ndarray:
@@ -135,33 +143,24 @@ class FormationSimulator:
         return self.tick >= self.tick_count
 
     def snapshot(self) -> Snapshot:
-        """The formation at the current tick; each UAV's arrays are its own copies."""
+        """The formation at the current tick: every UAV's numbers from one call of
+        physics.measurement.odometry_states, viewed from a fresh array (none of the
+        simulator's state)."""
         n = self.n
         nq = 6 * n + 3
-        uavs = []
-        # per UAV in plain floats: for the few UAVs of a formation this is several times
-        # faster than numpy on (n,) columns, and the same arithmetic
-        for (rx, ry, rz, phi, theta, psi), (vx, vy, vz, phi_dot, theta_dot, psi_dot) in zip(
-                self.state[:6 * n].reshape(n, 6).tolist(),
-                self.state[nq:nq + 6 * n].reshape(n, 6).tolist()):
-            s_phi, c_phi = math.sin(phi), math.cos(phi)
-            s_th, c_th = math.sin(theta), math.cos(theta)
-            s_psi, c_psi = math.sin(psi), math.cos(psi)
-            # R = Rz(psi) Ry(theta) Rx(phi), body -> world, as kinematics.rotation_matrix
-            rotation = np.array(((c_psi * c_th, c_psi * s_th * s_phi - s_psi * c_phi,
-                                  c_psi * s_th * c_phi + s_psi * s_phi),
-                                 (s_psi * c_th, s_psi * s_th * s_phi + c_psi * c_phi,
-                                  s_psi * s_th * c_phi - c_psi * s_phi),
-                                 (-s_th, c_th * s_phi, c_th * c_phi)))
-            rates = np.array((phi_dot - s_th * psi_dot,  # omega = W(eta) eta_dot, seed Eq. 2.7
-                              c_phi * theta_dot + s_phi * c_th * psi_dot,
-                              -s_phi * theta_dot + c_phi * c_th * psi_dot))
-            uavs.append(UavSnapshot(position=np.array((rx, ry, rz)),
-                                    velocity=np.array((vx, vy, vz)),
-                                    euler=np.array((phi, theta, psi)), rotation=rotation,
-                                    body_rates=rates))
-        return Snapshot(self.t_ns, tuple(uavs), self.state[6 * n:nq].copy(),
-                        self.state[nq + 6 * n:].copy())
+        rows = np.empty((1, n, ODOMETRY_COLUMNS))
+        odometry_states(self.state.reshape(1, -1), n, rows)
+        odometry = rows[0]
+        uavs = tuple(UavSnapshot(
+            position=row[MEASURED_POSITION:MEASURED_POSITION + 3],
+            velocity=row[MEASURED_VELOCITY:MEASURED_VELOCITY + 3],
+            euler=row[MEASURED_EULER:MEASURED_EULER + 3],
+            rotation=row[ODOMETRY_ROTATION:ODOMETRY_ROTATION + 9].reshape(3, 3),
+            body_rates=row[MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3],
+            body_velocity=row[ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3],
+            orientation=row[ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4]) for row in odometry)
+        return Snapshot(self.t_ns, uavs, self.state[6 * n:nq].copy(),
+                        self.state[nq + 6 * n:].copy(), odometry)
 
     @property
     def taut(self) -> np.ndarray:

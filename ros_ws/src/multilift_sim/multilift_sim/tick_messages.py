@@ -9,14 +9,17 @@ World frame, SI units.
 """
 from __future__ import annotations
 
-import math
 from typing import Sequence
 
 import numpy as np
 
 from multilift_sim import cdr
-from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, formation_snapshot, odometry,
-                                     uav_frame, vec3)
+from multilift_sim.msgvalues import IDENTITY, PAYLOAD_FRAME, formation_snapshot, uav_frame, vec3
+from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
+                                          MEASURED_POSITION, MEASURED_VELOCITY,
+                                          ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
+                                          ODOMETRY_QUATERNION)
+from multilift_sim.physics.measurement import odometry_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.scene import FormationScene
 from multilift_sim.simulation import Snapshot
@@ -25,6 +28,14 @@ from multilift_sim.topics import (CLOCK, FORMATION_SNAPSHOT, FORMATION_STATE, MA
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
 _ZERO = (0.0, 0.0, 0.0)
+# an odometry row's 13 numbers (msgvalues.odometry's order: position, orientation (x, y, z, w),
+# body-frame velocity, body rates) taken from the rows of physics.measurement.odometry_states
+ODOMETRY_NUMBERS = np.r_[MEASURED_POSITION:MEASURED_POSITION + 3,
+                         ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4,
+                         ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3,
+                         MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3]
+# the FormationSnapshot's per-UAV blocks, each 3 per UAV: position, velocity, euler, body rates
+_SNAPSHOT_BLOCKS = (MEASURED_POSITION, MEASURED_VELOCITY, MEASURED_EULER, MEASURED_BODY_RATES)
 
 
 class SimulatorMessages:
@@ -51,10 +62,7 @@ class SimulatorMessages:
         answers), then for users, tools and bags every /uav{i}/odom, /payload/odom,
         /payload/gust (`gust`: the air velocity at the payload [m/s]) and /tf."""
         snapshot = None if last else formation_snapshot(snap, applied)
-        uavs = [[*vec3(position), *orientation, *linear, *angular]
-                for position, orientation, linear, angular in (
-                    odometry(u.position, u.velocity, u.euler, u.rotation, u.body_rates)
-                    for u in snap.uavs)]
+        uavs = snap.odometry[:, ODOMETRY_NUMBERS].tolist()
         return self.state_of(
             snap.t_ns, None if snapshot is None else np.concatenate(snapshot).tolist(),
             None if snapshot is None else len(snapshot[-1]), uavs,
@@ -109,44 +117,13 @@ class SimulatorMessages:
 def state_rows(states: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """The numbers `SimulatorMessages.state_of` takes, for K formation states (K, 2 (6n + 3))
     of n UAVs at once: (the FormationSnapshot rows (K, 12 n + 6) without the rotor speeds,
-    every UAV's odometry row (K, n, 13)). The same bits as `FormationSimulator.snapshot` and
-    `msgvalues.odometry` give tick by tick (tests/unit/test_headless_bag.py): the same
-    operations in the same order, element by element, the sines and cosines Python's (numpy's
-    own may differ in the last bit), R^T v by the same matrix product."""
+    every UAV's odometry row (K, n, 13)). One call of physics.measurement.odometry_states,
+    which `FormationSimulator.snapshot` calls too: the same bits tick by tick
+    (tests/unit/test_headless_bag.py)."""
     k, nq = states.shape[0], 6 * n + 3
-    q = states[:, :6 * n].reshape(k, n, 6)
-    q_dot = states[:, nq:nq + 6 * n].reshape(k, n, 6)
-    position, euler, velocity = q[..., :3], q[..., 3:], np.ascontiguousarray(q_dot[..., :3])
-    angles = euler.ravel().tolist()
-    sin = np.array(list(map(math.sin, angles))).reshape(k, n, 3)
-    cos = np.array(list(map(math.cos, angles))).reshape(k, n, 3)
-    s_phi, s_th, s_psi = sin[..., 0], sin[..., 1], sin[..., 2]
-    c_phi, c_th, c_psi = cos[..., 0], cos[..., 1], cos[..., 2]
-    # R = Rz(psi) Ry(theta) Rx(phi), body -> world, as FormationSimulator.snapshot
-    rotation = np.empty((k, n, 3, 3))
-    rotation[..., 0, 0] = c_psi * c_th
-    rotation[..., 0, 1] = c_psi * s_th * s_phi - s_psi * c_phi
-    rotation[..., 0, 2] = c_psi * s_th * c_phi + s_psi * s_phi
-    rotation[..., 1, 0] = s_psi * c_th
-    rotation[..., 1, 1] = s_psi * s_th * s_phi + c_psi * c_phi
-    rotation[..., 1, 2] = s_psi * s_th * c_phi - c_psi * s_phi
-    rotation[..., 2, 0] = -s_th
-    rotation[..., 2, 1] = c_th * s_phi
-    rotation[..., 2, 2] = c_th * c_phi
-    phi_dot, theta_dot, psi_dot = q_dot[..., 3], q_dot[..., 4], q_dot[..., 5]
-    rates = np.stack((phi_dot - s_th * psi_dot,  # omega = W(eta) eta_dot, seed Eq. 2.7
-                      c_phi * theta_dot + s_phi * c_th * psi_dot,
-                      -s_phi * theta_dot + c_phi * c_th * psi_dot), axis=-1)
-    linear = np.matmul(rotation.swapaxes(-1, -2), velocity[..., None])[..., 0]  # world -> body
-    # msgvalues.quaternion of the Euler angles
-    halves = (0.5 * euler).ravel().tolist()
-    sin = np.array(list(map(math.sin, halves))).reshape(k, n, 3)
-    cos = np.array(list(map(math.cos, halves))).reshape(k, n, 3)
-    sr, sp, sy = sin[..., 0], sin[..., 1], sin[..., 2]
-    cr, cp, cy = cos[..., 0], cos[..., 1], cos[..., 2]
-    orientation = np.stack((sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
-                            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy), axis=-1)
-    snapshot = np.concatenate((position.reshape(k, 3 * n), velocity.reshape(k, 3 * n),
-                               euler.reshape(k, 3 * n), rates.reshape(k, 3 * n),
-                               states[:, 6 * n:nq], states[:, nq + 6 * n:]), axis=1)
-    return snapshot, np.concatenate((position, orientation, linear, rates), axis=2)
+    rows = np.empty((k, n, ODOMETRY_COLUMNS))
+    odometry_states(np.ascontiguousarray(states), n, rows)
+    snapshot = np.concatenate(
+        [rows[..., block:block + 3].reshape(k, 3 * n) for block in _SNAPSHOT_BLOCKS]
+        + [states[:, 6 * n:nq], states[:, nq + 6 * n:]], axis=1)
+    return snapshot, rows[..., ODOMETRY_NUMBERS]

@@ -56,15 +56,15 @@ def ns_from_stamp(stamp: Time) -> int:
 
 
 def fill_odometry(msg: Odometry, t_ns: int, child_frame: str, position: np.ndarray,
-                  velocity_world: np.ndarray, euler: np.ndarray | None,
-                  rotation: np.ndarray | None, body_rates: np.ndarray | None) -> Odometry:
+                  velocity_world: np.ndarray, orientation: np.ndarray | None,
+                  body_velocity: np.ndarray | None, body_rates: np.ndarray | None) -> Odometry:
     """Odometry in `world`; twist in the child frame as nav_msgs/Odometry specifies (the
     values of msgvalues.odometry, which the headless bag packs too)."""
     msg.header.stamp = stamp_from_ns(t_ns)
     msg.header.frame_id = WORLD_FRAME
     msg.child_frame_id = child_frame
     position, orientation, linear, angular = msgvalues.odometry(
-        position, velocity_world, euler, rotation, body_rates)
+        position, velocity_world, orientation, body_velocity, body_rates)
     p, q = msg.pose.pose.position, msg.pose.pose.orientation
     v, w = msg.twist.twist.linear, msg.twist.twist.angular
     p.x, p.y, p.z = position

@@ -31,7 +31,7 @@ def clock(t_ns: int) -> Clock:
 def uav_odometry(t_ns: int, index: int, uav) -> Odometry:
     """UAV `index` (1 = leader) from a simulation.UavSnapshot."""
     return fill_odometry(Odometry(), t_ns, uav_frame(index), uav.position, uav.velocity,
-                         uav.euler, uav.rotation, uav.body_rates)
+                         uav.orientation, uav.body_velocity, uav.body_rates)
 
 
 def payload_odometry(t_ns: int, position: np.ndarray, velocity: np.ndarray) -> Odometry:

@@ -75,6 +75,19 @@ def prune_cache(days: float = 7.0) -> list[Path]:
     return stale
 
 
+def jit(function: Callable) -> Callable:
+    """The decorator of every kernel (physics, statistics, the laws, the engine's tick):
+    numba's njit with its on-disk cache and IEEE arithmetic in the source's order (no
+    fastmath), or the function itself where numba does not import (then only its uncompiled
+    run exists)."""
+    try:
+        _import_numba_quietly()
+        import numba
+    except ImportError:  # pragma: no cover - numba is a dependency; the pure run still works
+        return function
+    return numba.njit(cache=True, fastmath=False, nogil=True)(function)
+
+
 def mode() -> str:
     """MULTILIFT_KERNEL, checked: one of MODES."""
     value = os.environ.get(VARIABLE) or 'auto'

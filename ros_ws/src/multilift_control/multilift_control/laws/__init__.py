@@ -16,13 +16,5 @@ World frame z up, body FLU, ZYX Euler angles [rad], SI units (docs/conventions.m
 """
 from __future__ import annotations
 
-from multilift_sim import kernels
-from multilift_sim.kernels import runnable  # noqa: F401 - the wrappers' one way to a law
-
-# numba's array code without the scipy and coverage imports it does not need (their cost in
-# every process: kernels._import_numba_quietly)
-kernels._import_numba_quietly()
-import numba  # noqa: E402 - after the quiet import above
-
-# every law: compiled just in time, cached on disk, IEEE arithmetic in the source's order
-jit = numba.njit(cache=True, fastmath=False, nogil=True)
+from multilift_sim.kernels import jit, runnable  # noqa: F401 - every law's decorator; the
+# wrappers' one way to a law (compiled, or its uncompiled run, as MULTILIFT_KERNEL says)

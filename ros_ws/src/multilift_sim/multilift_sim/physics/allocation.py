@@ -1,5 +1,5 @@
 """Rotor speeds -> body wrenches (seed Eq. 2.14), for the formation's UAVs at once."""
-from multilift_sim.physics._jit import jit
+from multilift_sim.kernels import jit
 
 
 @jit

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from multilift_sim.physics._jit import jit
+from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import (
     CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST, EULER,
     FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,

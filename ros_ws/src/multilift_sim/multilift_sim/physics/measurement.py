@@ -5,7 +5,7 @@ and .quaternion_from_euler, msgvalues.quaternion are the numpy and float forms t
 them to, and what plots and markers use)."""
 import math
 
-from multilift_sim.physics._jit import jit
+from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import (EULER, MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_QUATERNION,

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from multilift_sim.physics._jit import jit
+from multilift_sim.kernels import jit
 from multilift_sim.physics.formation_dae import cable_multipliers, residuals, rk4_step, solve
 from multilift_sim.physics.layout import (
     CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, FORMATION_INV_PAYLOAD_MASS,

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from multilift_sim.physics._jit import jit
+from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import POSITION, UAV_COORDINATES
 from multilift_sim.statistics.layout import (
     CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS, FORMATION_NORM_SUM,

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from multilift_sim.physics._jit import jit
+from multilift_sim.kernels import jit
 
 # How far outside a ball a candidate may lie and still count as inside it [m].
 FEASIBILITY = 1e-9

@@ -322,7 +322,7 @@ class _ProgressFile:
 
 
 def _ticker(progress: _ProgressFile, total: float) -> Callable[..., None]:
-    """An on_tick for run_headless / record_headless reporting simulated time."""
+    """An on_tick for run_headless reporting simulated time."""
     def on_tick(sim: Any, *_: Any) -> None:
         if sim.tick % 200 == 0 or sim.finished:
             progress(sim.t, total)
@@ -337,7 +337,7 @@ def _record(name: str, bag: Path, progress: _ProgressFile) -> dict:
     if bag.exists():
         shutil.rmtree(bag)
     bag.parent.mkdir(parents=True, exist_ok=True)
-    run = record_headless(scenario, bag, _ticker(progress, scenario.simulation.duration))
+    run = record_headless(scenario, bag, progress)  # progress(t, t_max) every chunk of ticks
     (bag / 'summary.json').write_text(json.dumps(run.summary(), indent=1, sort_keys=True))
     return {'bag': str(bag), 'wall_time': run.wall_time}
 

@@ -99,10 +99,11 @@ class FlownRun:
 PROGRESS_TICKS = 50
 
 
-def _ticker(progress: Callable[[float, float], None]) -> TickObserver:
-    """An on_tick calling `progress(t, t_max)` every PROGRESS_TICKS ticks."""
+def progress_ticker(progress: Callable[[float, float], None],
+                    every: int = PROGRESS_TICKS) -> TickObserver:
+    """An on_tick calling `progress(t, t_max)` [s] every `every` ticks."""
     def on_tick(sim: FormationSimulator, *_) -> None:
-        if sim.tick % PROGRESS_TICKS == 0:
+        if sim.tick % every == 0:
             progress(sim.t, sim.tick_count * sim.period_ns * 1e-9)
     return on_tick
 
@@ -115,12 +116,12 @@ def fly(scenario: Scenario, progress: Callable[[float, float], None] | None = No
     itself raises SimulationStopped (its message the simulator's), or with raise_on_stop=False
     ends the run with `error` set."""
     if not engine_flies(scenario):  # tick by tick: the same tick, another integrator
-        return run_headless(scenario, None if progress is None else _ticker(progress),
+        return run_headless(scenario, None if progress is None else progress_ticker(progress),
                             raise_on_stop)
     start = time.monotonic()
     engine = Engine(scenario)
     run = FlownRun(scenario, engine)
-    t_max = float(engine.arrays.tick_count[0] * engine.arrays.period_ns[0] * 1e-9)
+    t_max = float(engine.t_max[0])
     try:
         while engine.running[0]:
             engine.step(PROGRESS_TICKS if progress is not None

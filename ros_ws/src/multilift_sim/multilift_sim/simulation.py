@@ -50,6 +50,20 @@ class Snapshot:
     odometry: np.ndarray  # every UAV's row (n, ODOMETRY_COLUMNS), physics.layout ODOMETRY_*
 
 
+def stop_message(status: int, cable: int, value: float, t: float, sim) -> str:
+    """Why Algorithm 1 stopped a run (a `statistics.accumulators.run_check` status other than
+    CHECK_OK): the non-finite state, or the cable (from 0) whose |g| [m^2] or |g_dot| [m^2/s]
+    `value` left its tolerance (`sim`: the scenario's SimulationConfig), at t [s]."""
+    if status == CHECK_NON_FINITE:
+        return f'the formation state became non-finite at t = {t:.3f} s'
+    if status == CHECK_G:
+        return (f'cable {cable + 1}: constraint residual |g| = {value:.3g} m^2 exceeds '
+                f'the tolerance {sim.constraint_tolerance:g} m^2 at t = {t:.3f} s '
+                '(Algorithm 1: change the step or the Baumgarte gains)')
+    return (f'cable {cable + 1}: constraint rate |g_dot| = {value:.3g} m^2/s '
+            f'exceeds the tolerance {sim.constraint_rate_tolerance:g} m^2/s at t = {t:.3f} s')
+
+
 def cable_reach(scenario: Scenario) -> np.ndarray:
     """How far each cable reaches for the swing's equilibrium place [m], (n,): l_i widened by
     the constraint tolerance, so cables held within it always meet."""
@@ -246,18 +260,12 @@ class FormationSimulator:
             sim.constraint_tolerance, sim.constraint_rate_tolerance, t, self.tick,
             self._swing_every, self._reach)
         if status == CHECK_NON_FINITE:
-            raise SimulationStopped(f'the formation state became non-finite at t = {t:.3f} s')
+            raise SimulationStopped(stop_message(status, cable, 0.0, t, sim))
         self.residuals = (g, g_dot)
         gust = self.payload_gust = self.model.gust_velocity_at_payload(t, self.state)
         if self.scenario.gusts:
             east, north, up = gust.tolist()  # the engine's arithmetic (engine.tick.check)
             self.stats.add_gust_speed(math.sqrt(east * east + north * north + up * up))
-        if status == CHECK_G:
-            raise SimulationStopped(
-                f'cable {cable + 1}: constraint residual |g| = {abs(g[cable]):.3g} m^2 exceeds '
-                f'the tolerance {sim.constraint_tolerance:g} m^2 at t = {t:.3f} s '
-                '(Algorithm 1: change the step or the Baumgarte gains)')
-        if status == CHECK_G_DOT:
-            raise SimulationStopped(
-                f'cable {cable + 1}: constraint rate |g_dot| = {abs(g_dot[cable]):.3g} m^2/s '
-                f'exceeds the tolerance {sim.constraint_rate_tolerance:g} m^2/s at t = {t:.3f} s')
+        if status in (CHECK_G, CHECK_G_DOT):
+            value = abs(g[cable]) if status == CHECK_G else abs(g_dot[cable])
+            raise SimulationStopped(stop_message(status, cable, value, t, sim))

@@ -24,7 +24,7 @@ import numpy as np
 from multilift_control.answer_messages import AnswerMessages
 from multilift_control.engine import Engine
 from multilift_control.engine.arrays import MODE_CASCADE, TickRecord, engine_flies
-from multilift_control.headless import FlownRun, HeadlessRun, run_headless
+from multilift_control.headless import FlownRun, HeadlessRun, progress_ticker, run_headless
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
@@ -208,7 +208,7 @@ def record_headless(scenario: Scenario, bag_dir: Path, progress: Progress | None
             raise SimulationStopped(run.error)
         bag = EngineBag(scenario, engine, writer)
         record = engine.new_record(CHUNK_TICKS)
-        t_max = float(engine.arrays.tick_count[0] * engine.arrays.period_ns[0] * 1e-9)
+        t_max = float(engine.t_max[0])
         while engine.running[0]:
             first = int(engine.memory.tick[0])
             flown = int(engine.step(CHUNK_TICKS, record)[0])
@@ -235,13 +235,14 @@ def _record_per_object(scenario: Scenario, bag_dir: Path, progress: Progress | N
     writer = BagWriter(bag_dir)
     bag = HeadlessBag(scenario, writer)
     simulator: list[FormationSimulator] = []
+    report = None if progress is None else progress_ticker(progress, CHUNK_TICKS)
 
     def tick(sim: FormationSimulator, snap: Snapshot, answers: list[ControllerAnswer]) -> None:
         if not simulator:
             simulator.append(sim)
         bag.tick(sim, snap, answers)
-        if progress is not None and sim.tick % CHUNK_TICKS == 0:
-            progress(sim.t, sim.tick_count * sim.period_ns * 1e-9)
+        if report is not None:
+            report(sim)
 
     try:
         return run_headless(scenario, tick, raise_on_stop)

@@ -12,8 +12,14 @@ from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAIN
                                              TickRecord, batch_arrays, empty_record)
 from multilift_sim.dynamics import StateLayout
 from multilift_sim.scenario import Scenario
+from multilift_sim.simulation import stop_message
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
+from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
+
+
+# the engine's stop statuses -> the check's codes (the simulator's words: stop_message)
+_CHECKS = {NOT_FINITE: CHECK_NON_FINITE, OFF_CONSTRAINT: CHECK_G, OFF_RATE: CHECK_G_DOT}
 
 
 class Engine:
@@ -84,6 +90,11 @@ class Engine:
         return self.memory.tick * self.arrays.period_ns * 1e-9
 
     @property
+    def t_max(self) -> np.ndarray:
+        """Each formation's duration (B,) [s]: its last tick's time."""
+        return self.arrays.tick_count * self.arrays.period_ns * 1e-9
+
+    @property
     def positions(self) -> np.ndarray:
         """UAV positions (B, n, 3) [m], world."""
         n = self.n_uavs
@@ -110,19 +121,12 @@ class Engine:
 
     def stop_reason(self, b: int) -> str | None:
         """Why formation b stopped, in the simulator's words (None while it has not)."""
-        status, t = int(self.memory.status[b]), float(self.t[b])
-        cable, value = int(self.memory.worst_cable[b]) + 1, float(self.memory.worst_value[b])
-        tolerances = self.arrays.tolerances[b]
-        if status == NOT_FINITE:
-            return f'the formation state became non-finite at t = {t:.3f} s'
-        if status == OFF_CONSTRAINT:
-            return (f'cable {cable}: constraint residual |g| = {value:.3g} m^2 exceeds the '
-                    f'tolerance {tolerances[0]:g} m^2 at t = {t:.3f} s (Algorithm 1: change '
-                    'the step or the Baumgarte gains)')
-        if status == OFF_RATE:
-            return (f'cable {cable}: constraint rate |g_dot| = {value:.3g} m^2/s exceeds the '
-                    f'tolerance {tolerances[1]:g} m^2/s at t = {t:.3f} s')
-        return None
+        check = _CHECKS.get(int(self.memory.status[b]))
+        if check is None:
+            return None
+        return stop_message(check, int(self.memory.worst_cable[b]),
+                            float(self.memory.worst_value[b]), float(self.t[b]),
+                            self.scenarios[b].simulation)
 
     # ----------------------------------------------------------------------------- figures
     def summary(self, b: int = 0, wall_time: float | None = None) -> dict:

@@ -29,7 +29,16 @@ SCENARIOS = ROOT / 'scenarios'
 LAYERS = {'unit': 'no ROS graph, no processes (tests/unit/)',
           'ros': 'starts processes or talks to a ROS graph (tests/ros/)'}
 T = TypeVar('T')
-_domains = itertools.count(int(os.environ.get('ROS_DOMAIN_ID', '77')) % 50 + 20)
+# ROS domains: each pytest process (pytest-xdist worker gwK of W, or the one process) draws
+# from a band of its own, so concurrent workers never share a domain; every test that starts a
+# graph takes its domain from next_domain() (the one allocator)
+# 1..101: higher domains' ports fall in Linux's ephemeral range (ROS 2's domain ID guide)
+DOMAIN_BANDS = range(1, 102)
+_worker = int(os.environ.get('PYTEST_XDIST_WORKER', 'gw0')[2:])
+_workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
+_band = DOMAIN_BANDS[_worker * len(DOMAIN_BANDS) // _workers:
+                     (_worker + 1) * len(DOMAIN_BANDS) // _workers]
+_domains = itertools.count(int(os.environ.get('ROS_DOMAIN_ID', '77')))
 
 
 def pytest_configure(config) -> None:
@@ -68,8 +77,19 @@ def pytest_sessionstart(session) -> None:
     remove_stale_files()
 
 
+# The longest test files (a minute or more of wall time each) first: pytest-xdist hands a
+# worker one file at a time in this order, so none of them is left to run alone at the end.
+LONGEST_FIRST = ('test_killed_runs.py', 'test_formation_missions.py', 'test_compose.py',
+                 'test_end_to_end.py', 'test_robustness.py')
+
+
 def pytest_collection_modifyitems(config, items) -> None:
-    """Mark every test with its layer, the folder it lives in (`-m unit`, `-m ros`)."""
+    """Mark every test with its layer, the folder it lives in (`-m unit`, `-m ros`); the
+    LONGEST_FIRST files first (the order within a file kept)."""
+    def rank(item) -> int:
+        name = Path(str(item.fspath)).name
+        return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
+    items.sort(key=rank)
     for item in items:
         layer = Path(str(item.fspath)).resolve().relative_to(TESTS).parts[0]
         if layer in LAYERS:
@@ -92,8 +112,34 @@ def twin():
 
 
 def next_domain() -> int:
-    """A ROS domain no earlier test of this session used (1..100, round robin)."""
-    return next(_domains) % 100 + 1
+    """A ROS domain no earlier test of this pytest process used and no other worker of the
+    session uses (round robin over this process's band of DOMAIN_BANDS)."""
+    return _band[next(_domains) % len(_band)]
+
+
+@pytest.fixture
+def multilift_domain(monkeypatch) -> int:
+    """multilift_tools.testing's fixture of that name, on a domain of next_domain()'s (this
+    suite runs in parallel workers: a domain from the pid, as the plugin draws it, could be
+    another worker's)."""
+    domain = next_domain()
+    monkeypatch.setenv('ROS_DOMAIN_ID', str(domain))
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    return domain
+
+
+@pytest.fixture(autouse=True)
+def restored_environ():
+    """os.environ after each test restored to what it was before, whatever the test or the code
+    it calls set there directly. Autouse, so it is set up before and torn down after the
+    test's own fixtures, monkeypatch included. (use_fastdds_profile names its profile in
+    os.environ: left behind in a pytest worker, it gave the worker's later runs rmw's shared
+    memory and no live view.)"""
+    saved = dict(os.environ)
+    yield os.environ
+    if dict(os.environ) != saved:
+        os.environ.clear()
+        os.environ.update(saved)
 
 
 @pytest.fixture

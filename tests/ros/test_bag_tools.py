@@ -3,7 +3,7 @@
 Bags to start from are built with BagWriter (deterministic, fast) or recorded by a real
 `scripts/multilift run`; the tools run as separate processes (`scripts/multilift bag ...` once
 cli.py dispatches to bag_tools, else bag_main directly) on a ROS domain of this module's own
-(2-9, drawn from the pid), discovery on localhost only. Every process is started in a session of
+(conftest.next_domain), discovery on localhost only. Every process is started in a session of
 its own and killed (its whole group) at teardown, also when a test fails.
 """
 
@@ -35,9 +35,9 @@ from multilift_sim.bagyaml import OfferedQos, qos_yaml
 from multilift_tools.topic_tools import RateWindow, format_hz
 from multilift_sim.topics import run_topics
 
-from conftest import ROOT
+from conftest import ROOT, next_domain
 MULTILIFT = ROOT / 'scripts' / 'multilift'
-DOMAIN = 2 + os.getpid() % 8
+DOMAIN = next_domain()
 ENV = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
            TZ='UTC', PYTHONUNBUFFERED='1')
 LATCHED = qos_yaml([OfferedQos()])  # reliable + transient_local, as our nodes offer

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from conftest import ROOT, SCENARIOS, wait_for, wait_until_simulated
+from conftest import ROOT, SCENARIOS, next_domain, wait_for, wait_until_simulated
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 
@@ -34,7 +34,8 @@ def stamp_ns(msg) -> int:
 
 @pytest.fixture(scope='module')
 def single_lift_bag(tmp_path_factory):
-    env = dict(os.environ, ROS_DOMAIN_ID='41', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    env = dict(os.environ, ROS_DOMAIN_ID=str(next_domain()),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     bag = tmp_path_factory.mktemp('run') / 'single_lift'
     out = subprocess.run([MULTILIFT, 'run', 'single_lift', '--duration', '12', '--bag', str(bag)],
                          capture_output=True, text=True, timeout=300, env=env)

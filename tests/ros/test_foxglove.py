@@ -2,9 +2,10 @@
 Foxglove layout.
 
 The bridge runs as a separate process (`scripts/multilift foxglove` once cli.py dispatches to it,
-else foxglove_main directly) on a free port and a ROS domain of this module's own (10-17, drawn
-from the pid), discovery on localhost only; the test process publishes /payload/odom and is the
-WebSocket client (the `websockets` package, subprotocol foxglove.sdk.v1, as the Foxglove app).
+else foxglove_main directly) on a free port and a ROS domain of this module's own
+(conftest.next_domain), discovery on localhost only; the test process publishes /payload/odom
+and is the WebSocket client (the `websockets` package, subprotocol foxglove.sdk.v1, as the
+Foxglove app).
 """
 
 from __future__ import annotations
@@ -30,8 +31,8 @@ from websockets.sync.client import connect
 from multilift_sim import msgdefs
 from multilift_tools.foxglove_bridge import SUBPROTOCOL, is_bridged, stamp_ns
 
-from conftest import ROOT
-DOMAIN = 10 + os.getpid() % 8
+from conftest import ROOT, next_domain
+DOMAIN = next_domain()
 ENV = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
            PYTHONUNBUFFERED='1')
 LATCHED = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,

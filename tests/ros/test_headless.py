@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from conftest import ROOT
+from conftest import ROOT, next_domain
 from multilift_tools.bagdata import load_run
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
@@ -18,7 +18,7 @@ MULTILIFT = str(ROOT / 'scripts' / 'multilift')
 @pytest.fixture(scope='module')
 def twin_bags(tmp_path_factory):
     root = tmp_path_factory.mktemp('headless')
-    env = dict(os.environ, ROS_DOMAIN_ID=os.environ.get('MULTILIFT_TEST_DOMAIN', '51'),
+    env = dict(os.environ, ROS_DOMAIN_ID=str(next_domain()),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     for mode in ('ros', 'headless'):
         args = [MULTILIFT, 'run', 'twin_lift', '--duration', '6', '--bag', str(root / mode)]

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT, raw_messages
+from conftest import ROOT, next_domain, raw_messages
 from multilift_sim.ros.fastdds import FASTDDS_PROFILE
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')
@@ -30,7 +30,7 @@ DEPLOYMENT = ROOT / 'docs' / 'deployment.md'
 SCENARIO = 'twin_lift'
 DURATION = '5'
 RUN_TIMEOUT = 300.0  # [s] wall, a loaded machine included
-DOMAIN = os.environ.get('MULTILIFT_TEST_DOMAIN') or os.environ.get('ROS_DOMAIN_ID', '77')
+DOMAIN = str(next_domain())
 SIM_ADDRESS, CONTROLLER_ADDRESS = '10.77.0.1', '10.77.0.2'
 DEVICES = ('mlsim0', 'mlctl0')  # the veth's ends, each inside its namespace
 PROFILE_VARIABLES = ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE',

@@ -2,8 +2,8 @@
 
 The test process publishes known messages; the recorder runs as `scripts/multilift node
 multilift_sim recorder_node ...` when that script exists, else as the installed console script.
-The module has a ROS domain of its own (50-74, drawn from the pid, so that two runs of the suite at
-once on a shared machine do not hear each other), discovery on localhost only.
+The module has a ROS domain of its own (conftest.next_domain: no other test or worker has it),
+discovery on localhost only.
 """
 
 from __future__ import annotations
@@ -32,8 +32,8 @@ from multilift_sim.bag import recover
 from multilift_sim import recording
 from multilift_sim.recording import LogTime, is_recordable, parse_topic_spec
 
-from conftest import ROOT
-DOMAIN = 50 + os.getpid() % 25
+from conftest import ROOT, next_domain
+DOMAIN = next_domain()
 LATCHED = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 DDS_ENV = {'ROS_DOMAIN_ID': str(DOMAIN), 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}

@@ -18,7 +18,7 @@ import yaml
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from conftest import ROOT, SCENARIOS, raw_messages, wait_for, wait_until_simulated
+from conftest import ROOT, SCENARIOS, next_domain, raw_messages, wait_for, wait_until_simulated
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
 from multilift_sim.allocation import FRAME_TYPES
@@ -332,7 +332,8 @@ def test_ros_runs_give_byte_identical_state_messages(tmp_path):
 
 def test_two_runs_on_different_domains_do_not_see_each_other(tmp_path):
     runs = []
-    for domain, (name, n) in zip((13, 14), (('single_lift', 1), ('twin_lift', 2))):
+    domains = (next_domain(), next_domain())
+    for domain, (name, n) in zip(domains, (('single_lift', 1), ('twin_lift', 2))):
         bag = tmp_path / name
         proc = subprocess.Popen([MULTILIFT, 'run', name, '--duration', '3', '--bag', str(bag)],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -551,7 +552,7 @@ def test_the_fastdds_profile_is_written_and_parsed_and_a_users_own_wins(tmp_path
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', discovery)
-    monkeypatch.setenv('ROS_DOMAIN_ID', '16')
+    monkeypatch.setenv('ROS_DOMAIN_ID', str(next_domain()))
     default_env = dict(os.environ)
     path = use_fastdds_profile()
     assert path == tmp_path / 'cache' / 'multilift' / file
@@ -587,7 +588,7 @@ def test_our_localhost_participants_and_anyone_elses_hear_each_other(monkeypatch
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'cache'))
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    monkeypatch.setenv('ROS_DOMAIN_ID', '17')
+    monkeypatch.setenv('ROS_DOMAIN_ID', str(next_domain()))
     theirs = dict(os.environ)
     use_fastdds_profile()
     ours = dict(os.environ)

@@ -1,7 +1,7 @@
 """`multilift topic ...` and `multilift node ...` (cli_tools), against live publishers.
 
 The tools run as separate processes (`scripts/multilift` when it exists, else cli_tools directly)
-on a ROS domain of this module's own (75-99, drawn from the pid), discovery on localhost only.
+on a ROS domain of this module's own (conftest.next_domain), discovery on localhost only.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from std_msgs.msg import Byte, ByteMultiArray, Int64
 
 from multilift_sim.ros.introspection import message_to_ordered, message_to_yaml
 
-from conftest import ROOT, wait_for
-DOMAIN = 75 + os.getpid() % 25
+from conftest import ROOT, next_domain, wait_for
+DOMAIN = next_domain()
 ENV = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
 LATCHED = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)

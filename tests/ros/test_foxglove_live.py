@@ -132,7 +132,7 @@ def stamp(message) -> int | None:
 
 @pytest.fixture
 def ros_env(multilift_domain) -> dict:
-    """The test's own domain (multilift_tools.testing: MULTILIFT_TEST_DOMAIN when given), so no
+    """The test's own domain (multilift_domain: conftest's, next_domain), so no
     other run on this machine shows up in the bridge."""
     return dict(os.environ)
 

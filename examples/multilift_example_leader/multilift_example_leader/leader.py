@@ -6,12 +6,7 @@ twist in the body frame) and waits, at every control tick, for one /uav1/rotor_c
 the state it answers. This node answers with the project's cascade controller following the
 scenario's mission; put your own control law in `control()`.
 
-Written the usual way: default QoS (reliable, volatile) on both topics, with one change: the
-command publisher keeps 100 commands, not 10. The simulator runs in lockstep with its
-controllers, not with the recorder; on a loaded machine the recorder can fall more than 10 ticks
-behind, and a reliable writer that keeps 10 overwrites a command the recorder has not yet
-received (a packet dropped on a full socket buffer is then never resent): the run is the same,
-but the bag lacks that command (seen here: 2 of 200 under two parallel test workers).
+Written the usual way: default QoS (reliable, volatile, depth 10) on both topics.
 
     ros2 run multilift_example_leader leader --ros-args -p scenario:=single_lift
 """
@@ -34,7 +29,7 @@ class ExampleLeader(Node):
         super().__init__('example_leader')
         name = self.declare_parameter('scenario', 'single_lift').value
         self.controller = make_controller(scenario_io.load(name), index=0)
-        self.command_pub = self.create_publisher(RotorCommand, '/uav1/rotor_cmd', 100)
+        self.command_pub = self.create_publisher(RotorCommand, '/uav1/rotor_cmd', 10)
         self.create_subscription(Odometry, '/uav1/odom', self.on_odometry, 10)
         self.answered = 0
 

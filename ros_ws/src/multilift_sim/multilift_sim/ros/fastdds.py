@@ -32,9 +32,18 @@ from pathlib import Path
 # runs here). So our participants announce themselves to this many ids: the processes of a V of
 # 30 with its recorder, a live view and a few tools.
 LOCALHOST_PARTICIPANTS = 64
+# - Receive buffers of 4 MiB (RECEIVE_BUFFER; the kernel caps them at net.core.rmem_max): a
+#   node's socket receives every topic it reads, and the recorder's took a lockstep run's
+#   traffic of about 40 ms at the OS default (208 KiB) before the kernel dropped datagrams
+#   (this machine counted 454,506 UDP receive-buffer errors after a day of tests). Our writers
+#   resend what was dropped; a user's writer that keeps 10 messages and announces every 3 s
+#   (Fast DDS's defaults) has overwritten them by then: seen as 6 of 50 commands missing from
+#   a bag under two parallel test workers.
+RECEIVE_BUFFER = 4 * 1024 * 1024  # [bytes]
 _TRANSPORT = """    <transport_descriptor>
       <transport_id>multilift_udp</transport_id>
-      <type>UDPv4</type>{whitelist}
+      <type>UDPv4</type>
+      <receiveBufferSize>{receive}</receiveBufferSize>{whitelist}
     </transport_descriptor>"""
 _LOCALHOST_TRANSPORT = """
       <interfaceWhiteList><address>127.0.0.1</address></interfaceWhiteList>
@@ -88,7 +97,8 @@ def fastdds_profile(localhost: bool, announcement: float | None = None) -> str:
                 nanosec=int(round(announcement * 1e9))),
             localhost=_LOCALHOST_DISCOVERY if localhost else '')
     return _PROFILE.format(
-        transport=_TRANSPORT.format(whitelist=_LOCALHOST_TRANSPORT if localhost else ''),
+        transport=_TRANSPORT.format(receive=RECEIVE_BUFFER,
+                                    whitelist=_LOCALHOST_TRANSPORT if localhost else ''),
         discovery=builtin)
 
 

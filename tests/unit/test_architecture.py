@@ -1,6 +1,6 @@
 """The package layering, read from the sources (ast, nothing imported):
 
-    multilift_msgs <- multilift_sim <- multilift_control <- multilift_tools
+    multilift_msgs <- multilift_sim <- multilift_control <- multilift_tools <- multilift_learning
 
 - no cycle between packages;
 - every package imported by a package's code is declared in its package.xml (`<depend>` or
@@ -40,6 +40,7 @@ THIRD_PARTY = {
     'pandas': 'python3-pandas', 'psutil': 'python3-psutil', 'jinja2': 'python3-jinja2',
     'numba': 'python3-numba',
     'zstandard': 'python3-zstandard', 'tqdm': 'python3-tqdm', 'lark': 'python3-lark',
+    'gymnasium': 'python3-gymnasium',
 }
 # ROS packages imported by their own name that are the ROS runtime (not messages)
 ROS_RUNTIME = frozenset({'rclpy', 'rosidl_runtime_py', 'rpyutils', 'rosbag2_py'})
@@ -215,7 +216,7 @@ WORKSPACE = load_workspace(SRC)
 
 def test_the_workspace_is_read():
     assert WORKSPACE.packages >= {'multilift_msgs', 'multilift_sim', 'multilift_control',
-                                  'multilift_tools'}
+                                  'multilift_tools', 'multilift_learning'}
     assert 'multilift_sim.ros.common' in WORKSPACE.modules
     assert 'rclpy' in WORKSPACE.modules['multilift_sim.ros.common'].imports
 
@@ -233,7 +234,8 @@ def test_the_core_reaches_no_rclpy_and_no_message_type():
 
 
 def test_packages_import_one_way():
-    order = ['multilift_msgs', 'multilift_sim', 'multilift_control', 'multilift_tools']
+    order = ['multilift_msgs', 'multilift_sim', 'multilift_control', 'multilift_tools',
+             'multilift_learning']
     for module in WORKSPACE.modules.values():
         for name in module.imports:
             if _top(name) in order:

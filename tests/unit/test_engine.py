@@ -104,3 +104,26 @@ def test_a_stopped_formation_stops_alone_and_says_why():
 def test_formations_of_different_shapes_are_refused():
     with pytest.raises(ValueError, match='differ in the shape'):
         Engine([scenario_io.load('twin_lift'), scenario_io.load('circle3')])
+
+
+def test_answers_from_outside_fly_the_engine_s_own_tick_to_the_bit():
+    """answer() then step_commanded() (a learning environment's step) is the tick step() runs;
+    reset(which) starts those formations again and leaves the others."""
+    scenarios = [_short('circle3', 1.0), _short('circle3', 1.0, cable_model='slack')]
+    own, commanded = Engine(scenarios), Engine(scenarios)
+    own.step(40)
+    for _ in range(40):
+        speeds, saturated = commanded.answer()  # once per tick: the controllers advance
+        commanded.step_commanded(speeds, saturated)
+    assert np.array_equal(own.state, commanded.state)
+    assert np.array_equal(own.memory.run, commanded.memory.run)
+    assert np.array_equal(own.memory.follower_memory, commanded.memory.follower_memory)
+    later = commanded.state[1].copy()
+    commanded.reset(np.array([True, False]))
+    assert commanded.memory.tick.tolist() == [0, 40]
+    assert np.array_equal(commanded.state[0], Engine(scenarios[0]).state[0])
+    assert np.array_equal(commanded.state[1], later)
+    commanded.step_commanded(np.full((2, 3, 4), 1500.0), which=np.array([False, True]))
+    assert commanded.memory.tick.tolist() == [0, 41]
+    with pytest.raises(ValueError, match='speeds must be'):
+        commanded.step_commanded(np.zeros((2, 3, 3)))

@@ -10,6 +10,7 @@ from multilift_control.engine import tick as compiled
 from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAINT, OFF_RATE,
                                              RUNNING, FormationArrays, FormationMemory,
                                              TickRecord, batch_arrays, empty_record)
+from multilift_control.laws.layout import UAV_STATE_SIZE
 from multilift_sim.dynamics import StateLayout
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import stop_message
@@ -51,6 +52,14 @@ class Engine:
         self.layout = StateLayout(self.n_uavs)
         self._run_ticks = laws.runnable(compiled.run_ticks)
         self._start = laws.runnable(compiled.start)
+        self._measure_all = laws.runnable(compiled.measure_all)
+        self._answer_all = laws.runnable(compiled.answer_all)
+        self._run_commanded = laws.runnable(compiled.run_commanded)
+        rotors = self.arrays.allocation.shape[-1]
+        self._tension = np.zeros((self.batch, self.n_uavs))
+        self._measured = np.empty((self.batch, self.n_uavs, UAV_STATE_SIZE))
+        self._answer = (np.zeros((self.batch, self.n_uavs, rotors)),
+                        np.zeros((self.batch, self.n_uavs, rotors), dtype=bool))
         self._no_record = empty_record(self.arrays, 0)
         self.reset()
 
@@ -58,10 +67,20 @@ class Engine:
     def batch(self) -> int:
         return len(self.scenarios)
 
-    def reset(self) -> None:
-        """Every formation back to its scenario's start (t = 0, controllers' memories empty)."""
-        self.memory = FormationMemory(*(np.array(field, copy=True) for field in self._initial))
-        self._start(self.arrays, self.memory)
+    def reset(self, which: np.ndarray | None = None) -> None:
+        """Every formation (or those where `which` (B,) bool is set) back to its scenario's
+        start (t = 0, controllers' memories and run figures empty)."""
+        if which is None or not hasattr(self, 'memory'):
+            self.memory = FormationMemory(*(np.array(field, copy=True)
+                                            for field in self._initial))
+            which = np.ones(self.batch, dtype=bool)
+        else:
+            which = np.asarray(which, dtype=bool)
+            if which.shape != (self.batch,):
+                raise ValueError(f'which must be ({self.batch},) bool, got {which.shape}')
+            for field, initial in zip(self.memory, self._initial):
+                field[which] = initial[which]
+        self._start(self.arrays, self.memory, which)
 
     def step(self, ticks: int = 1, record: TickRecord | None = None) -> np.ndarray:
         """Up to `ticks` control ticks of each running formation; with `record`
@@ -73,6 +92,39 @@ class Engine:
             raise ValueError(f'the record holds {record.speeds.shape[0]} ticks, not {ticks}')
         return self._run_ticks(self.arrays, self.memory, int(ticks),
                                self._no_record if record is None else record)
+
+    def measured(self) -> np.ndarray:
+        """Every formation's measured UAV states (B, n, UAV_STATE_SIZE) at its current tick
+        (multilift_control.laws.layout slots: position, velocity (world), roll/pitch/yaw,
+        body rates); a view the next call overwrites."""
+        self._measure_all(self.arrays, self.memory, self._measured)
+        return self._measured
+
+    def answer(self) -> tuple[np.ndarray, np.ndarray]:
+        """The scenario's own controllers' rotor speeds (B, n, rotors) [rad/s] and saturation
+        flags for every running formation at its current tick, as a tick computes them (the
+        controllers' memories advance: call it once per tick, before `step_commanded`).
+        Views the next call overwrites."""
+        speeds, saturated = self._answer
+        self._answer_all(self.arrays, self.memory, self.measured(), speeds, saturated)
+        return speeds, saturated
+
+    def step_commanded(self, speeds: np.ndarray, saturated: np.ndarray | None = None,
+                       which: np.ndarray | None = None) -> np.ndarray:
+        """One control tick of every running formation (those in `which` (B,) bool) under the
+        given rotor speeds (B, n, rotors) [rad/s], held over the control period (seed Eq.
+        2.14, RK4), then Algorithm 1's check; `saturated` flags speeds at a limit (the run's
+        saturation figure; default none). Returns the cable tensions (B, n) [N] of the tick
+        (a formation not stepped keeps its row)."""
+        speeds = np.ascontiguousarray(speeds, dtype=float)
+        if speeds.shape != self._answer[0].shape:
+            raise ValueError(f'speeds must be {self._answer[0].shape}, got {speeds.shape}')
+        if saturated is None:
+            saturated = np.zeros(speeds.shape, dtype=bool)
+        which = np.ones(self.batch, dtype=bool) if which is None else np.asarray(which, bool)
+        self._run_commanded(self.arrays, self.memory, speeds,
+                            np.ascontiguousarray(saturated, dtype=bool), which, self._tension)
+        return self._tension
 
     def new_record(self, ticks: int) -> TickRecord:
         """Arrays for `ticks` ticks of every formation (`step`'s record)."""

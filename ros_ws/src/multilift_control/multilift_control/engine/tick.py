@@ -109,15 +109,11 @@ def check(a, m, b):
 
 
 @jit
-def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference, errors,
-                   rates, tension):
-    """One control tick of formation b: measure, answer, hold the speeds over the control
-    period (RK4), then check; the tension T_i = 2 l_i lambda_i [N] at the tick into tension."""
-    n = states.shape[0]
-    t = m.tick[b] * a.period_ns[b] * 1e-9
-    measured_states(m.state[b], n, states)
-    answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
-                     errors, rates)
+def advance_formation(a, m, b, speeds, saturated, tension):
+    """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
+    limit) held over the control period (RK4), then checked; the tension T_i = 2 l_i lambda_i
+    [N] at the tick into tension. The second half of a tick, whoever answered."""
+    n = speeds.shape[0]
     period = a.period_ns[b] * 1e-9
     run_add_commands(m.run[b], speeds, saturated, period)
     wrenches = np.empty((n, WRENCH_COLUMNS))
@@ -145,9 +141,63 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
 
 
 @jit
-def start(a, m):
-    """Every formation's residuals and check at its initial state (before the first tick)."""
+def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference, errors,
+                   rates, tension):
+    """One control tick of formation b: measure, answer, hold the speeds over the control
+    period (RK4), then check; the tension T_i = 2 l_i lambda_i [N] at the tick into tension."""
+    n = states.shape[0]
+    t = m.tick[b] * a.period_ns[b] * 1e-9
+    measured_states(m.state[b], n, states)
+    answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
+                     errors, rates)
+    advance_formation(a, m, b, speeds, saturated, tension)
+
+
+@jit
+def measure_all(a, m, states):
+    """Every formation's measured states (B, n, UAV_STATE_SIZE) at its current tick."""
+    n = a.uavs.shape[1]
     for b in range(m.state.shape[0]):
+        measured_states(m.state[b], n, states[b])
+
+
+@jit
+def answer_all(a, m, states, speeds, saturated):
+    """The scenario's own controllers' answers (speeds, saturated: (B, n, rotors)) to every
+    running formation's measured `states` (B, n, UAV_STATE_SIZE) at its current tick, as a
+    tick gives them (their memories and the run's tracking figures advance with it)."""
+    n = a.uavs.shape[1]
+    rows = a.targets.shape[1]
+    setpoints = np.empty((n, 3))
+    thrust = np.empty(n)
+    reference = np.empty(REFERENCE_SIZE)
+    errors = np.full((n, max(rows, 1)), math.nan)
+    rates = np.full((n, max(rows, 1)), math.nan)
+    for b in range(m.state.shape[0]):
+        if m.status[b] != RUNNING:
+            continue
+        t = m.tick[b] * a.period_ns[b] * 1e-9
+        answer_formation(a, m, b, t, states[b], speeds[b], saturated[b], setpoints, thrust,
+                         reference, errors, rates)
+
+
+@jit
+def run_commanded(a, m, speeds, saturated, which, tension):
+    """One control tick of every running formation b with which[b] under the given rotor
+    speeds (B, n, rotors) [rad/s] (`advance_formation`); the tensions (B, n) [N] into
+    tension."""
+    for b in range(m.state.shape[0]):
+        if which[b] and m.status[b] == RUNNING:
+            advance_formation(a, m, b, speeds[b], saturated[b], tension[b])
+
+
+@jit
+def start(a, m, which):
+    """The residuals and check of each formation b with which[b] at its initial state (before
+    its first tick)."""
+    for b in range(m.state.shape[0]):
+        if not which[b]:
+            continue
         residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
         check(a, m, b)
         if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:

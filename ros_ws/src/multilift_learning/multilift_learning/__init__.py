@@ -1,0 +1,24 @@
+"""Learning environments of multilift (issue "Learning environments"), registered with
+Gymnasium on import:
+
+    import gymnasium, multilift_learning
+    env = gymnasium.make('multilift/Hover-v0')                     # twin_lift, hover
+    env = gymnasium.make('multilift/Mission-v0', scenario='multi_lift')
+    envs = gymnasium.make_vec('multilift/Hover-v0', num_envs=256)  # one batched engine
+
+Spaces, rewards and ends: multilift_learning.batch; tasks: multilift_learning.tasks.
+"""
+from __future__ import annotations
+
+import gymnasium
+
+ENVIRONMENTS = {
+    'multilift/Hover-v0': 'hover',
+    'multilift/Mission-v0': 'mission',
+}
+
+for _id, _task in ENVIRONMENTS.items():
+    if _id not in gymnasium.registry:
+        gymnasium.register(id=_id, entry_point='multilift_learning.env:FormationEnv',
+                           vector_entry_point='multilift_learning.vector_env:FormationVectorEnv',
+                           kwargs={'task': _task})

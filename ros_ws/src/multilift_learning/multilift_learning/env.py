@@ -1,0 +1,69 @@
+"""`FormationEnv`: one formation of a task as a Gymnasium environment (`multilift/Hover-v0`,
+`multilift/Mission-v0`); the spaces, rewards and ends are `multilift_learning.batch`'s."""
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+
+from multilift_learning.batch import REWARD_WEIGHTS, FormationBatch, observation_names
+from multilift_learning.tasks import scenario_of
+from multilift_sim.scenario import Scenario
+
+
+def spaces(batch: FormationBatch) -> tuple[gymnasium.spaces.Box, gymnasium.spaces.Box]:
+    """(observation space, action space) of one formation of `batch` (float64: the baseline's
+    actions keep every bit of the controllers' rotor speeds)."""
+    size = len(observation_names(batch.n))
+    observation = gymnasium.spaces.Box(-np.inf, np.inf, (size,), np.float64)
+    action = gymnasium.spaces.Box(-1.0, 1.0, (batch.n * batch.rotors,), np.float64)
+    return observation, action
+
+
+class FormationEnv(gymnasium.Env):
+    """A formation carrying its payload, one control tick a step (the scenario's control
+    period). `scenario`: a name, a path or a Scenario; `overrides`: {'payload.mass': 1.2, ...}
+    (the keys of `multilift sweep --set`); `duration` [s]: the episode's length (the
+    scenario's by default); `task`: 'hover' or 'mission' (multilift_learning.tasks);
+    `target_radius` [m]: hover's targets drawn within it.
+
+    `expert_action()` is the seed's controller's answer at the current state: the baseline."""
+
+    metadata = {'render_modes': []}
+
+    def __init__(self, scenario: str | Scenario = 'twin_lift', task: str = 'hover',
+                 overrides: dict[str, Any] | None = None, duration: float | None = None,
+                 target_radius: float = 0.5):
+        self.batch = FormationBatch([scenario_of(scenario, overrides, duration)], task,
+                                    target_radius)
+        self.observation_space, self.action_space = spaces(self.batch)
+        self.observation_names = observation_names(self.batch.n)
+        self.reward_weights = dict(REWARD_WEIGHTS)
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        self.batch.rngs = [self.np_random]
+        self.batch.reset()
+        observation, _ = self.batch.observe()
+        return observation[0], self._info()
+
+    def step(self, action):
+        action = np.asarray(action, dtype=float)[None]
+        self.batch.step(action)
+        observation, seen = self.batch.observe()
+        reward, terms = self.batch.reward(seen, action)
+        terminated, truncated = self.batch.ends(seen)
+        info = self._info()
+        info['reward_terms'] = {name: float(value[0]) for name, value in terms.items()}
+        return observation[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), info
+
+    def expert_action(self) -> np.ndarray:
+        """The seed's controllers' answer to the current state, as an action (the baseline
+        policy); the same until the next step."""
+        return self.batch.expert_actions()[0]
+
+    def _info(self) -> dict:
+        engine = self.batch.engine
+        return {'t': float(engine.t[0]), 'tension': self.batch.tension[0].copy(),
+                'stop_reason': engine.stop_reason(0)}

@@ -1,0 +1,131 @@
+"""The tasks a learning environment poses (one registry, `TASKS`), and the scenario it flies.
+
+A task says where the payload should be at each tick (its target, world frame z up [m], and
+the target's velocity [m/s]) and how a reset draws it. Every environment's observation and
+reward are built on that target (`multilift_learning.batch`).
+
+- `hover`: hold the payload still at its rest place under the UAVs' start (statistics.swing.
+  equilibrium_point: a scenario may release it swinging) moved by a horizontal offset drawn
+  at each reset, uniform in a disc of `target_radius` [m] (0: the rest place itself). The
+  scenario's leader, when it has a mission, gets one that hovers there (`task_scenario`; the
+  mission's place follows each draw), so the seed's controllers hold the target too.
+- `mission`: follow the scenario's mission (seed §4.2): the payload's target is the leader's
+  mission reference (`multilift_control.laws.reference.mission_reference`) less the leader's
+  start offset from the payload's rest place; its velocity the reference's.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+import yaml
+
+from multilift_control import laws
+from multilift_control.laws.layout import (MISSION_FINAL, MISSION_START, REFERENCE_POSITION,
+                                           REFERENCE_VELOCITY, SEGMENT_ORIGIN)
+from multilift_control.laws.reference import mission_reference
+from multilift_sim import scenario as scenario_io
+from multilift_sim.scenario import MissionSegment, Scenario
+from multilift_tools.campaign import edited, format_value, load_base, parse_key
+
+
+@dataclass(frozen=True)
+class Task:
+    """A task's name, what it asks, and whether it needs the scenario's mission."""
+    name: str
+    summary: str
+    needs_mission: bool
+
+
+TASKS = {
+    'hover': Task('hover', 'hold the payload still at a point drawn near its start', False),
+    'mission': Task('mission', "follow the scenario's mission with the payload", True),
+}
+
+
+def task(name: str) -> Task:
+    """The registered task `name` (ValueError naming the known ones otherwise)."""
+    if name not in TASKS:
+        raise ValueError(f'unknown task {name!r}: one of {", ".join(TASKS)}')
+    return TASKS[name]
+
+
+def scenario_of(source: str | Scenario, overrides: dict[str, Any] | None = None,
+                duration: float | None = None) -> Scenario:
+    """The scenario an environment flies: a Scenario, or a scenario name or path with
+    `overrides` ({'payload.mass': 1.2, ...}: the keys of `multilift sweep --set`), validated by
+    the scenario loader; `duration` [s] replaces simulation.duration (the episode's length)."""
+    if isinstance(source, Scenario):
+        if overrides:
+            raise ValueError('overrides apply to a scenario name or path, not a Scenario')
+        scenario = source
+    elif overrides:
+        path, base = load_base(source)
+        edits = [(key, tuple(parse_key(key, 'overrides')), value)
+                 for key, value in overrides.items()]
+        label = f'{path} with ' + ', '.join(f'{k}={format_value(v)}' for k, _, v in edits)
+        scenario = scenario_io.loads(yaml.safe_dump(edited(base, edits), sort_keys=False), label)
+    else:
+        scenario = scenario_io.load(source)
+    return scenario if duration is None else scenario.with_duration(duration)
+
+
+def task_scenario(scenario: Scenario, task_name: str) -> Scenario:
+    """The scenario as `task_name` flies it: for hover, a leader with a mission hovers at its
+    start for the whole duration (one segment at rest); otherwise unchanged."""
+    if task(task_name).name != 'hover' or scenario.control.mode != 'cascade':
+        return scenario
+    hold = MissionSegment(velocity=(0.0, 0.0, 0.0), end_time=scenario.simulation.duration)
+    return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))
+
+
+class Targets:
+    """The payload's target of B formations of one engine (`engine.arrays`) under `task`:
+    `position(t)`, `velocity(t)` (B, 3) at each formation's time t (B,) [s]; `reset(which,
+    rngs)` draws new ones (hover)."""
+
+    def __init__(self, name: str, arrays, start_payload: np.ndarray, start_offsets: np.ndarray,
+                 target_radius: float):
+        self.task = task(name)
+        self.arrays = arrays
+        self.start_payload = start_payload          # (B, 3): its rest place at the start [m]
+        self.leader_offset = start_offsets[:, 0]    # (B, 3): the leader above the payload [m]
+        self.target_radius = float(target_radius)
+        if self.target_radius < 0:
+            raise ValueError(f'target_radius must be >= 0 [m], got {target_radius}')
+        self.hold = start_payload.copy()            # hover's targets (B, 3)
+        self._reference = laws.runnable(mission_reference)
+
+    def reset(self, which: np.ndarray, rngs: list[np.random.Generator]) -> None:
+        """New targets for the formations in `which` (B,) bool, each from its own generator;
+        for hover the leader's mission (its positions: start, end, each segment's origin)
+        moves with the target."""
+        a = self.arrays
+        for b in np.flatnonzero(which):
+            offset = np.zeros(3)
+            if self.task.name == 'hover' and self.target_radius > 0:
+                radius = self.target_radius * np.sqrt(rngs[b].uniform())
+                angle = rngs[b].uniform(0.0, 2.0 * np.pi)
+                offset[:2] = radius * np.cos(angle), radius * np.sin(angle)
+            shift = offset - (self.hold[b] - self.start_payload[b])
+            self.hold[b] = self.start_payload[b] + offset
+            if self.task.name == 'hover':
+                a.mission[b, MISSION_START:MISSION_START + 3] += shift
+                a.mission[b, MISSION_FINAL:MISSION_FINAL + 3] += shift
+                a.segments[b, :, SEGMENT_ORIGIN:SEGMENT_ORIGIN + 3] += shift
+
+    def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(position, velocity) of each formation's target at its time t (B,) [s]."""
+        if self.task.name == 'hover':
+            return self.hold, np.zeros_like(self.hold)
+        a = self.arrays
+        position = np.empty((len(t), 3))
+        velocity = np.empty((len(t), 3))
+        for b, tb in enumerate(t):
+            reference = self._reference(a.mission[b], a.segments[b], a.mission_steps[b],
+                                        float(tb))
+            position[b] = reference[REFERENCE_POSITION:REFERENCE_POSITION + 3] \
+                - self.leader_offset[b]
+            velocity[b] = reference[REFERENCE_VELOCITY:REFERENCE_VELOCITY + 3]
+        return position, velocity

@@ -1,0 +1,108 @@
+"""The learning environments (multilift_learning): Gymnasium's own checks, determinism, the
+baseline (the seed's controllers) equal to the engine's headless run, the vectorised
+environment equal to single ones and its autoreset as Gymnasium's NEXT_STEP defines it."""
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import multilift_learning
+from multilift_control.engine import Engine
+from multilift_learning.batch import observation_names
+from multilift_learning.tasks import task_scenario
+from multilift_learning.vector_env import FormationVectorEnv
+from multilift_sim import scenario as scenario_io
+
+
+@pytest.mark.parametrize('env_id', sorted(multilift_learning.ENVIRONMENTS))
+def test_registered_on_import_and_gymnasium_s_checker_passes(env_id):
+    env = gymnasium.make(env_id, duration=0.1)
+    check_env(env.unwrapped, skip_render_check=True)
+    observation, info = env.reset(seed=0)
+    assert observation.shape == (len(observation_names(2)),) == (38,)
+    assert env.action_space.shape == (8,) and info['t'] == 0.0
+
+
+def _episode(env, seed: int, steps: int) -> list[np.ndarray]:
+    observation, _ = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    seen = [observation]
+    for _ in range(steps):
+        observation, reward, terminated, truncated, _ = env.step(env.action_space.sample() * 0.1)
+        seen.append(np.append(observation, reward))
+    return seen
+
+
+def test_the_same_seed_gives_the_same_episode():
+    env = gymnasium.make('multilift/Hover-v0', duration=0.2)
+    first, again = _episode(env, 7, 15), _episode(env, 7, 15)
+    other = _episode(env, 8, 15)
+    assert all(np.array_equal(a, b) for a, b in zip(first, again))
+    assert not np.array_equal(first[0], other[0])  # the target drawn differs
+
+
+@pytest.mark.parametrize('env_id,name', [('multilift/Mission-v0', 'twin_lift'),
+                                         ('multilift/Mission-v0', 'multi_lift'),
+                                         ('multilift/Hover-v0', 'twin_lift')])
+def test_the_baseline_episode_is_the_headless_run(env_id, name):
+    """The seed's controllers as the policy fly what the engine flies on its own (1e-9 m),
+    tick by tick to the episode's truncation at the scenario's duration."""
+    env = gymnasium.make(env_id, scenario=name, duration=3.0, target_radius=0.0).unwrapped
+    env.reset(seed=0)
+    scenario = scenario_io.load(name).with_duration(3.0)
+    headless = Engine(task_scenario(scenario, env.batch.targets.task.name))
+    steps, baseline = 0, 0.0
+    while True:
+        _, reward, terminated, truncated, info = env.step(env.expert_action())
+        headless.step(1)
+        steps, baseline = steps + 1, baseline + reward
+        assert np.abs(env.batch.engine.state - headless.state).max() < 1e-9
+        if terminated or truncated:
+            break
+    assert truncated and not terminated and steps == 300 and headless.finished[0]
+    assert np.isfinite(baseline)
+    print(f'{env_id} {name}: return of the baseline over 3 s: {baseline:.1f}')
+
+
+def test_the_vector_env_is_single_envs_in_one_engine_with_next_step_autoreset():
+    vector = gymnasium.make_vec('multilift/Hover-v0', num_envs=3, duration=0.05)
+    assert isinstance(vector, FormationVectorEnv)  # the batched engine, no loop over envs
+    singles = [gymnasium.make('multilift/Hover-v0', duration=0.05) for _ in range(3)]
+    observations, _ = vector.reset(seed=10)
+    first = observations.copy()
+    for k, env in enumerate(singles):
+        assert np.array_equal(observations[k], env.reset(seed=10 + k)[0])
+    rng = np.random.default_rng(0)
+    for step in range(5):
+        actions = rng.uniform(-0.1, 0.1, vector.action_space.shape)
+        observations, rewards, terminated, truncated, infos = vector.step(actions)
+        for k, env in enumerate(singles):
+            single = env.step(actions[k])
+            assert np.array_equal(observations[k], single[0])
+            assert rewards[k] == single[1] and truncated[k] == single[3]
+        assert truncated.all() == (step == 4)
+    # the step after the end: each environment reset, its action ignored
+    observations, rewards, terminated, truncated, infos = vector.step(actions)
+    assert (rewards == 0).all() and not terminated.any() and not truncated.any()
+    assert (infos['t'] == 0).all()
+    assert not np.array_equal(observations, first)  # new targets drawn from each stream
+
+
+def test_bad_arguments_are_named():
+    with pytest.raises(ValueError, match='unknown task'):
+        FormationVectorEnv(2, task='juggle')
+    with pytest.raises(ValueError, match='num_envs must be >= 1'):
+        FormationVectorEnv(0)
+    with pytest.raises(ValueError, match='control.mode: cascade'):
+        gymnasium.make('multilift/Mission-v0', overrides={'control.mode': 'constant_rotor_speed'})
+    with pytest.raises(scenario_io.ScenarioError, match='payload.mass'):
+        gymnasium.make('multilift/Hover-v0', overrides={'payload.mass': -1.0})
+
+
+def test_overrides_reach_the_scenario():
+    env = gymnasium.make('multilift/Hover-v0', overrides={'payload.mass': 1.2},
+                         duration=1.0).unwrapped
+    assert env.batch.scenarios[0].payload.mass == 1.2
+    assert env.batch.engine.t_max[0] == pytest.approx(1.0)

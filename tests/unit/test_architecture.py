@@ -40,7 +40,7 @@ THIRD_PARTY = {
     'pandas': 'python3-pandas', 'psutil': 'python3-psutil', 'jinja2': 'python3-jinja2',
     'numba': 'python3-numba',
     'zstandard': 'python3-zstandard', 'tqdm': 'python3-tqdm', 'lark': 'python3-lark',
-    'gymnasium': 'python3-gymnasium',
+    'gymnasium': 'python3-gymnasium', 'pettingzoo': 'python3-pettingzoo',
 }
 # ROS packages imported by their own name that are the ROS runtime (not messages)
 ROS_RUNTIME = frozenset({'rclpy', 'rosidl_runtime_py', 'rpyutils', 'rosbag2_py'})

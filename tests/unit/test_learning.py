@@ -106,3 +106,37 @@ def test_overrides_reach_the_scenario():
                          duration=1.0).unwrapped
     assert env.batch.scenarios[0].payload.mass == 1.2
     assert env.batch.engine.t_max[0] == pytest.approx(1.0)
+
+
+def test_the_parallel_env_passes_pettingzoo_s_test_and_flies_the_baseline():
+    from pettingzoo.test import parallel_api_test
+
+    from multilift_learning.parallel_env import parallel_env
+    parallel_api_test(parallel_env(scenario='multi_lift', duration=0.2), num_cycles=30)
+    env = parallel_env(scenario='multi_lift', task='mission', duration=0.5)
+    single = gymnasium.make('multilift/Mission-v0', scenario='multi_lift', duration=0.5)
+    observations, _ = env.reset(seed=4)
+    flat, _ = single.reset(seed=4)
+    assert env.agents == ['uav1', 'uav2', 'uav3']
+    assert np.array_equal(observations['uav2'][:16], flat[16:32])
+    while env.agents:
+        observations, rewards, terminated, truncated, _ = env.step(env.expert_actions())
+        flat, reward, *_ = single.step(single.unwrapped.expert_action())
+        assert np.array_equal(observations['uav3'][-6:], flat[-6:]) and rewards['uav1'] == reward
+    assert truncated['uav1'] and not terminated['uav1']
+
+
+def test_a_population_in_one_batch_scores_as_its_candidates_alone():
+    """The example's search (examples/learning): candidates' returns from one batched
+    environment equal each candidate flown alone."""
+    import importlib.util
+
+    from conftest import ROOT
+    path = ROOT / 'examples' / 'learning' / 'tune_follower_gains.py'
+    spec = importlib.util.spec_from_file_location('tune_follower_gains', path)
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    gains = np.array([[2.1, 1.3], [1.0, 3.0], [3.0, 0.5]])
+    together = example.returns('twin_lift', 1.0, gains)
+    alone = [example.returns('twin_lift', 1.0, g[None])[0] for g in gains]
+    assert together.tolist() == alone and len(set(alone)) == 3

@@ -6,7 +6,8 @@ Gymnasium on import:
     env = gymnasium.make('multilift/Mission-v0', scenario='multi_lift')
     envs = gymnasium.make_vec('multilift/Hover-v0', num_envs=256)  # one batched engine
 
-Spaces, rewards and ends: multilift_learning.batch; tasks: multilift_learning.tasks.
+A PettingZoo ParallelEnv, an agent per UAV: multilift_learning.parallel_env. Spaces, rewards
+and ends: multilift_learning.batch; tasks: multilift_learning.tasks.
 """
 from __future__ import annotations
 

@@ -1,0 +1,95 @@
+"""`FormationParallelEnv`: a formation as a PettingZoo ParallelEnv, one agent per UAV
+(`uav1` the leader, `uav2`.. the followers), decentralised: each agent sees its own UAV's
+slots of the observation (`multilift_learning.batch`: position and velocity errors, attitude,
+body rates, its cable's direction and tension) and the payload's errors, and commands its own
+rotors (normalised speeds in [-1, 1]). The team shares one reward (the formation's).
+
+    from multilift_learning.parallel_env import parallel_env
+    env = parallel_env(scenario='multi_lift', task='mission')
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+from pettingzoo import ParallelEnv
+
+from multilift_learning.batch import (OBSERVATION_PAYLOAD, OBSERVATION_PER_UAV,
+                                      FormationBatch, observation_names)
+from multilift_learning.tasks import scenario_of
+from multilift_sim.scenario import Scenario
+
+
+class FormationParallelEnv(ParallelEnv):
+    """`FormationEnv`'s formation with an agent per UAV (same arguments)."""
+
+    metadata = {'name': 'multilift_formation_v0', 'render_modes': []}
+
+    def __init__(self, scenario: str | Scenario = 'twin_lift', task: str = 'hover',
+                 overrides: dict[str, Any] | None = None, duration: float | None = None,
+                 target_radius: float = 0.5):
+        self.batch = FormationBatch([scenario_of(scenario, overrides, duration)], task,
+                                    target_radius)
+        n, rotors = self.batch.n, self.batch.rotors
+        self.possible_agents = [f'uav{i}' for i in range(1, n + 1)]
+        self.agents: list[str] = []
+        names = observation_names(n)
+        payload = names[-OBSERVATION_PAYLOAD:]
+        self.observation_names = {
+            agent: names[k * OBSERVATION_PER_UAV:(k + 1) * OBSERVATION_PER_UAV] + payload
+            for k, agent in enumerate(self.possible_agents)}
+        size = OBSERVATION_PER_UAV + OBSERVATION_PAYLOAD
+        self._observation_space = gymnasium.spaces.Box(-np.inf, np.inf, (size,), np.float64)
+        self._action_space = gymnasium.spaces.Box(-1.0, 1.0, (rotors,), np.float64)
+
+    def observation_space(self, agent: str) -> gymnasium.spaces.Box:
+        return self._observation_space
+
+    def action_space(self, agent: str) -> gymnasium.spaces.Box:
+        return self._action_space
+
+    def _split(self, observation: np.ndarray) -> dict[str, np.ndarray]:
+        payload = observation[-OBSERVATION_PAYLOAD:]
+        return {agent: np.concatenate([observation[k * OBSERVATION_PER_UAV:
+                                                   (k + 1) * OBSERVATION_PER_UAV], payload])
+                for k, agent in enumerate(self.possible_agents)}
+
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        if seed is not None or not hasattr(self, '_seeded'):
+            self.batch.seed([seed])
+            self._seeded = True
+        self.batch.reset()
+        self.agents = list(self.possible_agents)
+        observation, _ = self.batch.observe()
+        return self._split(observation[0]), {agent: {} for agent in self.agents}
+
+    def step(self, actions: dict[str, np.ndarray]):
+        flat = np.concatenate([np.asarray(actions[agent], dtype=float)
+                               for agent in self.possible_agents])[None]
+        self.batch.step(flat)
+        observation, seen = self.batch.observe()
+        reward, terms = self.batch.reward(seen, flat)
+        terminated, truncated = self.batch.ends(seen)
+        agents = self.agents
+        observations = self._split(observation[0])
+        infos = {agent: {'reward_terms': {k: float(v[0]) for k, v in terms.items()}}
+                 for agent in agents}
+        result = (observations, {agent: float(reward[0]) for agent in agents},
+                  {agent: bool(terminated[0]) for agent in agents},
+                  {agent: bool(truncated[0]) for agent in agents}, infos)
+        if terminated[0] or truncated[0]:
+            self.agents = []
+        return result
+
+    def expert_actions(self) -> dict[str, np.ndarray]:
+        """The seed's controllers' answers, per agent (the baseline)."""
+        flat = self.batch.expert_actions()[0]
+        rotors = self.batch.rotors
+        return {agent: flat[k * rotors:(k + 1) * rotors]
+                for k, agent in enumerate(self.possible_agents)}
+
+
+def parallel_env(**kwargs) -> FormationParallelEnv:
+    """PettingZoo's usual constructor name."""
+    return FormationParallelEnv(**kwargs)

@@ -1,19 +1,29 @@
 """The learning environments (multilift_learning): Gymnasium's own checks, determinism, the
 baseline (the seed's controllers) equal to the engine's headless run, the vectorised
-environment equal to single ones and its autoreset as Gymnasium's NEXT_STEP defines it."""
+environment equal to single ones and its autoreset as Gymnasium's NEXT_STEP defines it; the
+PettingZoo environment, recorded episodes, the example's batched search."""
 from __future__ import annotations
+
+import importlib.util
 
 import gymnasium
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from pettingzoo.test import parallel_api_test
 
 import multilift_learning
+from conftest import ROOT, raw_messages
 from multilift_control.engine import Engine
 from multilift_learning.batch import observation_names
+from multilift_learning.parallel_env import parallel_env
+from multilift_learning.recording import RecordEpisodes
 from multilift_learning.tasks import task_scenario
 from multilift_learning.vector_env import FormationVectorEnv
 from multilift_sim import scenario as scenario_io
+from multilift_tools.bagdata import load_run
+from multilift_tools.figures import plot_main
+from multilift_tools.headless_bag import record_headless
 
 
 @pytest.mark.parametrize('env_id', sorted(multilift_learning.ENVIRONMENTS))
@@ -109,9 +119,6 @@ def test_overrides_reach_the_scenario():
 
 
 def test_the_parallel_env_passes_pettingzoo_s_test_and_flies_the_baseline():
-    from pettingzoo.test import parallel_api_test
-
-    from multilift_learning.parallel_env import parallel_env
     parallel_api_test(parallel_env(scenario='multi_lift', duration=0.2), num_cycles=30)
     env = parallel_env(scenario='multi_lift', task='mission', duration=0.5)
     single = gymnasium.make('multilift/Mission-v0', scenario='multi_lift', duration=0.5)
@@ -129,9 +136,6 @@ def test_the_parallel_env_passes_pettingzoo_s_test_and_flies_the_baseline():
 def test_a_population_in_one_batch_scores_as_its_candidates_alone():
     """The example's search (examples/learning): candidates' returns from one batched
     environment equal each candidate flown alone."""
-    import importlib.util
-
-    from conftest import ROOT
     path = ROOT / 'examples' / 'learning' / 'tune_follower_gains.py'
     spec = importlib.util.spec_from_file_location('tune_follower_gains', path)
     example = importlib.util.module_from_spec(spec)
@@ -140,3 +144,39 @@ def test_a_population_in_one_batch_scores_as_its_candidates_alone():
     together = example.returns('twin_lift', 1.0, gains)
     alone = [example.returns('twin_lift', 1.0, g[None])[0] for g in gains]
     assert together.tolist() == alone and len(set(alone)) == 3
+
+
+def test_an_episode_recorded_is_the_run_s_bag_and_plots(tmp_path, capsys):
+    """The baseline's episode, recorded: the simulator's topics of a headless run's bag (1e-9
+    m), the policy's rotor commands, no controller topic; `multilift plot` draws it."""
+    env = RecordEpisodes(gymnasium.make('multilift/Mission-v0', duration=1.0), tmp_path / 'ep')
+    env.reset(seed=0)
+    done = False
+    while not done:
+        _, _, terminated, truncated, _ = env.step(env.unwrapped.expert_action())
+        done = terminated or truncated
+    [bag] = env.bags
+    record_headless(scenario_io.load('twin_lift').with_duration(1.0), tmp_path / 'headless')
+    episode, headless = load_run(bag), load_run(tmp_path / 'headless')
+    assert np.array_equal(episode.t, headless.t) and len(episode.t) == 101
+    assert np.abs(episode.uav_positions() - headless.uav_positions()).max() < 1e-9
+    assert np.abs(episode.payload_position() - headless.payload_position()).max() < 1e-9
+    assert np.abs(episode.rotor_speeds(2) - headless.rotor_speeds(2)).max() < 1e-6
+    recorded = raw_messages(bag)
+    assert len(recorded['/uav1/rotor_cmd']) == 100
+    assert '/uav1/attitude_setpoint' not in recorded and '/uav1/reference' not in recorded
+    assert plot_main([str(bag), '--out', str(tmp_path / 'plots')]) == 0
+    assert list((tmp_path / 'plots').glob('*.png'))
+
+
+def test_rgb_array_frames_show_the_formation():
+    env = gymnasium.make('multilift/Hover-v0', duration=0.5, render_mode='rgb_array')
+    env.reset(seed=0)
+    first = env.render()
+    for _ in range(20):
+        env.step(env.unwrapped.expert_action())
+    later = env.render()
+    assert first.dtype == np.uint8 and first.ndim == 3 and first.shape[2] == 3
+    assert first.shape == later.shape and not np.array_equal(first, later)
+    with pytest.raises(ValueError, match='render_mode'):
+        gymnasium.make('multilift/Hover-v0', render_mode='ansi')

@@ -39,6 +39,12 @@ class AnswerMessages:
             None if error is None else error.tolist(),
             None if error is None else answer.formation_error_rate.tolist())
 
+    def command_of(self, index: int, t_ns: int, speeds: Sequence[float],
+                   saturated: Sequence[bool]) -> list[Message]:
+        """UAV `index`'s (from 0) /uav{i}/rotor_cmd alone: rotor speeds [rad/s], saturation."""
+        cmd_topic, cmd = self._uavs[index][:2]
+        return [(cmd_topic, cmd.pack(t_ns, speeds, saturated))]
+
     def answer_of(self, index: int, t_ns: int, speeds: Sequence[float],
                   saturated: Sequence[bool], setpoint: Sequence[float], thrust: float,
                   reference: Sequence[float] | None, errors: Sequence[float] | None,
@@ -47,10 +53,9 @@ class AnswerMessages:
         speeds [rad/s] and saturation, attitude setpoint (roll, pitch, yaw) [rad] and thrust
         [N], the leader's reference (position, velocity, acceleration: 9 numbers) or None, a
         follower's formation errors and their rates or None."""
-        cmd_topic, cmd, setpoint_topic, setpoint_packer, ref_topic, error_topic = \
-            self._uavs[index]
-        messages = [(cmd_topic, cmd.pack(t_ns, speeds, saturated)),
-                    (setpoint_topic, setpoint_packer.pack(t_ns, *setpoint, thrust))]
+        _, _, setpoint_topic, setpoint_packer, ref_topic, error_topic = self._uavs[index]
+        messages = self.command_of(index, t_ns, speeds, saturated)
+        messages.append((setpoint_topic, setpoint_packer.pack(t_ns, *setpoint, thrust)))
         if reference is not None:
             messages.append((ref_topic, self._reference.pack(t_ns, *reference)))
         if errors is not None:

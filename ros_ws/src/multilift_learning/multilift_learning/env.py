@@ -28,13 +28,20 @@ class FormationEnv(gymnasium.Env):
     scenario's by default); `task`: 'hover' or 'mission' (multilift_learning.tasks);
     `target_radius` [m]: hover's targets drawn within it.
 
-    `expert_action()` is the seed's controller's answer at the current state: the baseline."""
+    `expert_action()` is the seed's controller's answer at the current state: the baseline.
+    `render_mode='rgb_array'`: `render()` draws the formation in 3-D as `multilift animate`
+    does (UAVs, cables coloured by tension, payload, their paths so far), (H, W, 3) uint8."""
 
-    metadata = {'render_modes': []}
+    metadata = {'render_modes': ['rgb_array'], 'render_fps': 10}
 
     def __init__(self, scenario: str | Scenario = 'twin_lift', task: str = 'hover',
                  overrides: dict[str, Any] | None = None, duration: float | None = None,
-                 target_radius: float = 0.5):
+                 target_radius: float = 0.5, render_mode: str | None = None):
+        if render_mode not in (None, *self.metadata['render_modes']):
+            raise ValueError(f'render_mode {render_mode!r}: one of None, '
+                             f'{", ".join(self.metadata["render_modes"])}')
+        self.render_mode = render_mode
+        self._history: list[tuple[float, np.ndarray, np.ndarray, np.ndarray]] = []
         self.batch = FormationBatch([scenario_of(scenario, overrides, duration)], task,
                                     target_radius)
         self.observation_space, self.action_space = spaces(self.batch)
@@ -46,6 +53,8 @@ class FormationEnv(gymnasium.Env):
         self.batch.rngs = [self.np_random]
         self.batch.reset()
         observation, _ = self.batch.observe()
+        self._history = []
+        self._remember()
         return observation[0], self._info()
 
     def step(self, action):
@@ -54,6 +63,7 @@ class FormationEnv(gymnasium.Env):
         observation, seen = self.batch.observe()
         reward, terms = self.batch.reward(seen, action)
         terminated, truncated = self.batch.ends(seen)
+        self._remember()
         info = self._info()
         info['reward_terms'] = {name: float(value[0]) for name, value in terms.items()}
         return observation[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), info
@@ -62,6 +72,28 @@ class FormationEnv(gymnasium.Env):
         """The seed's controllers' answer to the current state, as an action (the baseline
         policy); the same until the next step."""
         return self.batch.expert_actions()[0]
+
+    def _remember(self) -> None:
+        if self.render_mode is not None:
+            engine = self.batch.engine
+            self._history.append((float(engine.t[0]), engine.positions[0].copy(),
+                                  engine.payload_positions[0].copy(), self.batch.tension[0].copy()))
+
+    def render(self) -> np.ndarray | None:
+        """The formation now, with its paths since the reset: (H, W, 3) uint8 RGB."""
+        if self.render_mode is None:
+            return None
+        from matplotlib import pyplot as plt
+
+        from multilift_tools.animation import AnimationData, FormationAnimator
+        t, uavs, payload, tension = zip(*self._history)
+        data = AnimationData(np.array(t), np.stack(uavs, axis=1), np.array(payload),
+                             np.array(tension), np.arange(len(t)))
+        animator = FormationAnimator(data, self.batch.scenarios[0].name)
+        try:
+            return animator.render(len(t) - 1)[:, :, :3].copy()
+        finally:
+            plt.close(animator.fig)
 
     def _info(self) -> dict:
         engine = self.batch.engine

@@ -80,13 +80,18 @@ def topic_type(topic: str) -> str | None:
     return UAV_TYPES[parsed[1]] if parsed else None
 
 
-def run_topics(n_uavs: int) -> list[tuple[str, str]]:
-    """Every topic a run of n UAVs publishes, with its type: what the recorder records."""
-    topics = list(RUN_TYPES.items()) + [(REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE)]
+def run_topics(n_uavs: int, controllers: bool = True) -> list[tuple[str, str]]:
+    """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
+    `controllers`, only the rotor commands of what the controllers publish (a policy's run,
+    which has no reference, set-points or formation errors)."""
+    topics = list(RUN_TYPES.items())
+    if controllers:
+        topics.append((REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE))
     for i in range(1, n_uavs + 1):
         topics += [(uav_topic(i, leaf), UAV_TYPES[leaf])
-                   for leaf in (ODOM, ROTOR_CMD, ATTITUDE_SETPOINT)]
-        if i > 1:
+                   for leaf in ((ODOM, ROTOR_CMD, ATTITUDE_SETPOINT) if controllers
+                                else (ODOM, ROTOR_CMD))]
+        if i > 1 and controllers:
             topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
     return topics
 

@@ -42,19 +42,23 @@ CHUNK_TICKS = 250
 Progress = Callable[[float, float], None]
 
 
-def _add_topics(scenario: Scenario, writer: BagWriter) -> None:
+def _add_topics(scenario: Scenario, writer: BagWriter, controllers: bool = True) -> None:
     qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
-    for topic, kind in run_topics(scenario.n_uavs):
+    for topic, kind in run_topics(scenario.n_uavs, controllers):
         writer.add_topic(topic, kind, qos)
 
 
 class EngineBag:
     """Writes one engine-flown run's messages to a BagWriter from its TickRecords (see the
     module docstring): the same messages, in the same order and the same `write_many` groups
-    (a chunk of the MCAP is finished after a group) as `HeadlessBag`."""
+    (a chunk of the MCAP is finished after a group) as `HeadlessBag`. With
+    `controllers=False` (answers that are a policy's rotor speeds) only the rotor commands of
+    the answers are written, and the bag has no controller topic."""
 
-    def __init__(self, scenario: Scenario, engine: Engine, writer: BagWriter) -> None:
-        _add_topics(scenario, writer)
+    def __init__(self, scenario: Scenario, engine: Engine, writer: BagWriter,
+                 controllers: bool = True) -> None:
+        _add_topics(scenario, writer, controllers)
+        self._controllers = controllers
         self._scenario, self._engine, self._write = scenario, engine, writer.write_many
         self._simulator = SimulatorMessages(scenario)
         self._answers = AnswerMessages(scenario)
@@ -95,6 +99,7 @@ class EngineBag:
         tension, g = record.tension[:count, 0].tolist(), record.g[:count, 0].tolist()
         g_dot, taut = record.g_dot[:count, 0].tolist(), record.taut[:count, 0].tolist()
         simulator, answer_of, write = self._simulator, self._answers.answer_of, self._write
+        command_of = self._answers.command_of
         for k in range(count):
             tick = first + k
             t_ns = tick * period
@@ -102,6 +107,9 @@ class EngineBag:
                                           odometry[k], payload_position[k],
                                           payload_velocity[k], gusts[k])
             for i in range(n):
+                if not self._controllers:
+                    messages += command_of(i, t_ns, speed_lists[k][i], saturated[k][i])
+                    continue
                 messages += answer_of(i, t_ns, speed_lists[k][i], saturated[k][i],
                                       setpoints[k][i], thrusts[k][i],
                                       references[k] if i == 0 and self._reference else None,

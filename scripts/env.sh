@@ -7,9 +7,9 @@ ML_VENV="$ML_ROOT/.venv"
 ML_INSTALL="$ML_ROOT/ros_ws/install"
 export VIRTUAL_ENV="$ML_VENV"
 export PATH="$ML_VENV/bin:$PATH"
-export AMENT_PREFIX_PATH="$ML_INSTALL/multilift_tools:$ML_INSTALL/multilift_control:$ML_INSTALL/multilift_sim:$ML_INSTALL/multilift_msgs:$ML_VENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
+export AMENT_PREFIX_PATH="$ML_INSTALL/multilift_learning:$ML_INSTALL/multilift_tools:$ML_INSTALL/multilift_control:$ML_INSTALL/multilift_sim:$ML_INSTALL/multilift_msgs:$ML_VENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
 export CMAKE_PREFIX_PATH="$ML_VENV${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
-for _pkg in multilift_msgs multilift_sim multilift_control multilift_tools; do
+for _pkg in multilift_msgs multilift_sim multilift_control multilift_tools multilift_learning; do
   PYTHONPATH="$ML_INSTALL/$_pkg/lib/python3.11/site-packages${PYTHONPATH:+:$PYTHONPATH}"
 done
 export LD_LIBRARY_PATH="$ML_INSTALL/multilift_msgs/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"

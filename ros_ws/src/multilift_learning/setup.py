@@ -16,4 +16,9 @@ setup(
     maintainer_email='dev@multilift.dev',
     description='Gymnasium environments of multilift on the batched engine.',
     license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'policy_node = multilift_learning.ros.policy_node:main',
+        ],
+    },
 )

@@ -150,14 +150,21 @@ class FormationBatch:
 
     # ----------------------------------------------------------------------- what they see
     def observe(self) -> tuple[np.ndarray, dict]:
-        """Observations (B, OBSERVATION_PER_UAV n + OBSERVATION_PAYLOAD) and the pieces the
-        reward uses."""
+        """Observations (B, OBSERVATION_PER_UAV n + OBSERVATION_PAYLOAD) of the engine's
+        formations, and the pieces the reward uses."""
         n = self.n
         state = self.engine.state
-        measured = self.engine.measured()
-        payload = state[:, 6 * n:6 * n + 3]
-        payload_velocity = state[:, (6 * n + 3) + 6 * n:(6 * n + 3) + 6 * n + 3]
-        target, target_velocity = self.targets.at(self.engine.t)
+        return self.observation_of(self.engine.measured(), state[:, 6 * n:6 * n + 3],
+                                   state[:, (6 * n + 3) + 6 * n:(6 * n + 3) + 6 * n + 3],
+                                   self.tension, self.engine.t)
+
+    def observation_of(self, measured: np.ndarray, payload: np.ndarray,
+                       payload_velocity: np.ndarray, tension: np.ndarray,
+                       t: np.ndarray) -> tuple[np.ndarray, dict]:
+        """`observe` from measured UAV states (B, n, UAV_STATE_SIZE), the payload's position
+        and velocity (B, 3), the last tick's cable tensions (B, n) [N] at times t (B,) [s]: what
+        a node computes from /formation/snapshot (multilift_learning.ros.policy_node)."""
+        target, target_velocity = self.targets.at(t)
         positions = measured[:, :, UAV_POSITION:UAV_POSITION + 3]
         cable = positions - payload[:, None, :]
         cable /= np.linalg.norm(cable, axis=2, keepdims=True)
@@ -167,7 +174,7 @@ class FormationBatch:
             measured[:, :, UAV_EULER:UAV_EULER + 3],
             measured[:, :, UAV_BODY_RATES:UAV_BODY_RATES + 3],
             cable,
-            (self.tension / self.tension_share)[:, :, None]], axis=2)
+            (tension / self.tension_share)[:, :, None]], axis=2)
         position_error = payload - target
         velocity_error = payload_velocity - target_velocity
         observation = np.concatenate([per_uav.reshape(self.batch, -1), position_error,

@@ -100,13 +100,15 @@ class Engine:
         self._measure_all(self.arrays, self.memory, self._measured)
         return self._measured
 
-    def answer(self) -> tuple[np.ndarray, np.ndarray]:
+    def answer(self, states: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The scenario's own controllers' rotor speeds (B, n, rotors) [rad/s] and saturation
         flags for every running formation at its current tick, as a tick computes them (the
-        controllers' memories advance: call it once per tick, before `step_commanded`).
-        Views the next call overwrites."""
+        controllers' memories advance: call it once per tick, before `step_commanded`), to
+        the formations' measured `states` (B, n, UAV_STATE_SIZE) if given (a state received
+        from elsewhere), else to their own. Views the next call overwrites."""
         speeds, saturated = self._answer
-        self._answer_all(self.arrays, self.memory, self.measured(), speeds, saturated)
+        states = self.measured() if states is None else np.ascontiguousarray(states, float)
+        self._answer_all(self.arrays, self.memory, states, speeds, saturated)
         return speeds, saturated
 
     def step_commanded(self, speeds: np.ndarray, saturated: np.ndarray | None = None,

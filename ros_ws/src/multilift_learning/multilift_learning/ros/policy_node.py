@@ -1,0 +1,125 @@
+"""policy_node: a policy trained on the learning environments flies a ROS run.
+
+    scripts/multilift run SCENARIO --external uav1,uav2[,...] [--bag DIR]
+    scripts/multilift node multilift_learning policy_node --ros-args -p scenario:=SCENARIO \\
+        [-p task:=mission] [-p policy:=baseline | -p policy:=my_package.my_module:act]
+
+Each `/formation/snapshot` (every UAV's state at t) becomes the environment's observation at t
+(`FormationBatch.observation_of`: the same slots, target and tension of the last tick, from
+`/formation/state`); the policy, a plain callable `act(observation) -> action` (a numpy array of
+`FormationEnv.observation_space`'s shape in, one of its action space out), gives every rotor's
+normalised speed, published as each UAV's `/uav{i}/rotor_cmd` stamped t. `policy:=baseline` is
+the seed's controllers (`expert_action`). The node commands every UAV of the formation, so the
+run names them all `--external`. Parameters: scenario, task (hover's target is its rest place:
+the radius is 0), policy, record (wait for the recorder's subscriptions, as our controllers).
+"""
+from __future__ import annotations
+
+import importlib
+from typing import Callable, NoReturn
+
+import numpy as np
+from multilift_msgs.msg import FormationSnapshot, FormationState, RotorCommand
+from rclpy.node import Node
+
+from multilift_control.answer_messages import AnswerMessages
+from multilift_learning.batch import FormationBatch
+from multilift_learning.tasks import scenario_of
+from multilift_sim import cdr
+from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
+                                      RawPublishers, controller_peers_missing, run_node,
+                                      serve_controllers)
+from multilift_sim.topics import FORMATION_SNAPSHOT, FORMATION_STATE, uav_topic
+
+Policy = Callable[[np.ndarray], np.ndarray]
+
+
+def load_policy(spec: str) -> Policy | None:
+    """`module:callable` -> the callable; 'baseline' -> None (the seed's controllers)."""
+    if spec == 'baseline':
+        return None
+    module, _, name = spec.partition(':')
+    if not module or not name:
+        raise Fatal(f'policy {spec!r}: expected baseline or MODULE:CALLABLE')
+    try:
+        policy = getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError) as error:
+        raise Fatal(f'policy {spec!r}: {error}') from None
+    if not callable(policy):
+        raise Fatal(f'policy {spec!r} is not callable')
+    return policy
+
+
+class PolicyNode(Node):
+    def __init__(self) -> None:
+        super().__init__('policy')
+        name = self.declare_parameter('scenario', '').value
+        task = self.declare_parameter('task', 'mission').value
+        self.policy = load_policy(self.declare_parameter('policy', 'baseline').value)
+        self.record = bool(self.declare_parameter('record', False).value)
+        self.summary_dir = ''
+        if not name:
+            raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
+        try:
+            self.batch = FormationBatch([scenario_of(name)], task, target_radius=0.0)
+        except ValueError as error:
+            raise Fatal(str(error)) from None
+        self.batch.reset()
+        scenario = self.batch.scenarios[0]
+        n = self.batch.n
+        self.period_ns = int(self.batch.engine.arrays.period_ns[0])
+        self.packer = AnswerMessages(scenario)
+        self.snapshot = cdr.FormationSnapshot([u.vehicle.n_rotors for u in scenario.uavs])
+        self.tension = np.zeros((1, n))
+        self.cmd_pubs = [self.create_publisher(RotorCommand, uav_topic(i, 'rotor_cmd'),
+                                               PUBLISHER_QOS) for i in range(1, n + 1)]
+        self.outputs = RawPublishers(*self.cmd_pubs,
+                                     confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
+        self.create_subscription(FormationState, FORMATION_STATE, self.on_formation_state,
+                                 SUBSCRIBER_QOS)
+        self.create_subscription(FormationSnapshot, FORMATION_SNAPSHOT, self.on_snapshot,
+                                 SUBSCRIBER_QOS, raw=True)
+        self.answered = 0
+
+    def missing_peers(self) -> str | None:
+        for pub in self.cmd_pubs:
+            what = controller_peers_missing(self, pub, self.record)
+            if what is not None:
+                return what
+        return None
+
+    def on_formation_state(self, msg: FormationState) -> None:
+        """The tensions of the integration that started at the last answered tick."""
+        self.tension[0] = msg.cable_tension
+
+    def on_snapshot(self, data: bytes) -> None:
+        t_ns, position, velocity, euler, rates, payload, payload_velocity, _ = \
+            self.snapshot.unpack(data)
+        n = self.batch.n
+        measured = np.concatenate([position.reshape(n, 3), velocity.reshape(n, 3),
+                                   euler.reshape(n, 3), rates.reshape(n, 3)], axis=1)[None]
+        engine = self.batch.engine
+        engine.memory.tick[0] = t_ns // self.period_ns
+        if self.policy is None:
+            speeds = engine.answer(measured)[0][0]
+        else:
+            observation, _ = self.batch.observation_of(
+                measured, np.asarray(payload)[None], np.asarray(payload_velocity)[None],
+                self.tension, np.array([t_ns * 1e-9]))
+            speeds = self.batch.speeds(np.asarray(self.policy(observation[0]), float)[None])[0]
+        low, high = self.batch.speed_min[0], self.batch.speed_max[0]
+        messages = []
+        for i in range(n):
+            saturated = [bool(s) for s in (speeds[i] <= low[i]) | (speeds[i] >= high[i])]
+            messages += self.packer.command_of(i, t_ns, speeds[i].tolist(), saturated)
+        self.outputs.send(messages)
+        self.answered += 1
+
+
+def main(args: list[str] | None = None) -> NoReturn:
+    run_node(PolicyNode, lambda node: serve_controllers(
+        [node], lambda n: ('policy', {'answered': n.answered})), args)
+
+
+if __name__ == '__main__':
+    main()

@@ -2,7 +2,8 @@
 `gymnasium.make_vec` (one batched engine), environment steps per second on one core (target
 >= 50,000), random actions; and the same with the baseline policy's actions (the seed's
 controllers computed in the same compiled call per step). CPU time is printed beside wall
-time (on a busy machine the CPU figure is the fairer one).
+time (on a busy machine the CPU figure is the fairer one). Then the baseline's return over
+whole episodes of each task, twin-lift and V.
 
     python benchmarks/learning.py [--envs 256] [--steps 2000]
 """
@@ -48,6 +49,22 @@ def main() -> None:
         wall, cpu = throughput(envs, args.steps, policy)
         print(f'Hover-v0 twin_lift, {args.envs} envs, {name}: {wall:,.0f} env steps/s wall, '
               f'{cpu:,.0f} per CPU s (target >= 50,000)')
+    baseline_returns()
+
+
+def baseline_returns() -> None:
+    """The baseline policy's return over whole episodes (the scenario's duration) of each task,
+    for the twin-lift and the V: the numbers a learned policy has to beat."""
+    for env_id in ('multilift/Hover-v0', 'multilift/Mission-v0'):
+        for scenario in ('twin_lift', 'multi_lift'):
+            env = gymnasium.make(env_id, scenario=scenario).unwrapped
+            env.reset(seed=0)
+            total, steps, done = 0.0, 0, False
+            while not done:
+                _, reward, terminated, truncated, _ = env.step(env.expert_action())
+                total, steps, done = total + reward, steps + 1, terminated or truncated
+            print(f'{env_id} {scenario}: return of the baseline {total:,.1f} over {steps} steps '
+                  f'({"truncated" if truncated else "terminated"})')
 
 
 if __name__ == '__main__':

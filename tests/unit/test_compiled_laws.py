@@ -145,6 +145,8 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
         check(cascade.attitude_from_force, force, yaw, c[CASCADE_MAX_TILT])
         check(cascade.thrust_axis, *rng.uniform(-1.5, 1.5, size=3))
         check(cascade.attitude_torque, c, state, rng.uniform(-1, 1, size=3))
+        check(cascade.attitude_command, c, m, state, rng.uniform(-0.3, 0.3, size=3),
+              rng.uniform(10.0, 40.0))
         check(cascade.command, c, m, state, force, yaw)
         out, (_, _, cascade_memory, *_) = check(cascade.cascade_update, c, m, cascade_memory,
                                                 t, state, ref, yaw)

@@ -15,6 +15,7 @@ from pettingzoo.test import parallel_api_test
 import multilift_learning
 from conftest import ROOT, raw_messages
 from multilift_control.engine import Engine
+from multilift_learning.attitude import AttitudeActions
 from multilift_learning.batch import observation_names
 from multilift_learning.parallel_env import parallel_env
 from multilift_learning.recording import RecordEpisodes
@@ -180,3 +181,21 @@ def test_rgb_array_frames_show_the_formation():
     assert first.shape == later.shape and not np.array_equal(first, later)
     with pytest.raises(ValueError, match='render_mode'):
         gymnasium.make('multilift/Hover-v0', render_mode='ansi')
+
+
+def test_attitude_actions_are_the_controllers_inner_half():
+    """The seed's controllers' own attitude set-points and thrust, given as AttitudeActions,
+    fly what the engine flies with its whole cascade (1e-9 m)."""
+    env = AttitudeActions(gymnasium.make('multilift/Mission-v0', duration=2.0))
+    env.reset(seed=0)
+    assert env.action_space.shape == (8,)
+    own = Engine(scenario_io.load('twin_lift').with_duration(2.0))
+    record = own.new_record(1)
+    done = False
+    while not done:
+        own.step(1, record)
+        action = env.attitude_action(record.setpoints[0, 0], record.thrust[0, 0])
+        _, _, terminated, truncated, _ = env.step(action)
+        done = terminated or truncated
+        assert np.abs(env.unwrapped.batch.engine.state - own.state).max() < 1e-9
+    assert truncated and own.finished[0]

@@ -95,7 +95,7 @@ class FormationBatch:
         rest = np.array([rest_place(self.engine.positions[b], cable_reach(s))
                          for b, s in enumerate(scenarios)])
         self.start_offsets = self.engine.positions.copy() - rest[:, None, :]
-        self.targets = Targets(task_name, self.engine.arrays, rest, self.start_offsets,
+        self.targets = Targets(task_name, self.engine, rest, self.start_offsets,
                                target_radius)
         self.tension = np.zeros((self.batch, n))
         self.rngs = [np.random.default_rng() for _ in range(self.batch)]

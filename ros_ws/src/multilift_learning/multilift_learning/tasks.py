@@ -21,10 +21,8 @@ from typing import Any
 import numpy as np
 import yaml
 
-from multilift_control import laws
 from multilift_control.laws.layout import (MISSION_FINAL, MISSION_START, REFERENCE_POSITION,
                                            REFERENCE_VELOCITY, SEGMENT_ORIGIN)
-from multilift_control.laws.reference import mission_reference
 from multilift_sim import scenario as scenario_io
 from multilift_sim.scenario import MissionSegment, Scenario
 from multilift_tools.campaign import edited, format_value, load_base, parse_key
@@ -85,17 +83,17 @@ class Targets:
     `position(t)`, `velocity(t)` (B, 3) at each formation's time t (B,) [s]; `reset(which,
     rngs)` draws new ones (hover)."""
 
-    def __init__(self, name: str, arrays, start_payload: np.ndarray, start_offsets: np.ndarray,
+    def __init__(self, name: str, engine, start_payload: np.ndarray, start_offsets: np.ndarray,
                  target_radius: float):
         self.task = task(name)
-        self.arrays = arrays
+        self.arrays = engine.arrays
+        self.references = engine.references   # (B,) times -> (B, REFERENCE_SIZE), compiled
         self.start_payload = start_payload          # (B, 3): its rest place at the start [m]
         self.leader_offset = start_offsets[:, 0]    # (B, 3): the leader above the payload [m]
         self.target_radius = float(target_radius)
         if self.target_radius < 0:
             raise ValueError(f'target_radius must be >= 0 [m], got {target_radius}')
         self.hold = start_payload.copy()            # hover's targets (B, 3)
-        self._reference = laws.runnable(mission_reference)
 
     def reset(self, which: np.ndarray, rngs: list[np.random.Generator]) -> None:
         """New targets for the formations in `which` (B,) bool, each from its own generator;
@@ -119,13 +117,6 @@ class Targets:
         """(position, velocity) of each formation's target at its time t (B,) [s]."""
         if self.task.name == 'hover':
             return self.hold, np.zeros_like(self.hold)
-        a = self.arrays
-        position = np.empty((len(t), 3))
-        velocity = np.empty((len(t), 3))
-        for b, tb in enumerate(t):
-            reference = self._reference(a.mission[b], a.segments[b], a.mission_steps[b],
-                                        float(tb))
-            position[b] = reference[REFERENCE_POSITION:REFERENCE_POSITION + 3] \
-                - self.leader_offset[b]
-            velocity[b] = reference[REFERENCE_VELOCITY:REFERENCE_VELOCITY + 3]
-        return position, velocity
+        reference = self.references(t)
+        return (reference[:, REFERENCE_POSITION:REFERENCE_POSITION + 3] - self.leader_offset,
+                reference[:, REFERENCE_VELOCITY:REFERENCE_VELOCITY + 3])

@@ -10,7 +10,7 @@ from multilift_control.engine import tick as compiled
 from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAINT, OFF_RATE,
                                              RUNNING, FormationArrays, FormationMemory,
                                              TickRecord, batch_arrays, empty_record)
-from multilift_control.laws.layout import UAV_STATE_SIZE
+from multilift_control.laws.layout import REFERENCE_SIZE, UAV_STATE_SIZE
 from multilift_sim.dynamics import StateLayout
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import stop_message
@@ -55,6 +55,8 @@ class Engine:
         self._measure_all = laws.runnable(compiled.measure_all)
         self._answer_all = laws.runnable(compiled.answer_all)
         self._run_commanded = laws.runnable(compiled.run_commanded)
+        self._attitude_commands = laws.runnable(compiled.attitude_commands)
+        self._mission_references = laws.runnable(compiled.mission_references)
         rotors = self.arrays.allocation.shape[-1]
         self._tension = np.zeros((self.batch, self.n_uavs))
         self._measured = np.empty((self.batch, self.n_uavs, UAV_STATE_SIZE))
@@ -109,6 +111,28 @@ class Engine:
         speeds, saturated = self._answer
         states = self.measured() if states is None else np.ascontiguousarray(states, float)
         self._answer_all(self.arrays, self.memory, states, speeds, saturated)
+        return speeds, saturated
+
+    def references(self, t: np.ndarray | None = None) -> np.ndarray:
+        """Every formation's mission reference (B, REFERENCE_SIZE: position [m], velocity
+        [m/s], acceleration [m/s^2], world) at times t (B,) [s], its own by default; NaN rows
+        for a leader without a mission."""
+        t = self.t if t is None else np.ascontiguousarray(t, float)
+        out = np.empty((self.batch, REFERENCE_SIZE))
+        self._mission_references(self.arrays, t, out)
+        return out
+
+    def attitude_speeds(self, setpoints: np.ndarray, thrust: np.ndarray,
+                        states: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Rotor speeds (B, n, rotors) [rad/s] and saturation flags holding attitude
+        `setpoints` (B, n, 3: roll, pitch, yaw [rad]) with collective `thrust` (B, n) [N]:
+        every UAV's attitude loop and mixer (the cascade's inner half, seed Ch. 3) at the
+        measured `states` (B, n, UAV_STATE_SIZE), the formations' own by default."""
+        states = self.measured() if states is None else np.ascontiguousarray(states, float)
+        speeds = np.empty(self._answer[0].shape)
+        saturated = np.empty(self._answer[1].shape, dtype=bool)
+        self._attitude_commands(self.arrays, states, np.ascontiguousarray(setpoints, float),
+                                np.ascontiguousarray(thrust, float), speeds, saturated)
         return speeds, saturated
 
     def step_commanded(self, speeds: np.ndarray, saturated: np.ndarray | None = None,

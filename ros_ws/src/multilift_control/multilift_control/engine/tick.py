@@ -13,10 +13,11 @@ import numpy as np
 from multilift_control.engine.arrays import (FINISHED, MODE_CASCADE, NOT_FINITE, OFF_CONSTRAINT,
                                              OFF_RATE, RUNNING)
 from multilift_control.laws import jit
-from multilift_control.laws.cascade import leader_update
+from multilift_control.laws.cascade import attitude_command, leader_update
 from multilift_control.laws.follower import follower_update, formation_terms, lift_vectors
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
+from multilift_control.laws.reference import mission_reference
 from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.formation_dae import air_velocity, residuals
 from multilift_sim.physics.formation_dae import integrate_period as rigid_period
@@ -179,6 +180,30 @@ def answer_all(a, m, states, speeds, saturated):
         t = m.tick[b] * a.period_ns[b] * 1e-9
         answer_formation(a, m, b, t, states[b], speeds[b], saturated[b], setpoints, thrust,
                          reference, errors, rates)
+
+
+@jit
+def mission_references(a, t, out):
+    """Every formation's mission reference (B, REFERENCE_SIZE) at its time t (B,) [s]
+    (`laws.reference.mission_reference`; a formation without a mission: NaN)."""
+    for b in range(t.shape[0]):
+        if a.leader_mode[b] != MODE_CASCADE:
+            out[b, :] = math.nan
+            continue
+        out[b, :] = mission_reference(a.mission[b], a.segments[b], a.mission_steps[b], t[b])
+
+
+@jit
+def attitude_commands(a, states, setpoints, thrust, speeds, saturated):
+    """Every UAV's rotor speeds and saturation (B, n, rotors) holding attitude `setpoints`
+    (B, n, 3: roll, pitch, yaw [rad]) with collective `thrust` (B, n) [N] from its measured
+    `states` (B, n, UAV_STATE_SIZE): each UAV's cascade inner half (`attitude_command`)."""
+    for b in range(states.shape[0]):
+        for i in range(states.shape[1]):
+            s, sat = attitude_command(a.cascade[b, i], a.mixers[b, i], states[b, i],
+                                      setpoints[b, i], thrust[b, i])
+            speeds[b, i, :] = s
+            saturated[b, i, :] = sat
 
 
 @jit

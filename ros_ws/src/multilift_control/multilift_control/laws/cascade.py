@@ -126,16 +126,23 @@ def attitude_torque(constants, state, setpoint):
 
 
 @jit
+def attitude_command(constants, mixer, state, setpoint, thrust):
+    """(rotor speeds [rad/s], saturated) holding `setpoint` (roll, pitch, yaw) [rad] with
+    collective `thrust` [N]: the attitude loop, then the mixer (the cascade's inner half)."""
+    torque = attitude_torque(constants, state, setpoint)
+    wrench = np.array((thrust, torque[0], torque[1], torque[2]))
+    return rotor_speeds(mixer, constants[CASCADE_SQUARE_MIN], constants[CASCADE_SQUARE_MAX],
+                        wrench)
+
+
+@jit
 def command(constants, mixer, state, force, yaw):
     """(rotor speeds [rad/s], saturated, setpoint (roll, pitch, yaw) [rad], thrust [N]) that
     produce `force` (world) [N] at heading `yaw` [rad]: Eq. 3.13, the attitude loop, the mixer.
     The thrust is asked along the current body z."""
     roll, pitch, thrust = attitude_from_force(force, yaw, constants[CASCADE_MAX_TILT])
     setpoint = np.array((roll, pitch, yaw))
-    torque = attitude_torque(constants, state, setpoint)
-    wrench = np.array((thrust, torque[0], torque[1], torque[2]))
-    speeds, saturated = rotor_speeds(mixer, constants[CASCADE_SQUARE_MIN],
-                                     constants[CASCADE_SQUARE_MAX], wrench)
+    speeds, saturated = attitude_command(constants, mixer, state, setpoint, thrust)
     return speeds, saturated, setpoint, thrust
 
 

@@ -414,7 +414,9 @@ class _Stop:
             left = deadline - time.monotonic()
             if left <= 0:
                 return True
-            self.event.wait(min(left, SLEEP_SLICE))
+            # a sleep, not self.event.wait(): the signal handler (this thread) sets the event,
+            # and Event.set takes the lock Event.wait holds at moments: a deadlock
+            time.sleep(min(left, SLEEP_SLICE))
         return False
 
 

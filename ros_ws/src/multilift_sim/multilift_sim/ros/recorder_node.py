@@ -295,7 +295,10 @@ def main(args: list[str] | None = None) -> int:
         executor.add_node(node)
         while not stop.is_set() and rclpy.ok():
             node.read_round(executor, 0.1)
-            stop.wait(ROUND_PERIOD)
+            # a sleep, not stop.wait(): the handler runs in this thread and Event.set takes the
+            # lock Event.wait holds at moments, so a signal there hung the recorder until the
+            # launcher's SIGKILL (seen in a fresh-clone CI run: the bag had to be rebuilt)
+            time.sleep(ROUND_PERIOD)
         node.drain(executor, abort)
     except (BagError, ValueError) as error:  # bad parameters or bag directory
         print(f'recorder_node: {error}', file=sys.stderr)

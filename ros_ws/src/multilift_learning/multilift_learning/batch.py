@@ -121,6 +121,10 @@ class FormationBatch:
                     -1.0, 1.0)
         return self.speed_min + (a + 1.0) * 0.5 * self.speed_span
 
+    def at_limits(self, speeds: np.ndarray) -> np.ndarray:
+        """Which rotor speeds (B, n, rotors) [rad/s] sit at a vehicle limit (saturated)."""
+        return (speeds <= self.speed_min) | (speeds >= self.speed_max)
+
     def actions(self, speeds: np.ndarray) -> np.ndarray:
         """Rotor speeds (B, n, rotors) [rad/s] -> normalised actions (B, n * rotors)."""
         a = 2.0 * (speeds - self.speed_min) / self.speed_span - 1.0
@@ -141,8 +145,7 @@ class FormationBatch:
     def step(self, actions: np.ndarray, which: np.ndarray | None = None) -> None:
         """One control tick of every running formation (those in `which`) under `actions`."""
         speeds = self.speeds(actions)
-        saturated = (speeds <= self.speed_min) | (speeds >= self.speed_max)
-        tension = self.engine.step_commanded(speeds, saturated, which)
+        tension = self.engine.step_commanded(speeds, self.at_limits(speeds), which)
         if which is None:
             self.tension[:] = tension
         else:

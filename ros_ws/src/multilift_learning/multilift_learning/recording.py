@@ -47,9 +47,9 @@ class RecordEpisodes(gymnasium.Wrapper):
         record.g[k, 0], record.g_dot[k, 0] = memory.g[0], memory.g_dot[0]
         record.taut[k, 0], record.gust[k, 0] = memory.taut[0], memory.gust[0]
         result = self.env.step(action)
-        speeds = batch.speeds(np.asarray(action, dtype=float)[None])[0]
-        record.speeds[k, 0] = speeds
-        record.saturated[k, 0] = (speeds <= batch.speed_min[0]) | (speeds >= batch.speed_max[0])
+        speeds = batch.speeds(np.asarray(action, dtype=float)[None])
+        record.speeds[k, 0] = speeds[0]
+        record.saturated[k, 0] = batch.at_limits(speeds)[0]
         record.tension[k, 0] = batch.tension[0]
         self._count += 1
         if result[2] or result[3]:

@@ -107,11 +107,10 @@ class PolicyNode(Node):
                 measured, np.asarray(payload)[None], np.asarray(payload_velocity)[None],
                 self.tension, np.array([t_ns * 1e-9]))
             speeds = self.batch.speeds(np.asarray(self.policy(observation[0]), float)[None])[0]
-        low, high = self.batch.speed_min[0], self.batch.speed_max[0]
+        saturated = self.batch.at_limits(speeds[None])[0].tolist()
         messages = []
         for i in range(n):
-            saturated = [bool(s) for s in (speeds[i] <= low[i]) | (speeds[i] >= high[i])]
-            messages += self.packer.command_of(i, t_ns, speeds[i].tolist(), saturated)
+            messages += self.packer.command_of(i, t_ns, speeds[i].tolist(), saturated[i])
         self.outputs.send(messages)
         self.answered += 1
 

@@ -5,6 +5,8 @@ Eq. 2.14): compiled vs their uncompiled run to the bit, and against independent 
 product)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -81,10 +83,21 @@ def test_rotor_wrenches_are_each_allocation_times_the_squared_speeds():
     rng = np.random.default_rng(4)
     speeds = rng.uniform(800.0, 2000.0, size=(scenario.n_uavs, model.allocation.shape[2]))
     compiled, python = np.empty((scenario.n_uavs, 4)), np.empty((scenario.n_uavs, 4))
-    rotor_wrenches(model.allocation, speeds, compiled)
-    kernels.uncompiled(rotor_wrenches)(model.allocation, speeds, python)
+    intact = np.ones_like(speeds)
+    rotor_wrenches(model.allocation, speeds, intact, compiled)
+    kernels.uncompiled(rotor_wrenches)(model.allocation, speeds, intact, python)
     assert np.array_equal(compiled, python)
     for i, uav in enumerate(scenario.uavs):
         expected = uav.vehicle.allocator().matrix @ speeds[i] ** 2
         assert np.allclose(compiled[i], expected, rtol=1e-13)
     assert np.array_equal(model.wrenches(list(speeds)), compiled)
+    # a rotor at effectiveness e gives e times its thrust and moment: rotor 2 of UAV 1 at half
+    # is the intact rotor at speed omega / sqrt(2); a failed rotor adds nothing
+    effectiveness = intact.copy()
+    effectiveness[0, 1], effectiveness[1, 0] = 0.5, 0.0
+    rotor_wrenches(model.allocation, speeds, effectiveness, compiled)
+    slower = speeds.copy()
+    slower[0, 1] /= math.sqrt(2.0)
+    slower[1, 0] = 0.0
+    rotor_wrenches(model.allocation, slower, intact, python)
+    assert np.allclose(compiled, python, rtol=1e-13)

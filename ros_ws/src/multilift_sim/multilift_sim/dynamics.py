@@ -26,7 +26,9 @@ multilift_sim.physics.formation_dae):
 
 Forces: UAV i gets thrust ``u_T R(eta_i) e_z`` and gravity ``-m_i g e_z``, and body torque tau
 enters as ``W^T tau``; the payload gets gravity and the air-relative quadratic drag of
-disturbances.py (gusts included). Rotor speeds are held constant over each RK4 step.
+disturbances.py (gusts included). Rotor speeds are held constant over each RK4 step; with
+lagging rotors (`vehicle.motor_time_constant`, `motor_rate_limit`) each step holds their speeds
+at its midpoint (multilift_sim.physics.actuators).
 """
 from __future__ import annotations
 
@@ -43,7 +45,8 @@ from multilift_sim.frames import seed_to_world_vector
 from multilift_sim.multirotor import MultirotorParams, rotational_kinetic_energy
 from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (
-    CABLE_COLUMNS, FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY,
+    ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, CABLE_COLUMNS,
+    FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY,
     FORMATION_INV_PAYLOAD_MASS, FORMATION_PAYLOAD_MASS, FORMATION_SCALARS, FORMATION_TWO_ALPHA,
     GUST_CENTER, GUST_COLUMNS, GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED,
     UAV_COLUMNS, UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS, WORK_ROWS, WRENCH_COLUMNS)
@@ -217,17 +220,30 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     return uavs, gusts, formation
 
 
+def actuator_array(params: FormationParams) -> np.ndarray:
+    """Each UAV's rotor actuators (n, ACTUATOR_COLUMNS) (physics.layout ACTUATOR_*)."""
+    actuators = np.empty((params.n_uavs, ACTUATOR_COLUMNS))
+    actuators[:, ACTUATOR_TIME_CONSTANT] = [uav.motor_time_constant for uav in params.uavs]
+    actuators[:, ACTUATOR_RATE_LIMIT] = [uav.motor_rate_limit for uav in params.uavs]
+    return actuators
+
+
 class FormationModel:
     """The stabilised formation DAE (seed Eq. 2.70) with structure-exploiting solves.
 
     ``rotor_speeds`` arguments are sequences of n per-UAV arrays of rotor speeds [rad/s]
-    (shape (n_r,) each, rotor order of docs/conventions.md), held constant over a step.
+    (shape (n_r,) each, rotor order of docs/conventions.md), held constant over a step;
+    `integrate` takes them as commands the rotors follow (physics.actuators): `rotors` (n,
+    rotors) holds the rotors' speeds [rad/s] (NaN before the first command), `effectiveness`
+    (n, rotors) each rotor's share of its thrust and moment (1: intact).
 
     The arithmetic is `multilift_sim.physics.formation_dae` (numba functions over the arrays
     this model builds once: `constant_arrays`), compiled just in time, or under
     MULTILIFT_KERNEL=python (or aot: the physics is not built ahead of time) its uncompiled
     run, the same source run by Python (`kernels.runnable`).
     """
+
+    slack_cables = False  # whether its cables go slack (SlackCableModel)
 
     def __init__(self, params: FormationParams):
         self.params = params
@@ -248,6 +264,9 @@ class FormationModel:
         self.payload_mass = float(params.payload_mass)
         self.gravity = float(params.gravity)
         self._uavs, self._gusts, self._formation = constant_arrays(params)
+        self._actuators = actuator_array(params)
+        self.rotors = np.full(self.allocation.shape[::2], math.nan)
+        self.effectiveness = np.ones(self.allocation.shape[::2])
         # which cables are constraints: all of them here (SlackCableModel changes them)
         self._taut = np.ones(n, dtype=bool)
         # (MULTILIFT_KERNEL, {name: physics function}), made on first use
@@ -256,12 +275,13 @@ class FormationModel:
     # ------------------------------------------------------------------------- physics
     def _physics_functions(self) -> dict[str, Callable]:
         """The physics functions this model calls, by name (numba dispatchers)."""
+        from multilift_sim.physics.actuators import actuated_period
         from multilift_sim.physics.allocation import rotor_wrenches
         from multilift_sim.physics.formation_dae import (air_velocity, integrate_period,
                                                          residuals, rk4_step, solve)
         return {'solve': solve, 'rk4_step': rk4_step, 'integrate_period': integrate_period,
                 'residuals': residuals, 'rotor_wrenches': rotor_wrenches,
-                'air_velocity': air_velocity}
+                'air_velocity': air_velocity, 'actuated_period': actuated_period}
 
     def _physics(self) -> dict[str, Callable]:
         """_physics_functions as MULTILIFT_KERNEL says, loaded once per mode."""
@@ -285,8 +305,8 @@ class FormationModel:
         return x
 
     # ----------------------------------------------------------------------------- inputs
-    def wrenches(self, rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
-        """Body wrenches ``u_i = (u_T [N], tau_x, tau_y, tau_z [N m])`` (FLU), shape (n, 4)."""
+    def _speed_array(self, rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
+        """The speeds as one (n, rotors) array, a smaller UAV's padded with zeros."""
         if len(rotor_speeds) != self._n:
             raise ValueError(f'rotor_speeds has {len(rotor_speeds)} entries for {self._n} UAVs')
         rotors = self.allocation.shape[2]
@@ -306,9 +326,14 @@ class FormationModel:
                     raise ValueError(f'rotor_speeds[{i}] (uav{i + 1}) must have shape '
                                      f'({count},), got {own.shape}')
                 speeds[i, :count] = own
+        return np.ascontiguousarray(speeds)
+
+    def wrenches(self, rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
+        """Body wrenches ``u_i = (u_T [N], tau_x, tau_y, tau_z [N m])`` (FLU), shape (n, 4),
+        of rotors at these speeds (and the model's `effectiveness`)."""
         wrenches = np.empty((self._n, WRENCH_COLUMNS))
-        self._physics()['rotor_wrenches'](self.allocation, np.ascontiguousarray(speeds),
-                                          wrenches)
+        self._physics()['rotor_wrenches'](self.allocation, self._speed_array(rotor_speeds),
+                                          self.effectiveness, wrenches)
         return wrenches
 
     # --------------------------------------------------------------------------- dynamics
@@ -350,12 +375,15 @@ class FormationModel:
 
     def integrate(self, x: np.ndarray, rotor_speeds: Sequence[ArrayLike], dt: float,
                   steps: int) -> Integration:
-        """`steps` RK4 steps of dt [s] from x with the rotor speeds [rad/s] held (one control
-        period of seed Algorithm 1). The wrenches are formed once (the speeds are held) and
-        the tension is that of the first stage of the first step (the multipliers at x)."""
-        state, multipliers, g, g_dot = self._physics()['integrate_period'](
-            self._state_array(x), self.wrenches(rotor_speeds), self._uavs, self._gusts,
-            self._formation, self._taut, float(dt), int(steps))
+        """`steps` RK4 steps of dt [s] from x with the rotor speeds [rad/s] commanded (one
+        control period of seed Algorithm 1), the rotors following through their actuators
+        (`rotors` moves to the period's end; instant rotors: the speeds held, the wrenches
+        formed once). The tension is that of the first stage of the first step (the
+        multipliers at x)."""
+        state, multipliers, g, g_dot = self._physics()['actuated_period'](
+            self._state_array(x), self._speed_array(rotor_speeds), self.rotors,
+            self._actuators, self.effectiveness, self.allocation, self._uavs, self._gusts,
+            self._formation, self._taut, self.slack_cables, float(dt), int(steps))
         return Integration(state, 2.0 * self.cable_lengths * multipliers, g, g_dot)
 
     # -------------------------------------------------------------------------- reporting

@@ -40,6 +40,9 @@ class MultirotorParams:
     moment_coefficient: float            # k_D [N m s^2/rad^2]
     rotor_speed_min: float               # omega_r,min [rad/s]
     rotor_speed_max: float               # omega_r,max [rad/s]
+    # the rotors' actuators (physics.actuators; not in the seed, whose rotors answer at once)
+    motor_time_constant: float = 0.0     # tau_m [s] of each rotor's first-order lag; 0: none
+    motor_rate_limit: float = math.inf   # the largest |d omega / dt| [rad/s^2]; inf: none
 
     def __post_init__(self) -> None:
         rotor_count(self.frame_type)  # ValueError naming the valid frame types
@@ -56,6 +59,12 @@ class MultirotorParams:
         if not (math.isfinite(self.rotor_speed_min) and self.rotor_speed_min >= 0):
             raise ValueError(f'MultirotorParams.rotor_speed_min must be finite and >= 0, got '
                              f'{self.rotor_speed_min!r}')
+        if not (math.isfinite(self.motor_time_constant) and self.motor_time_constant >= 0):
+            raise ValueError(f'MultirotorParams.motor_time_constant must be finite and >= 0 '
+                             f'[s], got {self.motor_time_constant!r}')
+        if not self.motor_rate_limit > 0:  # inf allowed: no limit
+            raise ValueError(f'MultirotorParams.motor_rate_limit must be > 0 [rad/s^2] (inf: '
+                             f'none), got {self.motor_rate_limit!r}')
         if self.rotor_speed_min >= self.rotor_speed_max:
             raise ValueError(f'MultirotorParams.rotor_speed_min ({self.rotor_speed_min}) must be '
                              f'< rotor_speed_max ({self.rotor_speed_max})')

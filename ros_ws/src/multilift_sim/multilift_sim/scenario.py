@@ -254,7 +254,8 @@ class _Section:
 
 
 VEHICLE_KEYS = ('mass', 'inertia', 'frame_type', 'arm_length', 'thrust_coefficient',
-                'moment_coefficient', 'rotor_speed_min', 'rotor_speed_max')
+                'moment_coefficient', 'rotor_speed_min', 'rotor_speed_max',
+                'motor_time_constant', 'motor_rate_limit')
 
 
 def _vehicle(sec: _Section, base: dict[str, Any] | None) -> MultirotorParams:
@@ -270,9 +271,16 @@ def _vehicle(sec: _Section, base: dict[str, Any] | None) -> MultirotorParams:
     w_min = sec.non_negative('rotor_speed_min', default('rotor_speed_min'))
     w_max = sec.number('rotor_speed_max', default('rotor_speed_max'), lambda v: v > w_min,
                        f'must be > rotor_speed_min ({w_min})')
+    # the rotors' actuators (physics.actuators): optional, the seed's instant rotors by default
+    tau = sec.non_negative('motor_time_constant',
+                           0.0 if base is None else base['motor_time_constant'])
+    rate_default = math.inf if base is None else base['motor_rate_limit']
+    rate = sec.raw('motor_rate_limit', None)
+    rate = rate_default if rate is None else sec.positive('motor_rate_limit')
     return MultirotorParams(mass=mass, inertia=inertia, frame_type=frame_type,
                             arm_length=arm_length, thrust_coefficient=k_t,
-                            moment_coefficient=k_d, rotor_speed_min=w_min, rotor_speed_max=w_max)
+                            moment_coefficient=k_d, rotor_speed_min=w_min, rotor_speed_max=w_max,
+                            motor_time_constant=tau, motor_rate_limit=rate)
 
 
 SEED_INERTIA = (0.957, 0.486, 0.355)  # seed Table 4.1 / 4.2 [kg m^2]
@@ -455,6 +463,12 @@ def _scenario(data: Any, where: str) -> Scenario:
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model)
     _check_feasible(scenario)
+    lagging = [i + 1 for i, u in enumerate(scenario.uavs)
+               if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
+    if lagging and sim.integrator != 'baumgarte':
+        raise ScenarioError(f'{where}: vehicle.motor_time_constant / motor_rate_limit (uav'
+                            f'{lagging[0]}) need simulation.integrator: baumgarte, got '
+                            f'{sim.integrator!r}')
     if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')

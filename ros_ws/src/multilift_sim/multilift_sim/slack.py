@@ -39,6 +39,8 @@ class SlackCableModel(FormationModel):
     """FormationModel whose cables can go slack; `taut` (n,) bool says which are taut (the
     model's own array: write it in place or assign it)."""
 
+    slack_cables = True
+
     def __init__(self, params: FormationParams):
         super().__init__(params)
 

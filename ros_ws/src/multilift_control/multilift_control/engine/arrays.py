@@ -20,7 +20,7 @@ from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_MEMORY_SIZ
                                            FOLLOWER_SIZE, FOLLOWER_TWO_ALPHA, REFERENCE_SIZE,
                                            ROW_SIZE, UAV_STATE_SIZE)
 from multilift_control.runtime import ThrustBook
-from multilift_sim.dynamics import FormationModel, constant_arrays
+from multilift_sim.dynamics import FormationModel, actuator_array, constant_arrays
 from multilift_sim.physics.layout import UAV_MASS
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import cable_reach, initial_state, swing_sampling
@@ -48,6 +48,7 @@ class FormationArrays(NamedTuple):
     gusts: np.ndarray             # (B, k, GUST_COLUMNS)
     formation: np.ndarray         # (B, FORMATION_SCALARS)
     allocation: np.ndarray        # (B, n, 4, rotors): wrench per omega^2 (seed Eq. 2.14)
+    actuators: np.ndarray         # (B, n, ACTUATOR_COLUMNS): each UAV's rotor lag and rate limit
     cable_lengths: np.ndarray     # (B, n) [m]
     slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
     # time and Algorithm 1's tolerances
@@ -82,6 +83,8 @@ class FormationMemory(NamedTuple):
     """What a tick changes, for B formations (first axis)."""
     state: np.ndarray             # (B, 2(6n + 3)): the formation state at the current tick
     taut: np.ndarray              # (B, n) bool: which cables are taut
+    rotors: np.ndarray            # (B, n, rotors): rotor speeds [rad/s], NaN before a command
+    effectiveness: np.ndarray     # (B, n, rotors): each rotor's share of its thrust, in [0, 1]
     tick: np.ndarray              # (B,) int: control periods flown
     status: np.ndarray            # (B,) int: RUNNING, FINISHED or why it stopped
     worst_cable: np.ndarray       # (B,) int: the cable of a stop (from 0)
@@ -162,9 +165,10 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         follower[i], follower_memory[i], own_rows[i] = f.constants, f.memory, len(f.rows)
         if f.law_p.shape == (3, m):  # linear rows (else the law solves each tick)
             law_p[i], law_q[i] = f.law_p, f.law_q
+    model = FormationModel(params)
     arrays = dict(
-        uavs=uavs, gusts=gusts, formation=formation,
-        allocation=FormationModel(params).allocation,
+        uavs=uavs, gusts=gusts, formation=formation, allocation=model.allocation,
+        actuators=actuator_array(params),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
         slack=scenario.cable_model == 'slack',
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
@@ -185,7 +189,8 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         thrust_coefficients=np.array([u.vehicle.thrust_coefficient for u in scenario.uavs],
                                      dtype=float))
     memory = dict(
-        state=initial_state(scenario), taut=np.ones(n, dtype=bool), tick=0, status=RUNNING,
+        state=initial_state(scenario), taut=np.ones(n, dtype=bool), rotors=model.rotors,
+        effectiveness=model.effectiveness, tick=0, status=RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n),
         cascade_memory=np.stack([c.memory for c in cascades]),
         follower_memory=follower_memory,

@@ -18,12 +18,9 @@ from multilift_control.laws.follower import follower_update, formation_terms, li
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
-from multilift_sim.physics.allocation import rotor_wrenches
+from multilift_sim.physics.actuators import actuated_period
 from multilift_sim.physics.formation_dae import air_velocity, residuals
-from multilift_sim.physics.formation_dae import integrate_period as rigid_period
-from multilift_sim.physics.layout import WRENCH_COLUMNS
 from multilift_sim.physics.measurement import measured_states
-from multilift_sim.physics.slack_cables import integrate_period as slack_period
 from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
                                                    run_add_gust_speed, run_add_slack,
                                                    run_add_tensions, run_check, tracking_add)
@@ -112,21 +109,16 @@ def check(a, m, b):
 @jit
 def advance_formation(a, m, b, speeds, saturated, tension):
     """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
-    limit) held over the control period (RK4), then checked; the tension T_i = 2 l_i lambda_i
+    limit) commanded over the control period (RK4, the rotors through their actuators:
+    `physics.actuators`), then checked; the tension T_i = 2 l_i lambda_i
     [N] at the tick into tension. The second half of a tick, whoever answered."""
     n = speeds.shape[0]
     period = a.period_ns[b] * 1e-9
     run_add_commands(m.run[b], speeds, saturated, period)
-    wrenches = np.empty((n, WRENCH_COLUMNS))
-    rotor_wrenches(a.allocation[b], speeds, wrenches)
-    if a.slack[b]:
-        state, multipliers, g, g_dot = slack_period(
-            m.state[b], wrenches, a.uavs[b], a.gusts[b], a.formation[b], m.taut[b],
-            a.physics_dt[b], a.physics_steps[b])
-    else:
-        state, multipliers, g, g_dot = rigid_period(
-            m.state[b], wrenches, a.uavs[b], a.gusts[b], a.formation[b], m.taut[b],
-            a.physics_dt[b], a.physics_steps[b])
+    state, multipliers, g, g_dot = actuated_period(
+        m.state[b], speeds, m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
+        a.uavs[b], a.gusts[b], a.formation[b], m.taut[b], a.slack[b], a.physics_dt[b],
+        a.physics_steps[b])
     for i in range(n):
         tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
     run_add_tensions(m.run[b], tension)

@@ -5,7 +5,8 @@ named (numba freezes these module-level integers into the compiled code).
   UAV_COORDINATES at ``UAV_COORDINATES * i`` (POSITION: r_i [m], EULER: eta_i [rad], ZYX roll,
   pitch, yaw; world frame, z up), then the payload's r_p [m] at PAYLOAD; the rates follow
   at the same offsets from n_coordinates(n) ([m/s], [rad/s]);
-- a UAV's constants row (UAV_*, UAV_COLUMNS columns, one row per UAV);
+- a UAV's constants row (UAV_*, UAV_COLUMNS columns, one row per UAV) and its rotors'
+  actuator row (ACTUATOR_*);
 - a gust's row (GUST_*, seed Eq. 2.55);
 - the formation's scalars (FORMATION_*);
 - the scratch of a solve per cable (CABLE_*) and of an RK4 step (WORK_*);
@@ -42,6 +43,11 @@ UAV_COLUMNS = 8
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
 WRENCH_TORQUE = 1           # tau_x, tau_y, tau_z [N m], body FLU (3 slots)
 WRENCH_COLUMNS = 4
+
+# -- a UAV's rotor actuators (one row per UAV; physics.actuators) -----------------------------
+ACTUATOR_TIME_CONSTANT = 0  # tau_m [s]: each rotor's first-order lag to its command; 0: none
+ACTUATOR_RATE_LIMIT = 1     # the largest |d omega / dt| [rad/s^2]; inf: none
+ACTUATOR_COLUMNS = 2
 
 # -- a gust (seed Eq. 2.55; disturbances.Gust) ------------------------------------------------
 GUST_CENTER = 0             # (x, y) of its centre [m], world (2 slots)

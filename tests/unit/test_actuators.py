@@ -150,7 +150,8 @@ def test_compiled_equals_its_uncompiled_run():
         rotors = start.copy()
         out = function(x, commands, rotors, actuator_array(scenario.formation_params()),
                        effectiveness, model.allocation, model._uavs, model._gusts,
-                       model._formation, np.ones(3, dtype=bool), False, 0.005, 2)
+                       model._formation, np.ones(3, dtype=bool), np.zeros(3, dtype=bool),
+                       False, 0.005, 2)
         results.append((out, rotors))
     (compiled, compiled_rotors), (python, python_rotors) = results
     for a, b in zip(compiled, python):

@@ -107,7 +107,8 @@ def test_the_slack_path_with_a_snap_in_the_step_compiled_is_its_source_bit_for_b
     results = []
     for function in (slack_period, kernels.uncompiled(slack_period)):
         taut = np.zeros(1, bool)
-        results.append((function(x, wrenches, *_constants(model), taut, 1e-3, 2), taut))
+        results.append((function(x, wrenches, *_constants(model), taut, np.zeros(1, bool),
+                                 1e-3, 2), taut))
     (compiled, taut), (python, taut_python) = results
     for a, b in zip(compiled, python):
         assert np.array_equal(a, b)

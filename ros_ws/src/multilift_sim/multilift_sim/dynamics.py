@@ -267,10 +267,17 @@ class FormationModel:
         self._actuators = actuator_array(params)
         self.rotors = np.full(self.allocation.shape[::2], math.nan)
         self.effectiveness = np.ones(self.allocation.shape[::2])
-        # which cables are constraints: all of them here (SlackCableModel changes them)
+        # which cables are constraints: all of them here (SlackCableModel changes them), but
+        # for a released one (physics.events); the released ones never constrain again
         self._taut = np.ones(n, dtype=bool)
+        self.released = np.zeros(n, dtype=bool)
         # (MULTILIFT_KERNEL, {name: physics function}), made on first use
         self._loaded: tuple[str, dict[str, Callable]] | None = None
+
+    @property
+    def taut(self) -> np.ndarray:
+        """Which cables are constraints, (n,) bool: the model's own array."""
+        return self._taut
 
     # ------------------------------------------------------------------------- physics
     def _physics_functions(self) -> dict[str, Callable]:
@@ -383,7 +390,7 @@ class FormationModel:
         state, multipliers, g, g_dot = self._physics()['actuated_period'](
             self._state_array(x), self._speed_array(rotor_speeds), self.rotors,
             self._actuators, self.effectiveness, self.allocation, self._uavs, self._gusts,
-            self._formation, self._taut, self.slack_cables, float(dt), int(steps))
+            self._formation, self._taut, self.released, self.slack_cables, float(dt), int(steps))
         return Integration(state, 2.0 * self.cable_lengths * multipliers, g, g_dot)
 
     # -------------------------------------------------------------------------- reporting

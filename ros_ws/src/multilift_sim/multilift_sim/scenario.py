@@ -21,6 +21,7 @@ from multilift_sim.dynamics import FormationParams
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
+from multilift_sim.physics.layout import EVENT_KINDS
 
 
 class ScenarioError(ValueError):
@@ -115,6 +116,17 @@ class MissionConfig:
 
 
 @dataclass(frozen=True)
+class EventConfig:
+    """One of the scenario's `events:` (issue 21), applied at the first control tick at or
+    after its time (physics.events)."""
+    time: float                      # [s]
+    type: str                        # one of physics.layout.EVENT_KINDS
+    uav: int                         # the UAV it concerns, from 1 (1 = the leader)
+    rotor: int = 0                   # rotor_effectiveness: the rotor, from 1; else 0
+    effectiveness: float = 1.0       # rotor_effectiveness: its share of thrust, in [0, 1]
+
+
+@dataclass(frozen=True)
 class Scenario:
     name: str
     description: str
@@ -128,6 +140,7 @@ class Scenario:
     formation: FormationConfig | None = None
     warnings: tuple[str, ...] = field(default=())
     cable_model: str = 'rigid'       # one of CABLE_MODELS
+    events: tuple[EventConfig, ...] = ()  # in time order
 
     @property
     def n_uavs(self) -> int:
@@ -417,6 +430,8 @@ def _scenario(data: Any, where: str) -> Scenario:
                           reference_speed=g.non_negative('reference_speed')))
         g.done()
 
+    events = _events(top, uavs, duration)
+
     c = top.section('control')
     mode = c.text('mode', choices=CONTROL_MODES)
     constant = c.raw('constant_rotor_speed', None)
@@ -461,10 +476,13 @@ def _scenario(data: Any, where: str) -> Scenario:
                         mission=MissionConfig(start=start, segments=tuple(segments),
                                               reference_filter_time=reference_filter_time),
                         formation=formation, warnings=tuple(warnings),
-                        cable_model=cable_model)
+                        cable_model=cable_model, events=events)
     _check_feasible(scenario)
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
+    if events and sim.integrator != 'baumgarte':
+        raise ScenarioError(f'{where}: events need simulation.integrator: baumgarte, got '
+                            f'{sim.integrator!r}')
     if lagging and sim.integrator != 'baumgarte':
         raise ScenarioError(f'{where}: vehicle.motor_time_constant / motor_rate_limit (uav'
                             f'{lagging[0]}) need simulation.integrator: baumgarte, got '
@@ -473,6 +491,37 @@ def _scenario(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario
+
+
+def _events(top: _Section, uavs: list[UavConfig], duration: float) -> tuple[EventConfig, ...]:
+    """The `events:` list, validated (each key of its type, nothing else) and in time order."""
+    events = []
+    released: set[int] = set()
+    for k, entry in enumerate(top.sequence('events', [])):
+        e = _Section(entry, f'events[{k}]', top.where)
+        time = e.number('time', ..., lambda v: 0 <= v < duration,
+                        f'must be >= 0 and before the run\'s end ({duration:g} s)')
+        kind = e.text('type', choices=EVENT_KINDS)
+        uav = e.raw('uav')
+        if isinstance(uav, bool) or not isinstance(uav, int) or not 1 <= uav <= len(uavs):
+            raise e.fail('uav', uav, f'must be a UAV from 1 to {len(uavs)}')
+        event = EventConfig(time=time, type=kind, uav=uav)
+        if kind == 'rotor_effectiveness':
+            rotors = uavs[uav - 1].vehicle.n_rotors
+            rotor = e.raw('rotor')
+            if isinstance(rotor, bool) or not isinstance(rotor, int) or not 1 <= rotor <= rotors:
+                raise e.fail('rotor', rotor, f'must be a rotor of uav{uav}, from 1 to {rotors}')
+            event = dataclasses.replace(event, rotor=rotor, effectiveness=e.number(
+                'effectiveness', ..., lambda v: 0 <= v <= 1, 'must be within [0, 1]'))
+        elif kind == 'cable_release':
+            if uav in released:
+                raise e.fail('uav', uav, 'has let go of its cable already')
+            released.add(uav)
+            if len(released) == len(uavs):
+                raise e.fail('uav', uav, 'is the last cable holding the payload')
+        e.done()
+        events.append(event)
+    return tuple(sorted(events, key=lambda event: event.time))
 
 
 def _flies_a_period(duration: float, control_rate: float) -> bool:

@@ -15,11 +15,15 @@ from multilift_sim.dynamics import Integration, StateLayout, initial_state_singl
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
-from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
+from multilift_sim.physics.events import apply_events
+from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_KIND, EVENT_KINDS, EVENT_ROTOR,
+                                          EVENT_TICK, EVENT_TIME, EVENT_UAV, EVENT_VALUE,
+                                          MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
                                           ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
 from multilift_sim.physics.measurement import odometry_states
+from multilift_sim import kernels
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import RunStatistics
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
@@ -76,6 +80,21 @@ def swing_sampling(n_uavs: int) -> int:
     closed form); from three on, where rigid cables hold the payload at its equilibrium place,
     every 10th (10 Hz of a 100 Hz loop)."""
     return 1 if n_uavs <= 2 else 10
+
+
+def event_array(scenario: Scenario) -> np.ndarray:
+    """The scenario's events as rows (k, EVENT_COLUMNS) (physics.layout EVENT_*), in time
+    order, each at the first control tick at or after its time."""
+    rows = np.zeros((len(scenario.events), EVENT_COLUMNS))
+    rate = scenario.simulation.control_rate
+    for k, event in enumerate(scenario.events):
+        rows[k, EVENT_TICK] = math.ceil(event.time * rate - 1e-9)
+        rows[k, EVENT_TIME] = event.time
+        rows[k, EVENT_KIND] = EVENT_KINDS.index(event.type)
+        rows[k, EVENT_UAV] = event.uav - 1
+        rows[k, EVENT_ROTOR] = max(event.rotor - 1, 0)
+        rows[k, EVENT_VALUE] = event.effectiveness
+    return rows
 
 
 def initial_state(scenario: Scenario) -> np.ndarray:
@@ -138,8 +157,11 @@ class FormationSimulator:
         # the air velocity at the payload in the current state [m/s], world (/payload/gust)
         self.payload_gust: np.ndarray = np.zeros(3)
         self._reach = cable_reach(scenario)
-        self._all_taut = np.ones(self.n, dtype=bool)  # the cables of a rigid cable model
+        self._all_taut = np.ones(self.n, dtype=bool)  # a formulation without a taut set's
         self._swing_every = swing_sampling(self.n)
+        # the scenario's events (physics.events) and the row of the next one to come
+        self.events = event_array(scenario)
+        self.next_event = 0
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
         self._check(0.0)
@@ -207,6 +229,11 @@ class FormationSimulator:
     def advance(self, rotor_speeds: list[np.ndarray], saturated: list[np.ndarray]) -> None:
         """Hold `rotor_speeds` over one control period and integrate to the next tick."""
         speeds = self._checked_speeds(rotor_speeds)
+        if self.next_event < len(self.events):
+            model = self.model
+            self.next_event = kernels.runnable(apply_events)(
+                self.events, self.next_event, self.tick, model.effectiveness, model._taut,
+                model.released)
         self.stats.add_commands(speeds, saturated, self.period_ns * 1e-9)
         step = self.model.integrate(self.state, speeds, self.dt, self.steps_per_tick)
         self.state = step.state

@@ -23,7 +23,7 @@ from multilift_control.runtime import ThrustBook
 from multilift_sim.dynamics import FormationModel, actuator_array, constant_arrays
 from multilift_sim.physics.layout import UAV_MASS
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import cable_reach, initial_state, swing_sampling
+from multilift_sim.simulation import cable_reach, event_array, initial_state, swing_sampling
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
 
@@ -51,6 +51,7 @@ class FormationArrays(NamedTuple):
     actuators: np.ndarray         # (B, n, ACTUATOR_COLUMNS): each UAV's rotor lag and rate limit
     cable_lengths: np.ndarray     # (B, n) [m]
     slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
+    events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
     # time and Algorithm 1's tolerances
     physics_dt: np.ndarray        # (B,) [s]
     physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
@@ -85,6 +86,8 @@ class FormationMemory(NamedTuple):
     taut: np.ndarray              # (B, n) bool: which cables are taut
     rotors: np.ndarray            # (B, n, rotors): rotor speeds [rad/s], NaN before a command
     effectiveness: np.ndarray     # (B, n, rotors): each rotor's share of its thrust, in [0, 1]
+    released: np.ndarray          # (B, n) bool: the cables let go of for good (events)
+    next_event: np.ndarray        # (B,) int: the row of the next event to come
     tick: np.ndarray              # (B,) int: control periods flown
     status: np.ndarray            # (B,) int: RUNNING, FINISHED or why it stopped
     worst_cable: np.ndarray       # (B,) int: the cable of a stop (from 0)
@@ -170,7 +173,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         uavs=uavs, gusts=gusts, formation=formation, allocation=model.allocation,
         actuators=actuator_array(params),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
-        slack=scenario.cable_model == 'slack',
+        slack=scenario.cable_model == 'slack', events=event_array(scenario),
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),
@@ -190,7 +193,8 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
                                      dtype=float))
     memory = dict(
         state=initial_state(scenario), taut=np.ones(n, dtype=bool), rotors=model.rotors,
-        effectiveness=model.effectiveness, tick=0, status=RUNNING,
+        effectiveness=model.effectiveness, released=model.released, next_event=0, tick=0,
+        status=RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n),
         cascade_memory=np.stack([c.memory for c in cascades]),
         follower_memory=follower_memory,

@@ -95,10 +95,11 @@ def instant(actuators):
 
 @jit
 def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, uavs, gusts,
-                    formation, taut, slack, dt, steps):
+                    formation, taut, released, slack, dt, steps):
     """One control period of `steps` RK4 steps of dt [s] from state x under rotor `commands`
     (n, rotors) [rad/s] held, through the actuators: the DAE of rigid cables, or of cables
-    that go slack (`slack`; taut (n,) bool updated). `rotors` (n, rotors) holds each rotor's
+    that go slack (`slack`; taut (n,) bool updated, a `released` (n,) bool cable never taut
+    again). `rotors` (n, rotors) holds each rotor's
     speed [rad/s] at x (NaN: never commanded, it starts at its first command) and is moved to
     the period's end. Returns (the state at the end, the multipliers [N/m] at x, g [m^2] and
     g_dot [m^2/s] at the end); x is not written."""
@@ -112,7 +113,7 @@ def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, u
         rotor_wrenches(allocation, commands, effectiveness, wrenches)
         rotors[:, :] = commands
         if slack:
-            return slack_period(x, wrenches, uavs, gusts, formation, taut, dt, steps)
+            return slack_period(x, wrenches, uavs, gusts, formation, taut, released, dt, steps)
         return rigid_period(x, wrenches, uavs, gusts, formation, taut, dt, steps)
     speeds = np.empty((n, count))
     state = x.copy()
@@ -124,7 +125,7 @@ def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, u
         rotor_wrenches(allocation, speeds, effectiveness, wrenches)
         if slack:
             state, multipliers, g, g_dot = slack_period(state, wrenches, uavs, gusts,
-                                                        formation, taut, dt, 1)
+                                                        formation, taut, released, dt, 1)
         else:
             state, multipliers, g, g_dot = rigid_period(state, wrenches, uavs, gusts,
                                                         formation, taut, dt, 1)

@@ -49,6 +49,19 @@ ACTUATOR_TIME_CONSTANT = 0  # tau_m [s]: each rotor's first-order lag to its com
 ACTUATOR_RATE_LIMIT = 1     # the largest |d omega / dt| [rad/s^2]; inf: none
 ACTUATOR_COLUMNS = 2
 
+# -- an event of the scenario's `events:` (rows of (k, EVENT_COLUMNS) in time order;
+# physics.events) and the kinds it can be: the one registry, which scenario validation reads --
+EVENT_KINDS = ('rotor_effectiveness', 'cable_release')
+KIND_ROTOR_EFFECTIVENESS = 0    # a rotor's thrust and moment scale by EVENT_VALUE from then on
+KIND_CABLE_RELEASE = 1          # UAV EVENT_UAV's cable lets go of the payload for good
+EVENT_TICK = 0              # the control tick it happens at (the first at or after its time)
+EVENT_TIME = 1              # the time the scenario gives [s]
+EVENT_KIND = 2              # KIND_*: its index in EVENT_KINDS
+EVENT_UAV = 3               # the UAV it concerns, from 0
+EVENT_ROTOR = 4             # the rotor, from 0 (rotor_effectiveness; else 0)
+EVENT_VALUE = 5             # the effectiveness it sets, in [0, 1] (rotor_effectiveness)
+EVENT_COLUMNS = 6
+
 # -- a gust (seed Eq. 2.55; disturbances.Gust) ------------------------------------------------
 GUST_CENTER = 0             # (x, y) of its centre [m], world (2 slots)
 GUST_DIRECTION = 2          # unit direction, world (3 slots)

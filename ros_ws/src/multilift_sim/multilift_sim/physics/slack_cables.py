@@ -213,9 +213,10 @@ def guard(x, wrenches, uavs, gusts, formation, taut, tau, watched, out, value, w
 
 
 @jit
-def taut_event(x, wrenches, uavs, gusts, formation, taut, h, g, g_dot, states, values, flags,
-               work, cables):
-    """The first time tau in (0, h] at which a slack cable, shorter than l_i at x, reaches
+def taut_event(x, wrenches, uavs, gusts, formation, taut, released, h, g, g_dot, states, values,
+               flags, work, cables):
+    """The first time tau in (0, h] at which a slack cable (not `released`: (n,) bool, the
+    cables let go of for good), shorter than l_i at x, reaches
     l_i on the RK4 sub-step from x, or -1.0: the state there into states[SLACK_EVENT], which
     cables snap into flags[SLACK_SNAPPING]. g, g_dot (n,) at x; states[SLACK_END] and
     values[SLACK_G_END], values[SLACK_G_DOT_END] the RK4 step of h and its residuals.
@@ -235,7 +236,7 @@ def taut_event(x, wrenches, uavs, gusts, formation, taut, h, g, g_dot, states, v
     f_lo = f_hi = -math.inf
     for i in range(n):
         scale = uavs[i, UAV_LENGTH_SQ]
-        watched[i] = not taut[i] and g[i] / scale < 0.0
+        watched[i] = not taut[i] and not released[i] and g[i] / scale < 0.0
         crossing[i] = watched[i] and g1[i] / scale >= 0.0
         any_watched = any_watched or watched[i]
         any_crossing = any_crossing or crossing[i]
@@ -308,10 +309,11 @@ def taut_event(x, wrenches, uavs, gusts, formation, taut, h, g, g_dot, states, v
 
 
 @jit
-def slack_step(state, wrenches, uavs, gusts, formation, taut, dt, g, g_dot, states, values,
-               flags, work, cables):
+def slack_step(state, wrenches, uavs, gusts, formation, taut, released, dt, g, g_dot, states,
+               values, flags, work, cables):
     """One RK4 step of dt [s] from state (whose residuals are g, g_dot), cut at each taut
-    event: the state at its end into state, its g [m^2], g_dot [m^2/s] into g, g_dot."""
+    event of a cable not `released`: the state at its end into state, its g [m^2], g_dot
+    [m^2/s] into g, g_dot."""
     n = uavs.shape[0]
     end = states[SLACK_END]
     g_end, g_dot_end = values[SLACK_G_END], values[SLACK_G_DOT_END]
@@ -327,8 +329,8 @@ def slack_step(state, wrenches, uavs, gusts, formation, taut, dt, g, g_dot, stat
             g_dot[:] = g_dot_end
             return
         # an event makes a cable taut: a few per step at most (a bound against cycling)
-        tau = taut_event(state, wrenches, uavs, gusts, formation, taut, left, g, g_dot, states,
-                         values, flags, work, cables) if events <= 2 * n else -1.0
+        tau = taut_event(state, wrenches, uavs, gusts, formation, taut, released, left, g,
+                         g_dot, states, values, flags, work, cables) if events <= 2 * n else -1.0
         if tau < 0.0:
             break
         events += 1
@@ -346,7 +348,8 @@ def slack_step(state, wrenches, uavs, gusts, formation, taut, dt, g, g_dot, stat
     state[:] = end
     any_snapping = False
     for i in range(n):
-        snapping[i] = not taut[i] and g_end[i] >= 0.0 and g_dot_end[i] > 0.0
+        snapping[i] = (not taut[i] and not released[i] and g_end[i] >= 0.0
+                       and g_dot_end[i] > 0.0)
         any_snapping = any_snapping or snapping[i]
     g[:] = g_end
     g_dot[:] = g_dot_end
@@ -356,9 +359,10 @@ def slack_step(state, wrenches, uavs, gusts, formation, taut, dt, g, g_dot, stat
 
 
 @jit
-def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
+def integrate_period(x, wrenches, uavs, gusts, formation, taut, released, dt, steps):
     """`steps` RK4 steps of dt [s] from x with the wrenches held, cables going slack (at each
-    step's start, when their multiplier would push) and snapping taut (at the located event):
+    step's start, when their multiplier would push) and snapping taut (at the located event;
+    never a `released` one, (n,) bool):
     (the state at the end, the multipliers [N/m] at x after the taut set's update there,
     g [m^2] and g_dot [m^2/s] at the end). taut (n,) bool is updated; x is not written."""
     n = uavs.shape[0]
@@ -378,6 +382,6 @@ def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
         if step:
             update_taut_set(state, wrenches, uavs, gusts, formation, taut,
                             values[SLACK_MULTIPLIERS], work[WORK_ACC], cables)
-        slack_step(state, wrenches, uavs, gusts, formation, taut, dt, g, g_dot, states, values,
-                   flags, work, cables)
+        slack_step(state, wrenches, uavs, gusts, formation, taut, released, dt, g, g_dot,
+                   states, values, flags, work, cables)
     return state, first, g, g_dot

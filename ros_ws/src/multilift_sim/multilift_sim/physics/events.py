@@ -1,0 +1,27 @@
+"""The scenario's events (`events:`, issue 21) applied to a formation's arrays at the control
+tick they fall on, before the period from that tick is integrated: one function, which the
+engine's tick and FormationSimulator both call. Rows and kinds: `physics.layout` EVENT_*.
+"""
+from multilift_sim.kernels import jit
+from multilift_sim.physics.layout import (EVENT_KIND, EVENT_ROTOR, EVENT_TICK, EVENT_UAV,
+                                          EVENT_VALUE, KIND_CABLE_RELEASE,
+                                          KIND_ROTOR_EFFECTIVENESS)
+
+
+@jit
+def apply_events(events, next_event, tick, effectiveness, taut, released):
+    """Apply every event of `events` (k, EVENT_COLUMNS) from row `next_event` on whose tick is
+    at or before `tick`: a rotor's effectiveness (n, rotors) set; a cable released (released
+    (n,) bool set, its taut flag cleared: it no longer constrains, and a slack model never
+    snaps it taut again). Returns the row of the next event to come (k: none left)."""
+    k = next_event
+    while k < events.shape[0] and events[k, EVENT_TICK] <= tick:
+        kind = int(events[k, EVENT_KIND])
+        uav = int(events[k, EVENT_UAV])
+        if kind == KIND_ROTOR_EFFECTIVENESS:
+            effectiveness[uav, int(events[k, EVENT_ROTOR])] = events[k, EVENT_VALUE]
+        elif kind == KIND_CABLE_RELEASE:
+            released[uav] = True
+            taut[uav] = False
+        k += 1
+    return k

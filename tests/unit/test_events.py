@@ -1,0 +1,155 @@
+"""A scenario's events (`events:`, multilift_sim.physics.events, issue 21 item 4): validated
+at load; applied at their tick, the same in the engine and the per-object (ROS) path to the
+bit; a released cable lets go without doing work: energy and momentum of a free formation
+continue through the release, the released UAV flies on as a free body and never snaps taut
+again, the other cables hold."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from conftest import SCENARIOS
+from multilift_control.engine import Engine
+from multilift_control.headless import run_headless
+from multilift_sim import kernels
+from multilift_sim import scenario as scenario_io
+from multilift_sim.physics.events import apply_events
+from multilift_sim.simulation import event_array, initial_state
+from multilift_sim.slack import SlackCableModel
+from multilift_sim.dynamics import FormationModel
+
+
+def _edited(name: str, edit) -> str:
+    data = yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
+    edit(data)
+    return yaml.safe_dump(data)
+
+
+def _with_events(name: str, duration: float, events: list[dict], **top) -> scenario_io.Scenario:
+    def edit(data):
+        data['simulation']['duration'] = duration
+        data['events'] = events
+        data.update(top)
+    return scenario_io.loads(_edited(name, edit))
+
+
+def test_events_load_in_time_order_at_their_ticks():
+    scenario = _with_events('multi_lift', 10.0, [
+        {'time': 6.005, 'type': 'cable_release', 'uav': 3},
+        {'time': 2.0, 'type': 'rotor_effectiveness', 'uav': 2, 'rotor': 4,
+         'effectiveness': 0.25}])
+    assert [e.type for e in scenario.events] == ['rotor_effectiveness', 'cable_release']
+    rows = event_array(scenario)
+    # the first control tick (100 Hz) at or after each time; UAVs and rotors from 0
+    assert rows.tolist() == [[200.0, 2.0, 0.0, 1.0, 3.0, 0.25], [601.0, 6.005, 1.0, 2.0, 0.0,
+                                                                  1.0]]
+    assert scenario_io.load('multi_lift').events == ()  # the shipped scenarios have none
+
+
+@pytest.mark.parametrize('event,message', [
+    ({'time': 10.0, 'type': 'cable_release', 'uav': 2}, r"events\[0\]\.time: 10\.0 must be"),
+    ({'time': 1.0, 'type': 'cable_cut', 'uav': 2}, 'events.0..type.*must be one of'),
+    ({'time': 1.0, 'type': 'cable_release', 'uav': 4}, r'uav: 4 must be a UAV from 1 to 3'),
+    ({'time': 1.0, 'type': 'cable_release', 'uav': 1.0}, r'uav: 1\.0 must be a UAV'),
+    ({'time': 1.0, 'type': 'rotor_effectiveness', 'uav': 1, 'rotor': 5,
+      'effectiveness': 0.0}, 'rotor: 5 must be a rotor of uav1, from 1 to 4'),
+    ({'time': 1.0, 'type': 'rotor_effectiveness', 'uav': 1, 'rotor': 1,
+      'effectiveness': 1.5}, r'effectiveness: 1\.5 must be within \[0, 1\]'),
+    ({'time': 1.0, 'type': 'cable_release', 'uav': 2, 'rotor': 1}, 'rotor: unknown key'),
+    ({'time': 1.0, 'type': 'rotor_effectiveness', 'uav': 1}, 'rotor')])
+def test_bad_events_name_key_and_rule(event, message):
+    with pytest.raises(scenario_io.ScenarioError, match=message):
+        _with_events('multi_lift', 10.0, [event])
+
+
+def test_the_last_cable_and_a_second_release_are_refused():
+    release = [{'time': 1.0, 'type': 'cable_release', 'uav': uav} for uav in (1, 2)]
+    with pytest.raises(scenario_io.ScenarioError, match='the last cable holding the payload'):
+        _with_events('twin_lift', 10.0, release)
+    with pytest.raises(scenario_io.ScenarioError, match='has let go of its cable already'):
+        _with_events('twin_lift', 10.0, release[:1] * 2)
+    with pytest.raises(scenario_io.ScenarioError, match='events need simulation.integrator'):
+        _with_events('twin_lift', 10.0, release[:1], simulation={
+            **yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())['simulation'],
+            'duration': 10.0, 'integrator': 'nullspace'})
+
+
+@pytest.mark.parametrize('cables', ['rigid', 'slack'])
+def test_events_fly_the_same_in_the_engine_and_the_ros_path(cables):
+    events = [{'time': 1.5, 'type': 'rotor_effectiveness', 'uav': 2, 'rotor': 1,
+               'effectiveness': 0.7},
+              {'time': 3.0, 'type': 'cable_release', 'uav': 3}]
+    scenario = _with_events('multi_lift', 6.0, events, cable_model=cables)
+    quiet = dataclasses.replace(scenario, events=())
+    engine, before = Engine(scenario), Engine(quiet)
+    record, quiet_record = engine.new_record(600), before.new_record(600)
+    engine.step(600, record)
+    before.step(600, quiet_record)
+    run = run_headless(scenario)
+    assert np.array_equal(engine.state[0], run.simulator.state)
+    assert np.array_equal(engine.memory.taut[0], run.simulator.taut)
+    assert engine.memory.released[0].tolist() == [False, False, True]
+    assert engine.memory.effectiveness[0, 1].tolist() == [0.7, 1.0, 1.0, 1.0]
+    # nothing changes before the first event's tick (150), everything after it
+    assert np.array_equal(record.states[:151], quiet_record.states[:151])
+    assert not np.array_equal(record.states[152], quiet_record.states[152])
+    # the released cable is slack from tick 300 on (in the record: at the tick's start)
+    assert record.taut[300, 0, 2] and not record.taut[301:, 0, 2].any()
+    assert record.tension[300:, 0, 2].tolist() == [0.0] * 300
+    assert engine.summary(0)['sim']['max_abs_constraint'] < 1e-6  # the others hold
+
+
+def _free_twin_lift(model_class):
+    """A twin-lift without gravity, drag or rotors, everything moving at 0.4 m/s along x and
+    the payload swinging out of the UAVs-payload plane at 1.5 m/s (g_dot = 0 on both
+    cables): no external force, so momentum and energy are constants."""
+    base = scenario_io.load('twin_lift')
+    scenario = dataclasses.replace(
+        base, gusts=(), payload=dataclasses.replace(base.payload, drag_coefficient=0.0,
+                                                    swing=0.0),
+        simulation=dataclasses.replace(base.simulation, gravity=0.0))
+    model = model_class(scenario.formation_params())
+    x = initial_state(scenario)
+    layout = model.layout
+    uavs, payload = layout.uav_positions(x), layout.payload_position(x)
+    normal = np.cross(payload - uavs[0], payload - uavs[1])
+    drift = np.array([0.4, 0.0, 0.0])
+    layout.uav_velocities(x)[:] = drift
+    layout.payload_velocity(x)[:] = drift + 1.5 * normal / np.linalg.norm(normal)
+    return scenario, model, x
+
+
+def _momentum(model, x):
+    layout = model.layout
+    return (model.uav_masses @ layout.uav_velocities(x)
+            + model.payload_mass * layout.payload_velocity(x))
+
+
+@pytest.mark.parametrize('model_class', [FormationModel, SlackCableModel])
+def test_a_release_does_no_work_and_the_free_uav_flies_on(model_class):
+    scenario, model, x = _free_twin_lift(model_class)
+    events = event_array(dataclasses.replace(scenario, events=(
+        scenario_io.EventConfig(time=0.5, type='cable_release', uav=2),)))
+    energy, momentum = model.kinetic_energy(x), _momentum(model, x)
+    idle, next_event = [np.zeros(4)] * 2, 0
+    released_at = None
+    for tick in range(150):
+        next_event = kernels.runnable(apply_events)(events, next_event, tick,
+                                                    model.effectiveness, model._taut,
+                                                    model.released)
+        if next_event and released_at is None:
+            released_at = model.layout.uav_velocities(x)[1].copy()
+        x = model.integrate(x, idle, 0.005, 2).state
+        assert model.kinetic_energy(x) == pytest.approx(energy, rel=1e-9)
+        assert np.allclose(_momentum(model, x), momentum, rtol=0.0, atol=1e-12)
+    g, g_dot = model.constraint_residuals(x)
+    assert abs(g[0]) < 1e-6 and abs(g_dot[0]) < 1e-6  # the other cable holds (l^2 = 105 m^2)
+    # the released UAV drifts at the velocity it had when it let go, out beyond its cable
+    assert np.allclose(model.layout.uav_velocities(x)[1], released_at, rtol=0.0, atol=1e-12)
+    assert g[1] > 0.1 and not model.taut[1] and model.released.tolist() == [False, True]
+    assert not np.allclose(released_at, [0.4, 0.0, 0.0])  # the swing had pulled it along
+    assert math.isfinite(model.kinetic_energy(x))

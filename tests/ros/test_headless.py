@@ -118,3 +118,54 @@ def test_tf_is_the_odometry_at_every_tick(twin_bags):
                     poses[msg.child_frame_id, t] = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
         assert len(poses) == 3 * 601
         assert frames == poses
+
+
+def test_events_fly_and_are_recorded_alike_through_ros_and_headless(tmp_path):
+    """A scenario's events (docs/events.md) through the ROS nodes and headless: the same
+    /formation/events messages (one per event, stamped with the first state that shows it),
+    the same states after them, and the summary names them."""
+    import json
+
+    import yaml
+
+    from conftest import SCENARIOS
+    data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
+    data['events'] = [
+        {'time': 0.503, 'type': 'rotor_effectiveness', 'uav': 1, 'rotor': 2,
+         'effectiveness': 0.9},
+        {'time': 1.5, 'type': 'cable_release', 'uav': 2}]
+    scenario = tmp_path / 'twin_lift_events.yaml'
+    scenario.write_text(yaml.safe_dump(data))
+    env = dict(os.environ, ROS_DOMAIN_ID=str(next_domain()),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    events, summaries = [], []
+    for mode in ('ros', 'headless'):
+        args = [MULTILIFT, 'run', str(scenario), '--duration', '2.5', '--bag',
+                str(tmp_path / mode)] + (['--headless'] if mode == 'headless' else [])
+        out = subprocess.run(args, capture_output=True, text=True, timeout=600, env=env)
+        assert out.returncode == 0, out.stderr[-2000:]
+        assert 'event at 1.5 s   uav2 releases its cable' in out.stdout
+        with AnyReader([tmp_path / mode]) as reader:
+            connections = [c for c in reader.connections if c.topic == '/formation/events']
+            events.append([(stamp, reader.deserialize(raw, c.msgtype))
+                           for c, stamp, raw in reader.messages(connections)])
+        summaries.append(json.loads((tmp_path / mode / 'summary.json').read_text()))
+    ros, headless = events
+    assert len(ros) == len(headless) == 2
+    for (_, a), (_, b) in zip(ros, headless):
+        assert (a.header.stamp.sec, a.header.stamp.nanosec, a.type, a.uav, a.rotor, a.value,
+                a.scheduled_time, a.description) == (
+            b.header.stamp.sec, b.header.stamp.nanosec, b.type, b.uav, b.rotor, b.value,
+            b.scheduled_time, b.description)
+    first, second = (msg for _, msg in headless)
+    assert (first.header.stamp.sec, first.header.stamp.nanosec) == (0, 510_000_000)  # tick 51
+    assert (first.type, first.uav, first.rotor, first.value) == ('rotor_effectiveness', 1, 2,
+                                                                   0.9)
+    assert (second.type, second.uav, second.description) == ('cable_release', 2,
+                                                             'uav2 releases its cable')
+    assert summaries[0]['sim']['events'] == summaries[1]['sim']['events']
+    assert [e['type'] for e in summaries[1]['sim']['events']] == ['rotor_effectiveness',
+                                                                  'cable_release']
+    ros_run, headless_run = (load_run(tmp_path / mode) for mode in ('ros', 'headless'))
+    assert np.abs(ros_run.uav_positions() - headless_run.uav_positions()).max() < 1e-9
+    assert not headless_run.taut()[-1, 1] and headless_run.taut()[-1, 0]

@@ -24,7 +24,8 @@ def typestore():
                  'multilift_msgs/msg/AttitudeSetpoint', 'multilift_msgs/msg/TrackingReference',
                  'multilift_msgs/msg/VirtualConstraintError', 'multilift_msgs/msg/FormationState',
                  'visualization_msgs/msg/MarkerArray', 'geometry_msgs/msg/TransformStamped',
-                 'multilift_msgs/msg/FormationSnapshot', 'tf2_msgs/msg/TFMessage'):
+                 'multilift_msgs/msg/FormationSnapshot', 'tf2_msgs/msg/TFMessage',
+                 'multilift_msgs/msg/FormationEvent'):
         store.register(get_types_from_msg(msgdefs.message_definition(name), name))
     return store
 
@@ -129,6 +130,14 @@ def test_tracking_reference(typestore):
     packer = cdr.TrackingReference()
     check(packer.pack(T_NS, *ref.position, *ref.velocity, *ref.acceleration), packer,
           messages.tracking_reference(T_NS, ref), typestore)
+
+
+@pytest.mark.parametrize('row', [[1200.0, 12.0, 0.0, 1.0, 3.0, 0.25],      # uav2 rotor 4
+                                 [601.0, 6.005, 1.0, 2.0, 0.0, 1.0]])     # uav3 lets go
+def test_formation_event(row, typestore):
+    packer = cdr.FormationEvent()
+    packed = packer.pack(T_NS, *msgvalues.formation_event(row))
+    check(packed, packer, messages.formation_event(T_NS, row), typestore)
 
 
 @pytest.mark.parametrize('n', [1, 2, 3, 10])

@@ -97,9 +97,9 @@ def test_events_fly_the_same_in_the_engine_and_the_ros_path(cables):
     # nothing changes before the first event's tick (150), everything after it
     assert np.array_equal(record.states[:151], quiet_record.states[:151])
     assert not np.array_equal(record.states[152], quiet_record.states[152])
-    # the released cable is slack from tick 300 on (in the record: at the tick's start)
-    assert record.taut[300, 0, 2] and not record.taut[301:, 0, 2].any()
-    assert record.tension[300:, 0, 2].tolist() == [0.0] * 300
+    # the released cable is slack from the state at tick 300 on, and pulls no more
+    assert record.taut[299, 0, 2] and not record.taut[300:, 0, 2].any()
+    assert record.tension[299, 0, 2] > 1.0 and record.tension[300:, 0, 2].tolist() == [0.0] * 300
     assert engine.summary(0)['sim']['max_abs_constraint'] < 1e-6  # the others hold
 
 
@@ -153,3 +153,44 @@ def test_a_release_does_no_work_and_the_free_uav_flies_on(model_class):
     assert g[1] > 0.1 and not model.taut[1] and model.released.tolist() == [False, True]
     assert not np.allclose(released_at, [0.4, 0.0, 0.0])  # the swing had pulled it along
     assert math.isfinite(model.kinetic_energy(x))
+
+
+def test_a_headless_bag_carries_the_events_to_plots_and_layout(tmp_path):
+    """/formation/events in the bag (one message per event at its tick), `Run.events` reads
+    them back, every figure over time marks them, the Foxglove layout shows the topic."""
+    import matplotlib
+    matplotlib.use('Agg')
+
+    from multilift_tools.bagdata import load_run
+    from multilift_tools.figures import FIGURES, make_plots
+    from multilift_tools.foxglove_layout import layout
+    from multilift_tools.headless_bag import record_headless
+    from multilift_tools.plot_style import EVENT_COLOR, Context, plt
+    scenario = _with_events('twin_lift', 2.5, [
+        {'time': 0.503, 'type': 'rotor_effectiveness', 'uav': 1, 'rotor': 2,
+         'effectiveness': 0.9},
+        {'time': 1.5, 'type': 'cable_release', 'uav': 2}])
+    record_headless(scenario, tmp_path / 'bag')
+    run = load_run(tmp_path / 'bag')
+    assert run.events() == [(0.51, 'uav1 rotor 2 at 90 % of its thrust'),
+                            (1.5, 'uav2 releases its cable')]
+    assert run.taut()[149, 1] and not run.taut()[150:, 1].any() and run.taut()[150:, 0].all()
+    assert load_run(tmp_path / 'bag').events()  # and again (no state left behind)
+    drawn = []
+    original = plt.Axes.axvline
+
+    def axvline(ax, x, *args, **kwargs):
+        if kwargs.get('color') == EVENT_COLOR:
+            drawn.append(x)
+        return original(ax, x, *args, **kwargs)
+    plt.Axes.axvline = axvline
+    try:
+        written, _ = make_plots(Context(run, scenario), tmp_path / 'plots')
+    finally:
+        plt.Axes.axvline = original
+    timed = [spec.name for spec in FIGURES if spec.over_time
+             and (tmp_path / 'plots' / f'{spec.name}.png') in written]
+    assert len(timed) >= 5 and drawn.count(1.5) >= len(timed)
+    panels = layout(scenario)['configById']
+    assert panels['RawMessages!events']['topicPath'] == '/formation/events'
+    assert 'RawMessages!events' not in layout(scenario_io.load('twin_lift'))['configById']

@@ -43,7 +43,7 @@ class HeadlessRun:
         """The run's statistics as `run` reports them: {'sim': ..., 'leader': ...,
         'follower2': ...} (the same keys and definitions the nodes leave)."""
         sim = dict(self.simulator.stats.as_dict(), wall_time=self.wall_time, error=self.error,
-                   scenario=self.scenario.name)
+                   scenario=self.scenario.name, events=self.simulator.events_summary())
         return {'sim': sim, **{r.name: r.summary() for r in self.runtimes}}
 
 

@@ -198,6 +198,27 @@ class FormationState(FloatSequences):
         return self._struct.pack(*args, self._n, *(bool(v) for v in taut))
 
 
+class FormationEvent:
+    """multilift_msgs/FormationEvent: pack(t_ns, *msgvalues.formation_event(row)). Its strings
+    differ from event to event, so each message compiles its own layout (events are rare;
+    `layout`: the last one)."""
+
+    def __init__(self, frame: str = WORLD_FRAME) -> None:
+        self._frame = frame
+
+    def pack(self, t_ns: int, kind: str, uav: int, rotor: int, value: float,
+             scheduled_time: float, description: str) -> bytes:
+        layout, frame = _header_layout(self._frame)
+        kind_bytes = layout.string(kind)
+        layout.primitive('I', 2)
+        layout.primitive('d', 2)
+        text = layout.string(description)
+        self.layout = layout
+        return layout.compile().pack(ENCAPSULATION, *stamp(t_ns), *frame, len(kind_bytes) + 1,
+                                     kind_bytes, uav, rotor, value, scheduled_time,
+                                     len(text) + 1, text)
+
+
 def formation_state(n: int) -> FormationState:
     """multilift_msgs/FormationState of n cables."""
     return FormationState(n)

@@ -11,6 +11,9 @@ from typing import Sequence
 
 import numpy as np
 
+from multilift_sim.physics.layout import (EVENT_KIND, EVENT_KINDS, EVENT_ROTOR, EVENT_TIME,
+                                          EVENT_UAV, EVENT_VALUE, KIND_ROTOR_EFFECTIVENESS)
+
 
 WORLD_FRAME = 'world'
 PAYLOAD_FRAME = 'payload'
@@ -82,3 +85,20 @@ def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | N
             np.concatenate([u.body_rates for u in uavs]),
             np.asarray(snapshot.payload_position, dtype=float),
             np.asarray(snapshot.payload_velocity, dtype=float), previous)
+
+
+FormationEventValues = tuple[str, int, int, float, float, str]
+
+
+def formation_event(row: Sequence[float]) -> FormationEventValues:
+    """A multilift_msgs/FormationEvent's (type, uav (from 1), rotor (from 1; 0: none), value,
+    scheduled_time [s], description) from an event row (physics.layout EVENT_*)."""
+    kind = int(row[EVENT_KIND])
+    uav = int(row[EVENT_UAV]) + 1
+    if kind == KIND_ROTOR_EFFECTIVENESS:
+        rotor, value = int(row[EVENT_ROTOR]) + 1, float(row[EVENT_VALUE])
+        text = f'uav{uav} rotor {rotor} at {100.0 * value:g} % of its thrust'
+    else:  # cable_release
+        rotor, value = 0, 0.0
+        text = f'uav{uav} releases its cable'
+    return EVENT_KINDS[kind], uav, rotor, value, float(row[EVENT_TIME]), text

@@ -24,6 +24,7 @@ from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_KIND, EVENT_KINDS
                                           ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
 from multilift_sim.physics.measurement import odometry_states
 from multilift_sim import kernels
+from multilift_sim.msgvalues import formation_event
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import RunStatistics
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
@@ -97,6 +98,14 @@ def event_array(scenario: Scenario) -> np.ndarray:
     return rows
 
 
+def event_records(rows: np.ndarray) -> list[dict]:
+    """Event rows (physics.layout EVENT_*) as a run's summary lists them: each with its
+    scheduled time [s], type, uav (from 1), rotor (from 1; 0: none), value and description
+    (msgvalues.formation_event, what /formation/events carries)."""
+    keys = ('type', 'uav', 'rotor', 'value', 'time', 'description')
+    return [dict(zip(keys, formation_event(row))) for row in rows]
+
+
 def initial_state(scenario: Scenario) -> np.ndarray:
     """Initial formation state on the constraint manifold, at rest."""
     if scenario.n_uavs == 1:
@@ -159,9 +168,12 @@ class FormationSimulator:
         self._reach = cable_reach(scenario)
         self._all_taut = np.ones(self.n, dtype=bool)  # a formulation without a taut set's
         self._swing_every = swing_sampling(self.n)
-        # the scenario's events (physics.events) and the row of the next one to come
+        # the scenario's events (physics.events), the row of the next one to come and the rows
+        # of those that happened at the current tick
         self.events = event_array(scenario)
         self.next_event = 0
+        self.happened = range(0)
+        self._apply_events()
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
         self._check(0.0)
@@ -229,11 +241,6 @@ class FormationSimulator:
     def advance(self, rotor_speeds: list[np.ndarray], saturated: list[np.ndarray]) -> None:
         """Hold `rotor_speeds` over one control period and integrate to the next tick."""
         speeds = self._checked_speeds(rotor_speeds)
-        if self.next_event < len(self.events):
-            model = self.model
-            self.next_event = kernels.runnable(apply_events)(
-                self.events, self.next_event, self.tick, model.effectiveness, model._taut,
-                model.released)
         self.stats.add_commands(speeds, saturated, self.period_ns * 1e-9)
         step = self.model.integrate(self.state, speeds, self.dt, self.steps_per_tick)
         self.state = step.state
@@ -242,7 +249,28 @@ class FormationSimulator:
         if self.scenario.cable_model == 'slack':
             self.stats.add_slack(self.taut, self.period_ns * 1e-9)
         self.tick += 1
+        self._apply_events()
         self._check(self.t, (step.constraint, step.constraint_rate))
+
+    def happened_rows(self) -> np.ndarray:
+        """The rows (physics.layout EVENT_*) of the events the current tick is the first to
+        show."""
+        return self.events[self.happened.start:self.happened.stop]
+
+    def events_summary(self) -> list[dict]:
+        """The events that have happened, as the run's summary names them."""
+        return event_records(self.events[:self.next_event])
+
+    def _apply_events(self) -> None:
+        """The scenario's events of the current tick, applied to the model before the tick's
+        state is checked and sent (`physics.events.apply_events`); their rows in `happened`."""
+        first = self.next_event
+        if first < len(self.events):
+            model = self.model
+            self.next_event = kernels.runnable(apply_events)(
+                self.events, first, self.tick, model.effectiveness, model.taut,
+                model.released)
+        self.happened = range(first, self.next_event)
 
     def _checked_speeds(self, rotor_speeds: list[np.ndarray]) -> np.ndarray | list[np.ndarray]:
         """The commands as one (n, n_r) array (a list when the rotor counts differ), or

@@ -14,7 +14,8 @@ from typing import Sequence
 import numpy as np
 
 from multilift_sim import cdr
-from multilift_sim.msgvalues import IDENTITY, PAYLOAD_FRAME, formation_snapshot, uav_frame, vec3
+from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, formation_event, formation_snapshot,
+                                     uav_frame, vec3)
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
@@ -23,7 +24,7 @@ from multilift_sim.physics.measurement import odometry_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.scene import FormationScene
 from multilift_sim.simulation import Snapshot
-from multilift_sim.topics import (CLOCK, FORMATION_SNAPSHOT, FORMATION_STATE, MARKERS,
+from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE, MARKERS,
                                   PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
@@ -53,6 +54,7 @@ class SimulatorMessages:
         self._state = cdr.formation_state(n)
         self._scene = FormationScene(scenario)
         self._markers = cdr.MarkerArray(self._scene.specs)
+        self._event = cdr.FormationEvent()
 
     def state(self, snap: Snapshot, gust: Sequence[float],
               applied: Sequence[np.ndarray] | None, last: bool = False) -> list[Message]:
@@ -87,6 +89,11 @@ class SimulatorMessages:
         out.append((TF, self._tf.pack(t_ns, [u[:3] for u in uavs] + [payload_position],
                                       [u[3:7] for u in uavs] + [IDENTITY])))
         return out
+
+    def events(self, t_ns: int, rows: np.ndarray) -> list[Message]:
+        """/formation/events: one message per event row (physics.layout EVENT_*) that
+        happened at the tick t_ns, sent after the tick's state (which shows them)."""
+        return [(EVENTS, self._event.pack(t_ns, *formation_event(row))) for row in rows]
 
     def formation(self, t_ns: int, tension: np.ndarray, g: np.ndarray, g_dot: np.ndarray,
                   taut: np.ndarray) -> Message:

@@ -19,6 +19,7 @@ ROTOR_COMMAND_TYPE = 'multilift_msgs/msg/RotorCommand'
 ATTITUDE_SETPOINT_TYPE = 'multilift_msgs/msg/AttitudeSetpoint'
 TRACKING_REFERENCE_TYPE = 'multilift_msgs/msg/TrackingReference'
 FORMATION_ERROR_TYPE = 'multilift_msgs/msg/VirtualConstraintError'
+FORMATION_EVENT_TYPE = 'multilift_msgs/msg/FormationEvent'
 TF_TYPE = 'tf2_msgs/msg/TFMessage'
 
 # topics of the whole run
@@ -30,6 +31,7 @@ FORMATION_SNAPSHOT = '/formation/snapshot'  # what the controllers read, one mes
 MARKERS = '/visualization/markers'      # the formation drawn for RViz / Foxglove
 MARKER_DECIMATION = 10                  # MARKERS every this many control ticks
 TF = '/tf'                              # world -> uav{i}/base_link, world -> payload
+EVENTS = '/formation/events'            # the scenario's events as they happen
 
 # leaves of the per-UAV topics /uav{i}/{leaf}
 ODOM = 'odom'                           # UAV i's state (every UAV)
@@ -44,7 +46,7 @@ UAV_TYPES = {ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
 RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
              PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
-             MARKERS: MARKER_ARRAY_TYPE, TF: TF_TYPE}
+             MARKERS: MARKER_ARRAY_TYPE, TF: TF_TYPE, EVENTS: FORMATION_EVENT_TYPE}
 
 _UAV_TOPIC = re.compile(r'^/uav([1-9][0-9]*)/(' + '|'.join(UAV_TYPES) + r')$')
 

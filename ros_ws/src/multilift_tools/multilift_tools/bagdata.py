@@ -19,8 +19,9 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 import numpy as np
 
 from multilift_sim.kinematics import euler_from_quaternion
-from multilift_sim.topics import (ATTITUDE_SETPOINT, ATTITUDE_SETPOINT_TYPE, FORMATION_ERROR,
-                                  FORMATION_ERROR_TYPE, FORMATION_STATE, FORMATION_STATE_TYPE,
+from multilift_sim.topics import (ATTITUDE_SETPOINT, ATTITUDE_SETPOINT_TYPE, EVENTS,
+                                  FORMATION_ERROR, FORMATION_ERROR_TYPE, FORMATION_EVENT_TYPE,
+                                  FORMATION_STATE, FORMATION_STATE_TYPE,
                                   ODOM, ODOMETRY_TYPE, PAYLOAD_GUST, PAYLOAD_ODOM,
                                   REFERENCE_TOPIC, ROTOR_CMD, ROTOR_COMMAND_TYPE,
                                   TRACKING_REFERENCE_TYPE, VECTOR3_STAMPED_TYPE, topic_type,
@@ -77,11 +78,15 @@ def _vector3_stamped(msg: Any) -> dict[str, Any]:
     return {'vector': _vec(msg.vector)}
 
 
+def _formation_event(msg: Any) -> dict[str, Any]:
+    return {'type': str(msg.type), 'uav': int(msg.uav), 'description': str(msg.description)}
+
+
 _EXTRACT: dict[str, Callable[[Any], dict[str, Any]]] = {
     ODOMETRY_TYPE: _odometry, FORMATION_STATE_TYPE: _formation_state,
     ROTOR_COMMAND_TYPE: _rotor_command, ATTITUDE_SETPOINT_TYPE: _attitude_setpoint,
     TRACKING_REFERENCE_TYPE: _reference, FORMATION_ERROR_TYPE: _formation_error,
-    VECTOR3_STAMPED_TYPE: _vector3_stamped,
+    VECTOR3_STAMPED_TYPE: _vector3_stamped, FORMATION_EVENT_TYPE: _formation_event,
 }
 
 
@@ -145,6 +150,14 @@ class Run:
             return self.series[topic]
         except KeyError:
             raise RunDataError(f'bag {self.path} has no messages on {topic}') from None
+
+    def events(self) -> list[tuple[float, str]]:
+        """The scenario's events the run met: (time [s] of the first state showing it, its
+        description), from /formation/events (none in a bag without it)."""
+        if not self.has(EVENTS):
+            return []
+        series = self.topic(EVENTS)
+        return [(float(t), str(text)) for t, text in zip(series.t, series['description'])]
 
     @property
     def n_uavs(self) -> int:

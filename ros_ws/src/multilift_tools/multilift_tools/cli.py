@@ -122,6 +122,8 @@ def _summary(name: str, data: dict, bag: Path | None, scenario) -> None:
                          'place under the UAVs)')
         if scenario.gusts:
             lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} m/s')
+        for event in sim.get('events', []):
+            lines.append(f'  event at {event["time"]:g} s   {event["description"]}')
     leader = data.get('leader')
     if leader and leader.get('answered_states'):
         lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} m, '

@@ -22,7 +22,7 @@ from multilift_tools.bagdata import Run, RunDataError, rotor_limits
 from multilift_tools.metrics import interp_rows
 from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, SATURATION_GREY, WORLD,
                                         Context, Parser, equal_3d, finish_time_axes,
-                                        formation_row_labels, legend,
+                                        formation_row_labels, legend, mark_events,
                                         parse_and_load, plot_context, plt, save_figure,
                                         shade_flags, uav_color, uav_label, uav_width,
                                         value_span, vehicle_of)
@@ -330,11 +330,13 @@ def fig_leader_tracking(ctx: Context) -> Figure:
 @dataclass(frozen=True)
 class FigureSpec:
     """A figure of `plot`: file stem, function, and `lacks(run)`: what the bag lacks for it
-    (empty: it can be drawn)."""
+    (empty: it can be drawn); `over_time`: its axes share simulated time, on which the run's
+    events are marked."""
 
     name: str
     make: Callable[[Context], Figure]
     lacks: Callable[[Run], list[str]]
+    over_time: bool = True
 
 
 def _topics(*topics: str) -> Callable[[Run], list[str]]:
@@ -347,8 +349,8 @@ def _lacks_followers(run: Run) -> list[str]:
 
 
 FIGURES: tuple[FigureSpec, ...] = (
-    FigureSpec('trajectories_3d', fig_trajectories_3d, _topics(PAYLOAD_ODOM)),
-    FigureSpec('top_view', fig_top_view, _topics(PAYLOAD_ODOM)),
+    FigureSpec('trajectories_3d', fig_trajectories_3d, _topics(PAYLOAD_ODOM), over_time=False),
+    FigureSpec('top_view', fig_top_view, _topics(PAYLOAD_ODOM), over_time=False),
     FigureSpec('cable_constraints', fig_cable_constraints, _topics(FORMATION_STATE)),
     FigureSpec('cable_tensions', fig_tensions, _topics(FORMATION_STATE)),
     FigureSpec('formation_errors', fig_formation_errors, _lacks_followers),
@@ -375,6 +377,9 @@ def make_plots(ctx: Context, out: Path) -> tuple[list[Path], list[str]]:
             plt.close('all')
             skipped.append(f'{spec.name}: {exc}')
             continue
+        if spec.over_time:
+            mark_events([ax for ax in fig.axes if ax.get_label() != '<colorbar>'],
+                        ctx.run.events())
         written.append(save_figure(fig, out / f'{spec.name}.png'))
     return written, skipped
 

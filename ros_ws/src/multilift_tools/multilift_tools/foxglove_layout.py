@@ -4,12 +4,15 @@ The layout has the 3D panel (the markers of /visualization/markers and the tf fr
 following `world`) beside plots, every series against its message's header stamp: every
 cable's tension, every UAV's rotor speeds (as many as its frame type has), the leader's position
 against its mission reference, every UAV's attitude set-point, and every follower's formation
-(virtual-constraint) errors.
+(virtual-constraint) errors. A scenario with `events:` has, under the 3D panel, the messages
+of /formation/events as they happen (docs/events.md).
 """
 from __future__ import annotations
 
 import json
 from pathlib import Path
+
+from multilift_sim.topics import EVENTS
 
 COLORS = ['#4e98e2', '#f5774d', '#61cbff', '#b87fd6', '#71c26a', '#f7df71', '#e96d9f',
           '#9b9b9b']
@@ -91,9 +94,17 @@ def layout(scenario) -> dict:
                                        for k in range(rows))])
     frames = ['world', 'payload'] + [f'uav{i}/base_link' for i in range(1, n + 1)]
     config = {'3D!multilift': _three_d(frames), **plots}
+    scene: str | dict = '3D!multilift'
+    if scenario.events:
+        config['RawMessages!events'] = {
+            'topicPath': EVENTS, 'diffEnabled': False, 'diffMethod': 'custom',
+            'diffTopicPath': '', 'showFullMessageForDiff': False,
+            'foxglovePanelTitle': f'Events ({EVENTS})'}
+        scene = {'direction': 'column', 'splitPercentage': 75, 'first': scene,
+                 'second': 'RawMessages!events'}
     return {'configById': config, 'globalVariables': {}, 'userNodes': {},
             'playbackConfig': {'speed': 1},
-            'layout': {'direction': 'row', 'splitPercentage': 55, 'first': '3D!multilift',
+            'layout': {'direction': 'row', 'splitPercentage': 55, 'first': scene,
                        'second': _stack(list(plots))}}
 
 

@@ -29,6 +29,7 @@ from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
 from multilift_sim.formulations import make_formulation
+from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
@@ -106,6 +107,7 @@ class EngineBag:
             messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
                                           odometry[k], payload_position[k],
                                           payload_velocity[k], gusts[k])
+            messages += self._events_at(tick, t_ns)
             for i in range(n):
                 if not self._controllers:
                     messages += command_of(i, t_ns, speed_lists[k][i], saturated[k][i])
@@ -130,17 +132,24 @@ class EngineBag:
         payload_position = state[6 * n:6 * n + 3].tolist()
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
                                              state[12 * n + 3:12 * n + 6].tolist(),
-                                             memory.gust[0].tolist()), t_ns)
+                                             memory.gust[0].tolist())
+                    + self._events_at(tick, t_ns), t_ns)
         scenario = self._scenario
         model = make_formulation(scenario.simulation.integrator, scenario.formation_params(),
                                  scenario.cable_model)
-        if scenario.cable_model == 'slack':
-            model.taut = memory.taut[0]
+        model.taut[:] = memory.taut[0]  # released cables (events), slack ones
+        model.effectiveness[:] = memory.effectiveness[0]
         held = list(self._held.reshape(n, -1)) if self._held is not None else None
         tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
                         state[:6 * n].reshape(n, 6)[:, 3:].tolist(), payload_position)
+
+    def _events_at(self, tick: int, t_ns: int) -> list:
+        """/formation/events of the events that fall on `tick` (the state there shows them)."""
+        rows = self._engine.arrays.events[0]
+        return self._simulator.events(t_ns, rows[rows[:, EVENT_TICK] == tick]) if len(rows) \
+            else []
 
     def _formation(self, tick: int, t_ns: int, tension: list, g: list, g_dot: list,
                    taut: list, odometry: list, euler: list, payload_position: list) -> None:
@@ -177,6 +186,7 @@ class HeadlessBag:
         self.finish_pending(sim)
         messages = self._simulator.state(snap, sim.payload_gust, self._applied,
                                          last=sim.finished)
+        messages += self._simulator.events(snap.t_ns, sim.happened_rows())
         if answers:
             self._applied = [a.output.rotor_speeds for a in answers]
         for answer in answers:

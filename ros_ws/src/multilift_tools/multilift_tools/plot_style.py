@@ -29,6 +29,7 @@ TIME_LABEL = 't [s] (simulated)'
 PAYLOAD_COLOR = 'black'
 DPI = 120
 SATURATION_GREY = '0.82'
+EVENT_COLOR = 'tab:red'  # a scenario event's line (mark_events)
 AXES_XYZ = ('x', 'y', 'z')
 
 
@@ -62,6 +63,17 @@ def finish_time_axes(axes: Sequence[Axes]) -> None:
     for ax in axes:
         ax.grid(True, alpha=0.35)
     axes[-1].set_xlabel(TIME_LABEL)
+
+
+def mark_events(axes: Sequence[Axes], events: Sequence[tuple[float, str]]) -> None:
+    """A dashed line at each event's time [s] on every time axes, its description written
+    along the line on the first."""
+    for t, text in events:
+        for k, ax in enumerate(axes):
+            ax.axvline(t, color=EVENT_COLOR, ls='--', lw=0.9, alpha=0.85)
+            if k == 0:
+                ax.text(t, 0.98, f' {text}', transform=ax.get_xaxis_transform(), rotation=90,
+                        fontsize='x-small', color=EVENT_COLOR, ha='right', va='top')
 
 
 def legend(ax: Axes, **kwargs: Any) -> None:

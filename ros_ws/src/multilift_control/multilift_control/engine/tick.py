@@ -111,13 +111,11 @@ def check(a, m, b):
 def advance_formation(a, m, b, speeds, saturated, tension):
     """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
     limit) commanded over the control period (RK4, the rotors through their actuators:
-    `physics.actuators`), the events of this tick applied first (`physics.events`), then
+    `physics.actuators`), the events of the new tick applied (`physics.events`), then
     checked; the tension T_i = 2 l_i lambda_i
     [N] at the tick into tension. The second half of a tick, whoever answered."""
     n = speeds.shape[0]
     period = a.period_ns[b] * 1e-9
-    m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b], m.effectiveness[b],
-                                   m.taut[b], m.released[b])
     run_add_commands(m.run[b], speeds, saturated, period)
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], speeds, m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
@@ -132,6 +130,8 @@ def advance_formation(a, m, b, speeds, saturated, tension):
     m.g[b, :] = g
     m.g_dot[b, :] = g_dot
     m.tick[b] += 1
+    m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b], m.effectiveness[b],
+                                   m.taut[b], m.released[b])
     check(a, m, b)
     if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
         m.status[b] = FINISHED
@@ -214,12 +214,14 @@ def run_commanded(a, m, speeds, saturated, which, tension):
 
 @jit
 def start(a, m, which):
-    """The residuals and check of each formation b with which[b] at its initial state (before
-    its first tick)."""
+    """The residuals, events and check of each formation b with which[b] at its initial state
+    (before its first tick)."""
     for b in range(m.state.shape[0]):
         if not which[b]:
             continue
         residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
+        m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b],
+                                       m.effectiveness[b], m.taut[b], m.released[b])
         check(a, m, b)
         if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
             m.status[b] = FINISHED

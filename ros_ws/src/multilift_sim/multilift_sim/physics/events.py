@@ -1,6 +1,8 @@
 """The scenario's events (`events:`, issue 21) applied to a formation's arrays at the control
-tick they fall on, before the period from that tick is integrated: one function, which the
-engine's tick and FormationSimulator both call. Rows and kinds: `physics.layout` EVENT_*.
+tick they fall on, before that tick's state is checked and sent: the state at the tick shows
+them (a released cable no longer taut) and the period from the tick on feels them. One
+function, which the engine's tick and FormationSimulator both call. Rows and kinds:
+`physics.layout` EVENT_*.
 """
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import (EVENT_KIND, EVENT_ROTOR, EVENT_TICK, EVENT_UAV,

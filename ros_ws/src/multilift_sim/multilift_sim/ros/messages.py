@@ -9,8 +9,9 @@ from typing import Sequence
 
 import numpy as np
 from geometry_msgs.msg import Point, TransformStamped, Vector3, Vector3Stamped
-from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, FormationState,
-                                RotorCommand, TrackingReference, VirtualConstraintError)
+from multilift_msgs.msg import (AttitudeSetpoint, FormationEvent, FormationSnapshot,
+                                FormationState, RotorCommand, TrackingReference,
+                                VirtualConstraintError)
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
@@ -95,6 +96,16 @@ def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | N
                             rotor_count=[int(c) for c in rotor_counts],
                             previous_rotor_speeds=previous if previous.size else [])
     msg.header.stamp = stamp_from_ns(snapshot.t_ns)
+    msg.header.frame_id = WORLD_FRAME
+    return msg
+
+
+def formation_event(t_ns: int, row: Sequence[float]) -> FormationEvent:
+    """From an event row (physics.layout EVENT_*) that happened at the tick t_ns."""
+    kind, uav, rotor, value, scheduled, description = msgvalues.formation_event(row)
+    msg = FormationEvent(type=kind, uav=uav, rotor=rotor, value=value, scheduled_time=scheduled,
+                         description=description)
+    msg.header.stamp = stamp_from_ns(t_ns)
     msg.header.frame_id = WORLD_FRAME
     return msg
 

@@ -24,7 +24,7 @@ from typing import NoReturn
 
 import numpy as np
 from geometry_msgs.msg import Vector3Stamped
-from multilift_msgs.msg import FormationSnapshot, FormationState, RotorCommand
+from multilift_msgs.msg import FormationEvent, FormationSnapshot, FormationState, RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.node import Node, NodeNameNonExistentError
 from rclpy.qos import DurabilityPolicy
@@ -38,7 +38,7 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import (MARKER_DECIMATION, ODOM, parse_external, state_topics,
+from multilift_sim.topics import (EVENTS, MARKER_DECIMATION, ODOM, parse_external, state_topics,
                                    uav_topic)
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
@@ -87,11 +87,12 @@ class SimNode(Node):
         self.marker_pub = self.create_publisher(MarkerArray, '/visualization/markers',
                                                 PUBLISHER_QOS)
         self.tf_pub = self.create_publisher(TFMessage, '/tf', PUBLISHER_QOS)
+        self.events_pub = self.create_publisher(FormationEvent, EVENTS, PUBLISHER_QOS)
         # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
-            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub,
+            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, self.events_pub,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.commands: list[RotorCommand | None] = [None] * n
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
@@ -177,6 +178,8 @@ class SimNode(Node):
         snap = self.sim.snapshot()
         self.outputs.send(self.packer.state(snap, self.sim.payload_gust, self.applied,
                                             last=self.sim.finished))
+        if self.sim.happened:  # the scenario's events this state is the first to show
+            self.outputs.send(self.packer.events(snap.t_ns, self.sim.happened_rows()))
         return snap
 
     def wait_for_commands(self) -> None:
@@ -244,7 +247,8 @@ class SimNode(Node):
         if self.progress_file:
             self._progress(wall)
         stats = self.sim.stats.as_dict()
-        stats.update(wall_time=wall, error=error, scenario=self.scenario.name)
+        stats.update(wall_time=wall, error=error, scenario=self.scenario.name,
+                     events=self.sim.events_summary())
         write_summary(self.summary_dir, 'sim', stats)
 
 

@@ -45,8 +45,8 @@ def test_events_load_in_time_order_at_their_ticks():
     assert [e.type for e in scenario.events] == ['rotor_effectiveness', 'cable_release']
     rows = event_array(scenario)
     # the first control tick (100 Hz) at or after each time; UAVs and rotors from 0
-    assert rows.tolist() == [[200.0, 2.0, 0.0, 1.0, 3.0, 0.25], [601.0, 6.005, 1.0, 2.0, 0.0,
-                                                                  1.0]]
+    assert rows.tolist() == [[200.0, 2.0, 0.0, 1.0, 3.0, 0.25, 0.0],
+                             [601.0, 6.005, 1.0, 2.0, 0.0, 1.0, 0.0]]
     assert scenario_io.load('multi_lift').events == ()  # the shipped scenarios have none
 
 
@@ -60,7 +60,9 @@ def test_events_load_in_time_order_at_their_ticks():
     ({'time': 1.0, 'type': 'rotor_effectiveness', 'uav': 1, 'rotor': 1,
       'effectiveness': 1.5}, r'effectiveness: 1\.5 must be within \[0, 1\]'),
     ({'time': 1.0, 'type': 'cable_release', 'uav': 2, 'rotor': 1}, 'rotor: unknown key'),
-    ({'time': 1.0, 'type': 'rotor_effectiveness', 'uav': 1}, 'rotor')])
+    ({'time': 1.0, 'type': 'rotor_effectiveness', 'uav': 1}, 'rotor'),
+    ({'time': 1.0, 'type': 'controller_silence', 'uav': 2, 'duration': 0.0},
+     r'duration: 0\.0 must be > 0')])
 def test_bad_events_name_key_and_rule(event, message):
     with pytest.raises(scenario_io.ScenarioError, match=message):
         _with_events('multi_lift', 10.0, [event])
@@ -140,7 +142,7 @@ def test_a_release_does_no_work_and_the_free_uav_flies_on(model_class):
     for tick in range(150):
         next_event = kernels.runnable(apply_events)(events, next_event, tick,
                                                     model.effectiveness, model._taut,
-                                                    model.released)
+                                                    model.released, np.zeros(2, np.int64))
         if next_event and released_at is None:
             released_at = model.layout.uav_velocities(x)[1].copy()
         x = model.integrate(x, idle, 0.005, 2).state
@@ -194,3 +196,33 @@ def test_a_headless_bag_carries_the_events_to_plots_and_layout(tmp_path):
     panels = layout(scenario)['configById']
     assert panels['RawMessages!events']['topicPath'] == '/formation/events'
     assert 'RawMessages!events' not in layout(scenario_io.load('twin_lift'))['configById']
+
+
+def test_a_silent_controller_s_last_command_is_held_in_both_paths():
+    """uav2's controller silent from 2.0 s for 0.5 s: the simulator applies the last command
+    it got (the answer to the state at 1.99 s) over ticks 200..249, the answers again from
+    tick 250; the ROS path (FormationSimulator) flies the same to the bit."""
+    scenario = _with_events('multi_lift', 4.0, [
+        {'time': 2.0, 'type': 'controller_silence', 'uav': 2, 'duration': 0.5}])
+    assert event_array(scenario)[0].tolist() == [200.0, 2.0, 2.0, 1.0, 0.0, 0.5, 250.0]
+    engine = Engine(scenario)
+    record = engine.new_record(1)
+    held = []
+    for tick in range(260):
+        engine.step(1, record)
+        held.append((record.speeds[0, 0, 1].copy(), engine.memory.held[0, 1].copy()))
+    answers, applied = (np.array(x) for x in zip(*held))
+    assert np.array_equal(applied[:200], answers[:200])
+    assert (applied[200:250] == answers[199]).all()          # held through the silence ...
+    assert not np.array_equal(answers[200:250], np.broadcast_to(answers[199], (50, 4)))
+    assert np.array_equal(applied[250:], answers[250:])      # ... then its answers again
+    engine.step(10 ** 6)
+    run = run_headless(scenario)
+    assert np.array_equal(engine.state[0], run.simulator.state)
+    assert engine.summary(0)['sim']['events'] == run.summary()['sim']['events'] == [{
+        'type': 'controller_silence', 'uav': 2, 'rotor': 0, 'value': 0.5, 'time': 2.0,
+        'description': 'uav2 controller silent for 0.5 s (the simulator holds its last '
+                       'command)'}]
+    quiet = Engine(dataclasses.replace(scenario, events=()))
+    quiet.step(10 ** 6)
+    assert not np.array_equal(quiet.state[0], engine.state[0])

@@ -12,7 +12,8 @@ from typing import Sequence
 import numpy as np
 
 from multilift_sim.physics.layout import (EVENT_KIND, EVENT_KINDS, EVENT_ROTOR, EVENT_TIME,
-                                          EVENT_UAV, EVENT_VALUE, KIND_ROTOR_EFFECTIVENESS)
+                                          EVENT_UAV, EVENT_VALUE, KIND_CONTROLLER_SILENCE,
+                                          KIND_ROTOR_EFFECTIVENESS)
 
 
 WORLD_FRAME = 'world'
@@ -98,6 +99,10 @@ def formation_event(row: Sequence[float]) -> FormationEventValues:
     if kind == KIND_ROTOR_EFFECTIVENESS:
         rotor, value = int(row[EVENT_ROTOR]) + 1, float(row[EVENT_VALUE])
         text = f'uav{uav} rotor {rotor} at {100.0 * value:g} % of its thrust'
+    elif kind == KIND_CONTROLLER_SILENCE:
+        rotor, value = 0, float(row[EVENT_VALUE])
+        text = (f'uav{uav} controller silent for {value:g} s (the simulator holds its last '
+                'command)')
     else:  # cable_release
         rotor, value = 0, 0.0
         text = f'uav{uav} releases its cable'

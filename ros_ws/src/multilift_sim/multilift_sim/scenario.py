@@ -124,6 +124,7 @@ class EventConfig:
     uav: int                         # the UAV it concerns, from 1 (1 = the leader)
     rotor: int = 0                   # rotor_effectiveness: the rotor, from 1; else 0
     effectiveness: float = 1.0       # rotor_effectiveness: its share of thrust, in [0, 1]
+    duration: float = 0.0            # controller_silence: how long no command arrives [s]
 
 
 @dataclass(frozen=True)
@@ -513,6 +514,8 @@ def _events(top: _Section, uavs: list[UavConfig], duration: float) -> tuple[Even
                 raise e.fail('rotor', rotor, f'must be a rotor of uav{uav}, from 1 to {rotors}')
             event = dataclasses.replace(event, rotor=rotor, effectiveness=e.number(
                 'effectiveness', ..., lambda v: 0 <= v <= 1, 'must be within [0, 1]'))
+        elif kind == 'controller_silence':
+            event = dataclasses.replace(event, duration=e.positive('duration'))
         elif kind == 'cable_release':
             if uav in released:
                 raise e.fail('uav', uav, 'has let go of its cable already')

@@ -15,9 +15,10 @@ from multilift_sim.dynamics import Integration, StateLayout, initial_state_singl
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
-from multilift_sim.physics.events import apply_events
-from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_KIND, EVENT_KINDS, EVENT_ROTOR,
-                                          EVENT_TICK, EVENT_TIME, EVENT_UAV, EVENT_VALUE,
+from multilift_sim.physics.events import apply_events, held_commands
+from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_END_TICK, EVENT_KIND,
+                                          EVENT_KINDS, EVENT_ROTOR, EVENT_TICK, EVENT_TIME,
+                                          EVENT_UAV, EVENT_VALUE,
                                           MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
@@ -94,7 +95,11 @@ def event_array(scenario: Scenario) -> np.ndarray:
         rows[k, EVENT_KIND] = EVENT_KINDS.index(event.type)
         rows[k, EVENT_UAV] = event.uav - 1
         rows[k, EVENT_ROTOR] = max(event.rotor - 1, 0)
-        rows[k, EVENT_VALUE] = event.effectiveness
+        if event.type == 'controller_silence':
+            rows[k, EVENT_VALUE] = event.duration
+            rows[k, EVENT_END_TICK] = math.ceil((event.time + event.duration) * rate - 1e-9)
+        else:
+            rows[k, EVENT_VALUE] = event.effectiveness
     return rows
 
 
@@ -173,6 +178,12 @@ class FormationSimulator:
         self.events = event_array(scenario)
         self.next_event = 0
         self.happened = range(0)
+        # the commands applied last (held while a controller is silent: physics.events)
+        rotors = max(u.vehicle.n_rotors for u in scenario.uavs)
+        self.silent_until = np.zeros(self.n, dtype=np.int64)
+        self.held = np.full((self.n, rotors), math.nan)
+        self.held_saturated = np.zeros((self.n, rotors), dtype=bool)
+        self._silences = any(e.type == 'controller_silence' for e in scenario.events)
         self._apply_events()
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
@@ -241,6 +252,8 @@ class FormationSimulator:
     def advance(self, rotor_speeds: list[np.ndarray], saturated: list[np.ndarray]) -> None:
         """Hold `rotor_speeds` over one control period and integrate to the next tick."""
         speeds = self._checked_speeds(rotor_speeds)
+        if self._silences:
+            speeds, saturated = self._held(speeds, saturated)
         self.stats.add_commands(speeds, saturated, self.period_ns * 1e-9)
         step = self.model.integrate(self.state, speeds, self.dt, self.steps_per_tick)
         self.state = step.state
@@ -251,6 +264,23 @@ class FormationSimulator:
         self.tick += 1
         self._apply_events()
         self._check(self.t, (step.constraint, step.constraint_rate))
+
+    def _held(self, speeds, saturated) -> tuple:
+        """The commands applied over this period: a silent controller's held
+        (`physics.events.held_commands`), as (n, rotors) arrays, or lists of each UAV's own
+        where the rotor counts differ."""
+        padded = np.zeros_like(self.held)
+        flags = np.zeros_like(self.held_saturated)
+        for i, (own, own_flags) in enumerate(zip(speeds, saturated)):
+            padded[i, :len(own)] = own
+            flags[i, :len(own)] = own_flags
+        kernels.runnable(held_commands)(padded, flags, self.tick, self.silent_until, self.held,
+                                        self.held_saturated)
+        if self._uniform_rotors is not None:
+            return self.held.copy(), self.held_saturated.copy()
+        counts = [u.vehicle.n_rotors for u in self.scenario.uavs]
+        return ([self.held[i, :c].copy() for i, c in enumerate(counts)],
+                [self.held_saturated[i, :c].copy() for i, c in enumerate(counts)])
 
     def happened_rows(self) -> np.ndarray:
         """The rows (physics.layout EVENT_*) of the events the current tick is the first to
@@ -269,7 +299,7 @@ class FormationSimulator:
             model = self.model
             self.next_event = kernels.runnable(apply_events)(
                 self.events, first, self.tick, model.effectiveness, model.taut,
-                model.released)
+                model.released, self.silent_until)
         self.happened = range(first, self.next_event)
 
     def _checked_speeds(self, rotor_speeds: list[np.ndarray]) -> np.ndarray | list[np.ndarray]:

@@ -88,6 +88,9 @@ class FormationMemory(NamedTuple):
     effectiveness: np.ndarray     # (B, n, rotors): each rotor's share of its thrust, in [0, 1]
     released: np.ndarray          # (B, n) bool: the cables let go of for good (events)
     next_event: np.ndarray        # (B,) int: the row of the next event to come
+    silent_until: np.ndarray      # (B, n) int: the first tick a silent controller is heard
+    held: np.ndarray              # (B, n, rotors): the commands applied last [rad/s] (NaN: none)
+    held_saturated: np.ndarray    # (B, n, rotors) bool: their saturation flags
     tick: np.ndarray              # (B,) int: control periods flown
     status: np.ndarray            # (B,) int: RUNNING, FINISHED or why it stopped
     worst_cable: np.ndarray       # (B,) int: the cable of a stop (from 0)
@@ -193,8 +196,10 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
                                      dtype=float))
     memory = dict(
         state=initial_state(scenario), taut=np.ones(n, dtype=bool), rotors=model.rotors,
-        effectiveness=model.effectiveness, released=model.released, next_event=0, tick=0,
-        status=RUNNING,
+        effectiveness=model.effectiveness, released=model.released, next_event=0,
+        silent_until=np.zeros(n, dtype=np.int64),
+        held=np.full(model.rotors.shape, math.nan),
+        held_saturated=np.zeros(model.rotors.shape, dtype=bool), tick=0, status=RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n),
         cascade_memory=np.stack([c.memory for c in cascades]),
         follower_memory=follower_memory,

@@ -19,7 +19,7 @@ from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UA
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
 from multilift_sim.physics.actuators import actuated_period
-from multilift_sim.physics.events import apply_events
+from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
@@ -110,15 +110,18 @@ def check(a, m, b):
 @jit
 def advance_formation(a, m, b, speeds, saturated, tension):
     """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
-    limit) commanded over the control period (RK4, the rotors through their actuators:
+    limit) commanded over the control period (a silent controller's held: `physics.events`;
+    RK4, the rotors through their actuators:
     `physics.actuators`), the events of the new tick applied (`physics.events`), then
     checked; the tension T_i = 2 l_i lambda_i
     [N] at the tick into tension. The second half of a tick, whoever answered."""
     n = speeds.shape[0]
     period = a.period_ns[b] * 1e-9
-    run_add_commands(m.run[b], speeds, saturated, period)
+    held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
+                  m.held_saturated[b])
+    run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
     state, multipliers, g, g_dot = actuated_period(
-        m.state[b], speeds, m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
+        m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
         a.uavs[b], a.gusts[b], a.formation[b], m.taut[b], m.released[b], a.slack[b],
         a.physics_dt[b], a.physics_steps[b])
     for i in range(n):
@@ -131,7 +134,7 @@ def advance_formation(a, m, b, speeds, saturated, tension):
     m.g_dot[b, :] = g_dot
     m.tick[b] += 1
     m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b], m.effectiveness[b],
-                                   m.taut[b], m.released[b])
+                                   m.taut[b], m.released[b], m.silent_until[b])
     check(a, m, b)
     if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
         m.status[b] = FINISHED
@@ -221,7 +224,8 @@ def start(a, m, which):
             continue
         residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
         m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b],
-                                       m.effectiveness[b], m.taut[b], m.released[b])
+                                       m.effectiveness[b], m.taut[b], m.released[b],
+                                       m.silent_until[b])
         check(a, m, b)
         if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
             m.status[b] = FINISHED

@@ -94,10 +94,21 @@ class RotorMixer:
     """Body wrench -> rotor speeds with saturation (inverse of seed Eq. 2.14, Eq. 2.15:
     `laws.mixer.rotor_speeds`, attitude first)."""
 
-    def __init__(self, vehicle: MultirotorParams):
+    def __init__(self, vehicle: MultirotorParams, effectiveness: np.ndarray | None = None):
+        """`effectiveness` (n_rotors,) in [0, 1]: each rotor's share of its thrust and moment
+        as the controller knows it (None: all intact); the wrench is allocated over what the
+        rotors can give, a failed rotor's row left out (issue 21: reallocation after a rotor
+        fails, the fault known at once)."""
         self.matrix = allocation_matrix(vehicle.frame_type, vehicle.arm_length,
                                         vehicle.thrust_coefficient, vehicle.moment_coefficient)
-        self.pinv = np.linalg.pinv(self.matrix)
+        if effectiveness is None or np.all(np.asarray(effectiveness) == 1.0):
+            self.pinv = np.linalg.pinv(self.matrix)
+        else:
+            effectiveness = np.asarray(effectiveness, dtype=float)
+            self.pinv = np.linalg.pinv(self.matrix * effectiveness)
+            self.pinv[effectiveness == 0.0] = 0.0  # exactly out: `laws.mixer.rotor_speeds`
+            # round-off of a share that is 0 (a hexa's rotor opposite the failed one) made 0
+            self.pinv[np.abs(self.pinv) < 1e-9 * np.abs(self.pinv).max(axis=0)] = 0.0
         self.square_min = vehicle.rotor_speed_min ** 2
         self.square_max = vehicle.rotor_speed_max ** 2
         self.collective = self.pinv @ np.array([1.0, 0.0, 0.0, 0.0])  # omega^2 per newton

@@ -19,6 +19,7 @@ import numpy as np
 from multilift_control import laws
 from multilift_control.cascade import ControlOutput, FormationStates, UavState
 from multilift_control.controllers import make_controller
+from multilift_control.faults import FaultReallocation
 from multilift_control.formation import FormationFollower
 from multilift_control.laws.follower import lift_vectors
 from multilift_control.laws.mixer import collective_thrust
@@ -101,6 +102,8 @@ class ControllerRuntime:
         (`formation_runtimes`); by default its own (a node's)."""
         self.index = index
         self.is_follower = index > 0
+        self._period_ns = int(round(1e9 / scenario.simulation.control_rate))
+        self._faults = FaultReallocation(scenario, index)
         if self.is_follower:
             self.follower = FormationFollower.from_scenario(scenario, index)
             self.thrusts = ThrustBook(scenario) if thrusts is None else thrusts
@@ -126,6 +129,10 @@ class ControllerRuntime:
     def answer(self, t_ns: int, states: Sequence[UavState]) -> ControllerAnswer:
         """The answer to the formation state at t_ns (`states`: every UAV, from the leader)."""
         t = t_ns * 1e-9
+        cascade = self.follower.cascade if self.is_follower else getattr(self.leader, 'cascade',
+                                                                         None)
+        if cascade is not None:  # a fault of this UAV's rotors known from its tick on
+            self._faults.at(t_ns // self._period_ns, cascade.mixer)
         if not self.is_follower:
             output, reference = self.leader.update(t, states[0])
             if reference is not None:

@@ -15,6 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from multilift_control.controllers import LEADER_CONTROLLERS, ConstantRotorSpeed, MissionLeader
+from multilift_control.faults import fault_mixers
 from multilift_control.formation import FormationFollower
 from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_MEMORY_SIZE,
                                            FOLLOWER_SIZE, FOLLOWER_TWO_ALPHA, REFERENCE_SIZE,
@@ -63,7 +64,7 @@ class FormationArrays(NamedTuple):
     # the leader (multilift_control.laws.layout slots)
     leader_mode: np.ndarray       # (B,) int: MODE_*
     cascade: np.ndarray           # (B, n, CASCADE_SIZE): every UAV's cascade constants
-    mixers: np.ndarray            # (B, n, rotors, MIXER_SIZE)
+    fault_mixers: np.ndarray      # (B, k, rotors, MIXER_SIZE): faults.fault_mixers
     mission: np.ndarray           # (B, MISSION_SIZE)
     segments: np.ndarray          # (B, s, SEGMENT_SIZE)
     mission_steps: np.ndarray     # (B, s + 1 or 0, STEP_SIZE)
@@ -97,6 +98,7 @@ class FormationMemory(NamedTuple):
     worst_value: np.ndarray       # (B,): its |g| or |g_dot|
     g: np.ndarray                 # (B, n): g at the current tick [m^2]
     g_dot: np.ndarray             # (B, n): g_dot at the current tick [m^2/s]
+    mixers: np.ndarray            # (B, n, rotors, MIXER_SIZE): every UAV's, faults reallocated
     cascade_memory: np.ndarray    # (B, n, CASCADE_MEMORY_SIZE)
     follower_memory: np.ndarray   # (B, n, FOLLOWER_MEMORY_SIZE)
     thrusts: np.ndarray           # (B, n): the thrust book u_T,j [N]
@@ -183,7 +185,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         swing_every=swing_sampling(n), reach=cable_reach(scenario),
         leader_mode=LEADER_MODES.index(scenario.control.mode),
         cascade=np.stack([c.constants for c in cascades]),
-        mixers=np.stack([c.mixer.rows for c in cascades]),
+        fault_mixers=fault_mixers(scenario),
         mission=path.mission, segments=path.segments, mission_steps=path.steps,
         constant_speeds=np.asarray(constant.rotor_speeds, dtype=float),
         constant_saturated=np.asarray(constant.saturated, dtype=bool),
@@ -201,6 +203,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         held=np.full(model.rotors.shape, math.nan),
         held_saturated=np.zeros(model.rotors.shape, dtype=bool), tick=0, status=RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n),
+        mixers=np.stack([c.mixer.rows for c in cascades]),
         cascade_memory=np.stack([c.memory for c in cascades]),
         follower_memory=follower_memory,
         thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float), gust=np.zeros(3),

@@ -131,7 +131,8 @@ class Engine:
         states = self.measured() if states is None else np.ascontiguousarray(states, float)
         speeds = np.empty(self._answer[0].shape)
         saturated = np.empty(self._answer[1].shape, dtype=bool)
-        self._attitude_commands(self.arrays, states, np.ascontiguousarray(setpoints, float),
+        self._attitude_commands(self.arrays, self.memory, states,
+                                np.ascontiguousarray(setpoints, float),
                                 np.ascontiguousarray(thrust, float), speeds, saturated)
         return speeds, saturated
 

@@ -21,6 +21,7 @@ from multilift_control.laws.reference import mission_reference
 from multilift_sim.physics.actuators import actuated_period
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals
+from multilift_sim.physics.layout import EVENT_KIND, EVENT_UAV, KIND_ROTOR_EFFECTIVENESS
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
                                                    run_add_gust_speed, run_add_slack,
@@ -40,7 +41,7 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
     n = states.shape[0]
     if a.leader_mode[b] == MODE_CASCADE:
         s, sat, setpoint, lift, ref = leader_update(
-            a.cascade[b, 0], a.mixers[b, 0], m.cascade_memory[b, 0], a.mission[b],
+            a.cascade[b, 0], m.mixers[b, 0], m.cascade_memory[b, 0], a.mission[b],
             a.segments[b], a.mission_steps[b], t, states[0])
         for k in range(REFERENCE_SIZE):
             reference[k] = ref[k]
@@ -67,7 +68,7 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
         s, sat, setpoint, lift, own_errors, own_rates = follower_update(
             a.follower[b, i], a.masses[b], a.rows[b], a.targets[b], a.law_p[b, i],
             a.law_q[b, i], i, m.follower_memory[b, i], t, states, vectors, terms,
-            a.cascade[b, i], a.mixers[b, i])
+            a.cascade[b, i], m.mixers[b, i])
         speeds[i, :] = s
         saturated[i, :] = sat
         setpoints[i, :] = setpoint
@@ -108,6 +109,19 @@ def check(a, m, b):
 
 
 @jit
+def events(a, m, b):
+    """The scenario's events of formation b's current tick: in the physics
+    (`physics.events.apply_events`), and the controllers told of a rotor's fault at once (its
+    UAV's mixer reallocated: `faults.fault_mixers`)."""
+    first = m.next_event[b]
+    m.next_event[b] = apply_events(a.events[b], first, m.tick[b], m.effectiveness[b], m.taut[b],
+                                   m.released[b], m.silent_until[b])
+    for k in range(first, m.next_event[b]):
+        if int(a.events[b, k, EVENT_KIND]) == KIND_ROTOR_EFFECTIVENESS:
+            m.mixers[b, int(a.events[b, k, EVENT_UAV])] = a.fault_mixers[b, k]
+
+
+@jit
 def advance_formation(a, m, b, speeds, saturated, tension):
     """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
     limit) commanded over the control period (a silent controller's held: `physics.events`;
@@ -133,8 +147,7 @@ def advance_formation(a, m, b, speeds, saturated, tension):
     m.g[b, :] = g
     m.g_dot[b, :] = g_dot
     m.tick[b] += 1
-    m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b], m.effectiveness[b],
-                                   m.taut[b], m.released[b], m.silent_until[b])
+    events(a, m, b)
     check(a, m, b)
     if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
         m.status[b] = FINISHED
@@ -193,13 +206,13 @@ def mission_references(a, t, out):
 
 
 @jit
-def attitude_commands(a, states, setpoints, thrust, speeds, saturated):
+def attitude_commands(a, m, states, setpoints, thrust, speeds, saturated):
     """Every UAV's rotor speeds and saturation (B, n, rotors) holding attitude `setpoints`
     (B, n, 3: roll, pitch, yaw [rad]) with collective `thrust` (B, n) [N] from its measured
     `states` (B, n, UAV_STATE_SIZE): each UAV's cascade inner half (`attitude_command`)."""
     for b in range(states.shape[0]):
         for i in range(states.shape[1]):
-            s, sat = attitude_command(a.cascade[b, i], a.mixers[b, i], states[b, i],
+            s, sat = attitude_command(a.cascade[b, i], m.mixers[b, i], states[b, i],
                                       setpoints[b, i], thrust[b, i])
             speeds[b, i, :] = s
             saturated[b, i, :] = sat
@@ -223,9 +236,7 @@ def start(a, m, which):
         if not which[b]:
             continue
         residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
-        m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b],
-                                       m.effectiveness[b], m.taut[b], m.released[b],
-                                       m.silent_until[b])
+        events(a, m, b)
         check(a, m, b)
         if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
             m.status[b] = FINISHED

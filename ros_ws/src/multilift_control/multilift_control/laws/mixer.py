@@ -15,20 +15,33 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
     Attitude comes first: when a rotor would leave [omega_min, omega_max], the collective part
     is shifted (equal omega^2 on every rotor changes thrust only) to bring the request inside;
     what still does not fit is clipped. `saturated` flags the rotors whose request was out of
-    range."""
+    range.
+
+    After a rotor fails (`RotorMixer` of an effectiveness, issue 21) its row is 0: it is held
+    at omega_min and takes no part; a rotor that carries no collective share (the failed
+    one's opposite in a hexa's reallocation) is clipped but cannot take part in the shift."""
     n_rotors = mixer.shape[0]
     request = np.empty(n_rotors)
     saturated = np.empty(n_rotors, dtype=np.bool_)
-    highest = lowest = 0  # np.argmax, np.argmin: the first of equals
+    # np.argmax, np.argmin over the rotors with a collective share: the first of equals
+    highest = lowest = -1
     for k in range(n_rotors):
         total = 0.0
+        live = False
         for j in range(4):
             total += mixer[k, MIXER_WRENCH + j] * wrench[j]
+            live = live or mixer[k, MIXER_WRENCH + j] != 0.0
+        if not live:
+            request[k] = square_min
+            saturated[k] = False
+            continue
         request[k] = total
         saturated[k] = total > square_max or total < square_min
-        if total > request[highest]:
+        if mixer[k, MIXER_COLLECTIVE] <= 0.0:
+            continue
+        if highest < 0 or total > request[highest]:
             highest = k
-        if total < request[lowest]:
+        if lowest < 0 or total < request[lowest]:
             lowest = k
     high, low = request[highest], request[lowest]
     if high > square_max or low < square_min:
@@ -39,8 +52,8 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
             shift = -above if above > 0 else (below if below > 0 else 0.0)
             for k in range(n_rotors):
                 request[k] = request[k] + shift * mixer[k, MIXER_COLLECTIVE]
-        for k in range(n_rotors):
-            request[k] = min(max(request[k], square_min), square_max)
+    for k in range(n_rotors):  # what does not fit (a no-op for a request within the range)
+        request[k] = min(max(request[k], square_min), square_max)
     return np.sqrt(request), saturated
 
 

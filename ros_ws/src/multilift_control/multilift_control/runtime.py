@@ -131,8 +131,9 @@ class ControllerRuntime:
         t = t_ns * 1e-9
         cascade = self.follower.cascade if self.is_follower else getattr(self.leader, 'cascade',
                                                                          None)
-        if cascade is not None:  # a fault of this UAV's rotors known from its tick on
-            self._faults.at(t_ns // self._period_ns, cascade.mixer)
+        # the faults known from their tick on: this UAV's rotors, a follower's cable released
+        self._faults.at(t_ns // self._period_ns, None if cascade is None else cascade.mixer,
+                        self.follower.constraints if self.is_follower else None)
         if not self.is_follower:
             output, reference = self.leader.update(t, states[0])
             if reference is not None:

@@ -15,7 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from multilift_control.controllers import LEADER_CONTROLLERS, ConstantRotorSpeed, MissionLeader
-from multilift_control.faults import fault_mixers
+from multilift_control.faults import fault_mixers, target_schedule
 from multilift_control.formation import FormationFollower
 from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_MEMORY_SIZE,
                                            FOLLOWER_SIZE, FOLLOWER_TWO_ALPHA, REFERENCE_SIZE,
@@ -65,6 +65,7 @@ class FormationArrays(NamedTuple):
     leader_mode: np.ndarray       # (B,) int: MODE_*
     cascade: np.ndarray           # (B, n, CASCADE_SIZE): every UAV's cascade constants
     fault_mixers: np.ndarray      # (B, k, rotors, MIXER_SIZE): faults.fault_mixers
+    target_schedule: np.ndarray   # (B, S, 1 + m): (tick, targets) rows, faults.target_schedule
     mission: np.ndarray           # (B, MISSION_SIZE)
     segments: np.ndarray          # (B, s, SEGMENT_SIZE)
     mission_steps: np.ndarray     # (B, s + 1 or 0, STEP_SIZE)
@@ -74,7 +75,6 @@ class FormationArrays(NamedTuple):
     follower: np.ndarray          # (B, n, FOLLOWER_SIZE)
     masses: np.ndarray            # (B, n): M_f,r [kg]
     rows: np.ndarray              # (B, m, ROW_SIZE) int: the rows of g_vc
-    targets: np.ndarray           # (B, m)
     law_p: np.ndarray             # (B, n, 3, m): a linear follower's P (zeros otherwise)
     law_q: np.ndarray             # (B, n, 3, 3n): its Q
     own_rows: np.ndarray          # (B, n) int: how many rows of g_vc involve UAV i
@@ -99,6 +99,8 @@ class FormationMemory(NamedTuple):
     g: np.ndarray                 # (B, n): g at the current tick [m^2]
     g_dot: np.ndarray             # (B, n): g_dot at the current tick [m^2/s]
     mixers: np.ndarray            # (B, n, rotors, MIXER_SIZE): every UAV's, faults reallocated
+    targets: np.ndarray           # (B, m): the rows' targets, after the releases so far
+    next_target: np.ndarray       # (B,) int: the row of target_schedule to come
     cascade_memory: np.ndarray    # (B, n, CASCADE_MEMORY_SIZE)
     follower_memory: np.ndarray   # (B, n, FOLLOWER_MEMORY_SIZE)
     thrusts: np.ndarray           # (B, n): the thrust book u_T,j [N]
@@ -185,14 +187,13 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         swing_every=swing_sampling(n), reach=cable_reach(scenario),
         leader_mode=LEADER_MODES.index(scenario.control.mode),
         cascade=np.stack([c.constants for c in cascades]),
-        fault_mixers=fault_mixers(scenario),
+        fault_mixers=fault_mixers(scenario), target_schedule=target_schedule(scenario),
         mission=path.mission, segments=path.segments, mission_steps=path.steps,
         constant_speeds=np.asarray(constant.rotor_speeds, dtype=float),
         constant_saturated=np.asarray(constant.saturated, dtype=bool),
         follower=follower,
         masses=followers[0].masses if followers else np.array([uavs[0, UAV_MASS]]),
         rows=np.ascontiguousarray(rows, dtype=np.int64),
-        targets=followers[0].constraints.targets if followers else np.zeros(0),
         law_p=law_p, law_q=law_q, own_rows=own_rows,
         thrust_coefficients=np.array([u.vehicle.thrust_coefficient for u in scenario.uavs],
                                      dtype=float))
@@ -204,6 +205,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         held_saturated=np.zeros(model.rotors.shape, dtype=bool), tick=0, status=RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n),
         mixers=np.stack([c.mixer.rows for c in cascades]),
+        targets=followers[0].constraints.targets if followers else np.zeros(0), next_target=0,
         cascade_memory=np.stack([c.memory for c in cascades]),
         follower_memory=follower_memory,
         thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float), gust=np.zeros(3),

@@ -62,11 +62,11 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
     vectors = lift_vectors(states, thrusts)
     # what every follower's law shares, once (O(n)), then each follower's own step; the
     # constants of any follower (the last; n = 1: the unused row 0)
-    terms = formation_terms(a.follower[b, n - 1], a.masses[b], a.rows[b], a.targets[b], states,
+    terms = formation_terms(a.follower[b, n - 1], a.masses[b], a.rows[b], m.targets[b], states,
                             vectors)
     for i in range(1, n):
         s, sat, setpoint, lift, own_errors, own_rates = follower_update(
-            a.follower[b, i], a.masses[b], a.rows[b], a.targets[b], a.law_p[b, i],
+            a.follower[b, i], a.masses[b], a.rows[b], m.targets[b], a.law_p[b, i],
             a.law_q[b, i], i, m.follower_memory[b, i], t, states, vectors, terms,
             a.cascade[b, i], m.mixers[b, i])
         speeds[i, :] = s
@@ -111,14 +111,19 @@ def check(a, m, b):
 @jit
 def events(a, m, b):
     """The scenario's events of formation b's current tick: in the physics
-    (`physics.events.apply_events`), and the controllers told of a rotor's fault at once (its
-    UAV's mixer reallocated: `faults.fault_mixers`)."""
+    (`physics.events.apply_events`), and the controllers told of a fault at once (a rotor's:
+    its UAV's mixer reallocated, `faults.fault_mixers`; a cable's release: the formation's new
+    offsets, on their way along `faults.target_schedule`)."""
     first = m.next_event[b]
     m.next_event[b] = apply_events(a.events[b], first, m.tick[b], m.effectiveness[b], m.taut[b],
                                    m.released[b], m.silent_until[b])
     for k in range(first, m.next_event[b]):
         if int(a.events[b, k, EVENT_KIND]) == KIND_ROTOR_EFFECTIVENESS:
             m.mixers[b, int(a.events[b, k, EVENT_UAV])] = a.fault_mixers[b, k]
+    schedule = a.target_schedule[b]
+    while m.next_target[b] < schedule.shape[0] and schedule[m.next_target[b], 0] <= m.tick[b]:
+        m.targets[b, :] = schedule[m.next_target[b], 1:]
+        m.next_target[b] += 1
 
 
 @jit
@@ -180,7 +185,7 @@ def answer_all(a, m, states, speeds, saturated):
     running formation's measured `states` (B, n, UAV_STATE_SIZE) at its current tick, as a
     tick gives them (their memories and the run's tracking figures advance with it)."""
     n = a.uavs.shape[1]
-    rows = a.targets.shape[1]
+    rows = m.targets.shape[1]
     setpoints = np.empty((n, 3))
     thrust = np.empty(n)
     reference = np.empty(REFERENCE_SIZE)

@@ -171,19 +171,27 @@ def test_events_fly_and_are_recorded_alike_through_ros_and_headless(tmp_path):
     assert not headless_run.taut()[-1, 1] and headless_run.taut()[-1, 0]
 
 
-def test_hexa_rotor_failure_through_ros_is_the_headless_run(tmp_path):
-    """`hexa_rotor_failure`: the leader's rotor 1 fails at 30 s and its controller node
-    reallocates at that tick (multilift_control.faults), as the headless run does."""
+def _ros_and_headless(tmp_path, scenario: str, duration: str, says: str):
+    """`run SCENARIO --duration D` through the ROS nodes and headless, each saying `says` in
+    its summary: (ros, headless) runs, their UAVs in the same places to rounding."""
     env = dict(os.environ, ROS_DOMAIN_ID=str(next_domain()),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     for mode in ('ros', 'headless'):
-        args = [MULTILIFT, 'run', 'hexa_rotor_failure', '--duration', '32', '--bag',
+        args = [MULTILIFT, 'run', scenario, '--duration', duration, '--bag',
                 str(tmp_path / mode)] + (['--headless'] if mode == 'headless' else [])
         out = subprocess.run(args, capture_output=True, text=True, timeout=600, env=env)
         assert out.returncode == 0, out.stderr[-2000:]
-        assert 'event at 30 s   uav1 rotor 1 at 0 % of its thrust' in out.stdout
+        assert says in out.stdout
     ros, headless = (load_run(tmp_path / mode) for mode in ('ros', 'headless'))
     assert np.abs(ros.uav_positions() - headless.uav_positions()).max() < 1e-9
+    return ros, headless
+
+
+def test_hexa_rotor_failure_through_ros_is_the_headless_run(tmp_path):
+    """`hexa_rotor_failure`: the leader's rotor 1 fails at 30 s and its controller node
+    reallocates at that tick (multilift_control.faults), as the headless run does."""
+    _, headless = _ros_and_headless(tmp_path, 'hexa_rotor_failure', '32',
+                                    'event at 30 s   uav1 rotor 1 at 0 % of its thrust')
     speeds = headless.rotor_speeds(1)
     after = headless.topic('/uav1/rotor_cmd').t >= 30.0
     assert (speeds[after, 0] == 0.0).all() and (speeds[~after, 0] > 1000.0).all()
@@ -192,15 +200,7 @@ def test_hexa_rotor_failure_through_ros_is_the_headless_run(tmp_path):
 def test_v3_uav_loss_through_ros_is_the_headless_run(tmp_path):
     """`v3_uav_loss`: UAV 3's cable lets go at 60 s; the follower nodes take the formation's
     new offsets at that tick (multilift_control.faults), as the headless run does."""
-    env = dict(os.environ, ROS_DOMAIN_ID=str(next_domain()),
-               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
-    for mode in ('ros', 'headless'):
-        args = [MULTILIFT, 'run', 'v3_uav_loss', '--duration', '62', '--bag',
-                str(tmp_path / mode)] + (['--headless'] if mode == 'headless' else [])
-        out = subprocess.run(args, capture_output=True, text=True, timeout=600, env=env)
-        assert out.returncode == 0, out.stderr[-2000:]
-        assert 'event at 60 s   uav3 releases its cable' in out.stdout
-    ros, headless = (load_run(tmp_path / mode) for mode in ('ros', 'headless'))
-    assert np.abs(ros.uav_positions() - headless.uav_positions()).max() < 1e-9
+    ros, headless = _ros_and_headless(tmp_path, 'v3_uav_loss', '62',
+                                      'event at 60 s   uav3 releases its cable')
     assert np.abs(ros.formation_errors(3) - headless.formation_errors(3)).max() < 1e-9
     assert not headless.taut()[-1, 2] and headless.tensions()[-1, 2] == 0.0

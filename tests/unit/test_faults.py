@@ -67,12 +67,19 @@ def test_hexa_rotor_failure_flies_its_mission_where_an_unaware_leader_does_not()
     assert status == NOT_FINITE or unaware['leader']['rms_tracking_error'] > 10.0
 
 
-def test_the_engine_and_the_ros_path_reallocate_alike():
-    scenario = scenario_io.load('hexa_rotor_failure').with_duration(31.0)
+def _both_paths(name: str, duration: float):
+    """`name` flown `duration` [s] by the engine and by the per-object path (the ROS nodes'
+    objects, `run_headless`): (engine, run), their states equal to the bit."""
+    scenario = scenario_io.load(name).with_duration(duration)
     engine = Engine(scenario)
     engine.step(10 ** 6)
     run = run_headless(scenario)
     assert np.array_equal(engine.state[0], run.simulator.state)
+    return scenario, engine, run
+
+
+def test_the_engine_and_the_ros_path_reallocate_alike():
+    _, engine, run = _both_paths('hexa_rotor_failure', 31.0)
     assert np.array_equal(engine.memory.mixers[0, 0], run.runtimes[0].leader.cascade.mixer.rows)
     assert not np.array_equal(engine.memory.mixers[0, 0], engine._initial.mixers[0, 0])
 
@@ -140,11 +147,7 @@ def test_v3_uav_loss_the_twin_left_delivers_the_payload():
 
 
 def test_the_engine_and_the_ros_path_take_the_new_offsets_alike():
-    scenario = scenario_io.load('v3_uav_loss').with_duration(62.0)
-    engine = Engine(scenario)
-    engine.step(10 ** 6)
-    run = run_headless(scenario)
-    assert np.array_equal(engine.state[0], run.simulator.state)
+    scenario, engine, run = _both_paths('v3_uav_loss', 62.0)
     schedule = target_schedule(scenario)  # the controllers answered the state at tick 6199
     for runtime in run.runtimes[1:]:
         assert np.array_equal(runtime.follower.constraints.targets, schedule[199, 1:])

@@ -226,3 +226,18 @@ def test_a_silent_controller_s_last_command_is_held_in_both_paths():
     quiet = Engine(dataclasses.replace(scenario, events=()))
     quiet.step(10 ** 6)
     assert not np.array_equal(quiet.state[0], engine.state[0])
+
+
+def test_a_sweep_can_sample_an_event():
+    """`sweep --sample events[0].time=...`: a campaign's edit reaches an event like any key,
+    and a time past the scenario's end is that run's error line (issue 21 item 6; a shorter
+    `--duration` leaves a later event out, as the summary's `events` shows)."""
+    from multilift_tools import campaign
+    source, base = campaign.load_base('v3_uav_loss')
+    path = campaign.parse_key('events[0].time', '--sample')
+    early = campaign.run_one(source, base, [('events[0].time', path, 20.0)], duration=25.0)
+    late = campaign.run_one(source, base, [('events[0].time', path, 24.0)], duration=25.0)
+    assert early['status'] == late['status'] == 'ok'
+    assert early['payload_swing_max'] != late['payload_swing_max']
+    past = campaign.run_one(source, base, [('events[0].time', path, 130.0)])
+    assert past['status'] == 'error' and "before the run's end (120 s)" in past['message']

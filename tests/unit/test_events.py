@@ -241,3 +241,16 @@ def test_a_sweep_can_sample_an_event():
     assert early['payload_swing_max'] != late['payload_swing_max']
     past = campaign.run_one(source, base, [('events[0].time', path, 130.0)])
     assert past['status'] == 'error' and "before the run's end (120 s)" in past['message']
+
+
+def test_two_headless_runs_with_events_write_byte_identical_bags(tmp_path):
+    from multilift_tools.headless_bag import record_headless
+    scenario = _with_events('v3_uav_loss', 1.0, [
+        {'time': 0.2, 'type': 'rotor_effectiveness', 'uav': 2, 'rotor': 3, 'effectiveness': 0.5},
+        {'time': 0.4, 'type': 'controller_silence', 'uav': 1, 'duration': 0.2},
+        {'time': 0.6, 'type': 'cable_release', 'uav': 3}])
+    for run in ('a', 'b'):
+        record_headless(scenario, tmp_path / run / 'bag')
+    for name in ('bag_0.mcap', 'metadata.yaml'):
+        assert (tmp_path / 'a' / 'bag' / name).read_bytes() == \
+            (tmp_path / 'b' / 'bag' / name).read_bytes(), name

@@ -46,7 +46,7 @@ from multilift_sim.multirotor import MultirotorParams, rotational_kinetic_energy
 from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (
     ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, CABLE_COLUMNS,
-    FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY,
+    FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_WIND, UAV_DRAG,
     FORMATION_INV_PAYLOAD_MASS, FORMATION_PAYLOAD_MASS, FORMATION_SCALARS, FORMATION_TWO_ALPHA,
     GUST_CENTER, GUST_COLUMNS, GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED,
     UAV_COLUMNS, UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS, WORK_ROWS, WRENCH_COLUMNS)
@@ -64,6 +64,7 @@ class FormationParams:
     baumgarte_beta: float                    # beta_f of seed Eq. 2.59 [1/s]
     gusts: tuple[Gust, ...] = ()             # 1-cosine gusts acting on the payload
     gravity: float = 9.81                    # g [m/s^2], along -z of the world frame
+    wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world, everywhere
 
     def __post_init__(self) -> None:
         uavs = tuple(self.uavs)
@@ -99,6 +100,11 @@ class FormationParams:
         object.__setattr__(self, 'uavs', uavs)
         object.__setattr__(self, 'cable_lengths', lengths)
         object.__setattr__(self, 'gusts', gusts)
+        wind = tuple(float(v) for v in self.wind)
+        if len(wind) != 3 or not all(math.isfinite(v) for v in wind):
+            raise ValueError(f'FormationParams.wind must be a finite 3-vector [m/s], got '
+                             f'{self.wind!r}')
+        object.__setattr__(self, 'wind', wind)
 
     @property
     def n_uavs(self) -> int:
@@ -201,6 +207,7 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     uavs[:, UAV_INV_INERTIA:UAV_INV_INERTIA + 3] = (1.0 / moments).T
     # Euler's equation J omega_dot = tau - omega x J omega, per axis:
     # omega_dot_x = tau_x / I_xx - (I_zz - I_yy) / I_xx omega_y omega_z, and cyclically.
+    uavs[:, UAV_DRAG] = [uav.drag_coefficient for uav in params.uavs]
     uavs[:, UAV_GYRO:UAV_GYRO + 3] = np.array([(moments[2] - moments[1]) / moments[0],
                                                (moments[0] - moments[2]) / moments[1],
                                                (moments[1] - moments[0]) / moments[2]]).T
@@ -217,6 +224,7 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     formation[FORMATION_TWO_ALPHA] = 2.0 * params.baumgarte_alpha
     formation[FORMATION_BETA_SQ] = params.baumgarte_beta ** 2
     formation[FORMATION_DRAG] = params.payload_drag_coefficient
+    formation[FORMATION_WIND:FORMATION_WIND + 3] = params.wind
     return uavs, gusts, formation
 
 

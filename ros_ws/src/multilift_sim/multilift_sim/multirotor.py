@@ -43,6 +43,9 @@ class MultirotorParams:
     # the rotors' actuators (physics.actuators; not in the seed, whose rotors answer at once)
     motor_time_constant: float = 0.0     # tau_m [s] of each rotor's first-order lag; 0: none
     motor_rate_limit: float = math.inf   # the largest |d omega / dt| [rad/s^2]; inf: none
+    # the UAV's quadratic drag in the wind, -c_d |v - w| (v - w) (not in the seed, whose UAVs
+    # meet no air)
+    drag_coefficient: float = 0.0        # c_d [N s^2/m^2]
 
     def __post_init__(self) -> None:
         rotor_count(self.frame_type)  # ValueError naming the valid frame types
@@ -62,6 +65,9 @@ class MultirotorParams:
         if not (math.isfinite(self.motor_time_constant) and self.motor_time_constant >= 0):
             raise ValueError(f'MultirotorParams.motor_time_constant must be finite and >= 0 '
                              f'[s], got {self.motor_time_constant!r}')
+        if not (math.isfinite(self.drag_coefficient) and self.drag_coefficient >= 0):
+            raise ValueError(f'MultirotorParams.drag_coefficient must be finite and >= 0 '
+                             f'[N s^2/m^2], got {self.drag_coefficient!r}')
         if not self.motor_rate_limit > 0:  # inf allowed: no limit
             raise ValueError(f'MultirotorParams.motor_rate_limit must be > 0 [rad/s^2] (inf: '
                              f'none), got {self.motor_rate_limit!r}')

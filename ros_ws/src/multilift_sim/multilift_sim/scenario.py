@@ -142,6 +142,7 @@ class Scenario:
     warnings: tuple[str, ...] = field(default=())
     cable_model: str = 'rigid'       # one of CABLE_MODELS
     events: tuple[EventConfig, ...] = ()  # in time order
+    wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world
 
     @property
     def n_uavs(self) -> int:
@@ -157,7 +158,7 @@ class Scenario:
             payload_mass=self.payload.mass,
             payload_drag_coefficient=self.payload.drag_coefficient,
             gusts=self.gusts,
-            gravity=sim.gravity,
+            gravity=sim.gravity, wind=self.wind,
             baumgarte_alpha=sim.baumgarte_alpha if baumgarte_alpha is None else baumgarte_alpha,
             baumgarte_beta=sim.baumgarte_beta if baumgarte_beta is None else baumgarte_beta,
         )
@@ -269,7 +270,7 @@ class _Section:
 
 VEHICLE_KEYS = ('mass', 'inertia', 'frame_type', 'arm_length', 'thrust_coefficient',
                 'moment_coefficient', 'rotor_speed_min', 'rotor_speed_max',
-                'motor_time_constant', 'motor_rate_limit')
+                'motor_time_constant', 'motor_rate_limit', 'drag_coefficient')
 
 
 def _vehicle(sec: _Section, base: dict[str, Any] | None) -> MultirotorParams:
@@ -291,10 +292,12 @@ def _vehicle(sec: _Section, base: dict[str, Any] | None) -> MultirotorParams:
     rate_default = math.inf if base is None else base['motor_rate_limit']
     rate = sec.raw('motor_rate_limit', None)
     rate = rate_default if rate is None else sec.positive('motor_rate_limit')
+    drag = sec.non_negative('drag_coefficient',  # in the wind (issue 21); the seed's: none
+                            0.0 if base is None else base['drag_coefficient'])
     return MultirotorParams(mass=mass, inertia=inertia, frame_type=frame_type,
                             arm_length=arm_length, thrust_coefficient=k_t,
                             moment_coefficient=k_d, rotor_speed_min=w_min, rotor_speed_max=w_max,
-                            motor_time_constant=tau, motor_rate_limit=rate)
+                            motor_time_constant=tau, motor_rate_limit=rate, drag_coefficient=drag)
 
 
 SEED_INERTIA = (0.957, 0.486, 0.355)  # seed Table 4.1 / 4.2 [kg m^2]
@@ -432,6 +435,9 @@ def _scenario(data: Any, where: str) -> Scenario:
         g.done()
 
     events = _events(top, uavs, duration)
+    w = top.section('wind', {})
+    wind = w.vector('velocity', [0.0, 0.0, 0.0])  # steady, everywhere (issue 21)
+    w.done()
 
     c = top.section('control')
     mode = c.text('mode', choices=CONTROL_MODES)
@@ -477,10 +483,14 @@ def _scenario(data: Any, where: str) -> Scenario:
                         mission=MissionConfig(start=start, segments=tuple(segments),
                                               reference_filter_time=reference_filter_time),
                         formation=formation, warnings=tuple(warnings),
-                        cable_model=cable_model, events=events)
+                        cable_model=cable_model, events=events, wind=tuple(wind))
     _check_feasible(scenario)
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
+    if (any(wind) or any(u.vehicle.drag_coefficient for u in scenario.uavs)) and \
+            sim.integrator != 'baumgarte':
+        raise ScenarioError(f'{where}: wind and vehicle.drag_coefficient need '
+                            f'simulation.integrator: baumgarte, got {sim.integrator!r}')
     if events and sim.integrator != 'baumgarte':
         raise ScenarioError(f'{where}: events need simulation.integrator: baumgarte, got '
                             f'{sim.integrator!r}')

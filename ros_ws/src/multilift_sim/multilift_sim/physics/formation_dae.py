@@ -23,9 +23,9 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import (
     CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST, EULER,
     FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
-    FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, GUST_CENTER, GUST_DIRECTION,
-    GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, PAYLOAD_COORDINATES, POSITION, UAV_GYRO,
-    UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS, UAV_COORDINATES, WORK_ACC, WORK_K1, WORK_K2,
+    FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_DIRECTION,
+    GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, PAYLOAD_COORDINATES, POSITION, UAV_DRAG,
+    UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS, UAV_COORDINATES, WORK_ACC, WORK_K1, WORK_K2,
     WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE, WRENCH_THRUST, WRENCH_TORQUE)
 
 
@@ -54,13 +54,17 @@ def air_velocity(px, py, gusts):
 
 @jit
 def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
-    """Drag (gusts included) on the payload over m_p [m/s^2], world, gravity excluded: at
-    payload position (px, py, pz) [m] and velocity (pvx, pvy, pvz) [m/s]. (The numpy form
-    is disturbances.payload_drag and gust_velocity; tests hold them equal.)"""
+    """Drag (gusts and the steady wind included) on the payload over m_p [m/s^2], world,
+    gravity excluded: at payload position (px, py, pz) [m] and velocity (pvx, pvy, pvz)
+    [m/s]. (The numpy form is disturbances.payload_drag and gust_velocity; tests hold them
+    equal.)"""
     drag = formation[FORMATION_DRAG]
     if drag <= 0.0:
         return 0.0, 0.0, 0.0
     air_x, air_y, air_z = air_velocity(px, py, gusts)
+    air_x += formation[FORMATION_WIND]
+    air_y += formation[FORMATION_WIND + 1]
+    air_z += formation[FORMATION_WIND + 2]
     rel_x, rel_y, rel_z = pvx - air_x, pvy - air_y, pvz - air_z
     # Eq. 2.53 on the air-relative velocity: -c_pd v_rel |v_rel| / m_p
     scale = (-drag * formation[FORMATION_INV_PAYLOAD_MASS]
@@ -179,6 +183,15 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
         thrust_ax = (c_psi * s_theta_c_phi + s_psi * s_phi) * thrust_per_mass
         thrust_ay = (s_psi * s_theta_c_phi - c_psi * s_phi) * thrust_per_mass
         thrust_az = c_theta * c_phi * thrust_per_mass
+        drag = uavs[i, UAV_DRAG]
+        if drag > 0.0:  # the UAV's own drag in the steady wind: -c_d |v_rel| v_rel / m_i
+            rel_x = vx - formation[FORMATION_WIND]
+            rel_y = vy - formation[FORMATION_WIND + 1]
+            rel_z = vz - formation[FORMATION_WIND + 2]
+            scale = -drag / mass * math.sqrt(rel_x * rel_x + rel_y * rel_y + rel_z * rel_z)
+            thrust_ax += scale * rel_x
+            thrust_ay += scale * rel_y
+            thrust_az += scale * rel_z
 
         # cable i: d = r_p - r_i, its rate, and row i of the multiplier equation (Eq. 2.60)
         dx, dy, dz = px - rx, py - ry, pz - rz

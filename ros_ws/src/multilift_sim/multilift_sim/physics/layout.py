@@ -37,7 +37,8 @@ UAV_MASS = 0                # m_i [kg]
 UAV_LENGTH_SQ = 1           # l_i^2 [m^2], its cable's length squared
 UAV_INV_INERTIA = 2         # 1/I_xx, 1/I_yy, 1/I_zz [1/(kg m^2)], body FLU axes (3 slots)
 UAV_GYRO = 5                # (I_zz - I_yy)/I_xx, (I_xx - I_zz)/I_yy, (I_yy - I_xx)/I_zz (3)
-UAV_COLUMNS = 8
+UAV_DRAG = 8                # c_d [N s^2/m^2]: the UAV's quadratic drag in the wind; 0: none
+UAV_COLUMNS = 9
 
 # -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
@@ -78,13 +79,14 @@ FORMATION_GRAVITY = 2           # g [m/s^2], along -z of the world
 FORMATION_TWO_ALPHA = 3         # 2 alpha_f [1/s] (seed Eq. 2.59)
 FORMATION_BETA_SQ = 4           # beta_f^2 [1/s^2] (seed Eq. 2.59)
 FORMATION_DRAG = 5              # c_pd [N s^2/m^2] (seed Eq. 2.53); 0: no drag
-FORMATION_SCALARS = 6
+FORMATION_WIND = 6              # the steady wind [m/s], world, everywhere (3 slots)
+FORMATION_SCALARS = 9
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
 CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots)
 CABLE_RHS = 3               # row i of the right-hand side of the multiplier equation
 CABLE_INV_DELTA = 4         # 1 / delta_i = m_i / (4 |d_i|^2) [kg/m^2]
-CABLE_THRUST = 5            # UAV i's thrust acceleration u_T R e_z / m_i [m/s^2] (3 slots)
+CABLE_THRUST = 5            # UAV i's thrust (and drag) acceleration u_T R e_z / m_i [m/s^2] (3)
 CABLE_COLUMNS = 8
 
 # -- an RK4 step's scratch (rows of a (WORK_ROWS, 2 (6n + 3)) array) ---------------------------

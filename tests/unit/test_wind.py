@@ -1,0 +1,108 @@
+"""Steady wind on the UAVs and the payload (issue 21 item 3): each body's quadratic drag against
+the air, `vehicle.drag_coefficient` and the payload's c_pd (seed Eq. 2.53), with `wind.velocity`
+everywhere. Held against the momentum balance (the cables' pulls are internal: the formation's
+momentum changes by gravity, thrust and the two drags alone), the engine against the per-object
+(ROS) path to the bit, a formation trailing its payload downwind, and the keys' validation."""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import yaml
+
+from conftest import SCENARIOS
+from multilift_control.engine import Engine
+from multilift_control.headless import run_headless
+from multilift_sim import scenario as scenario_io
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.simulation import initial_state
+
+WIND = (3.0, -1.0, 0.5)  # [m/s], world
+
+
+def _windy(name: str, wind=WIND, uav_drag: float = 0.08, **top) -> scenario_io.Scenario:
+    data = yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
+    data['wind'] = {'velocity': list(wind)}
+    data['vehicle']['drag_coefficient'] = uav_drag
+    data.update(top)
+    return scenario_io.loads(yaml.safe_dump(data))
+
+
+def test_the_formation_s_momentum_changes_by_the_external_forces_alone():
+    """At any state: sum m_i a_i + m_p a_p = thrusts + gravity + every body's drag
+    -c |v - w| (v - w); the cable multipliers cancel (the slack twin with some cables taut,
+    some moving bodies)."""
+    scenario = _windy('twin_lift')
+    model = FormationModel(scenario.formation_params())
+    x = initial_state(scenario)
+    rng = np.random.default_rng(5)
+    layout = model.layout
+    layout.uav_velocities(x)[:] = rng.normal(size=(2, 3))
+    layout.payload_velocity(x)[:] = rng.normal(size=3)
+    speeds = [np.full(4, 1500.0), np.array([1400.0, 1550.0, 1500.0, 1450.0])]
+    acc, _ = model.accelerations(0.0, x, speeds)
+    masses = model.uav_masses
+    nq = layout.n_coordinates
+    uav_acc = np.array([acc[6 * i:6 * i + 3] for i in range(2)])
+    rate = masses @ uav_acc + model.payload_mass * acc[12:15]
+    wrenches = model.wrenches(speeds)
+    wind = np.array(WIND)
+    expected = -(masses.sum() + model.payload_mass) * np.array([0.0, 0.0, 9.81])
+    for i in range(2):
+        phi, theta, psi = x[6 * i + 3:6 * i + 6]
+        # R e_z of ZYX Euler angles: the body z axis in the world
+        body_z = np.array([np.cos(psi) * np.sin(theta) * np.cos(phi) + np.sin(psi) * np.sin(phi),
+                           np.sin(psi) * np.sin(theta) * np.cos(phi) - np.cos(psi) * np.sin(phi),
+                           np.cos(theta) * np.cos(phi)])
+        relative = x[nq + 6 * i:nq + 6 * i + 3] - wind
+        expected += wrenches[i, 0] * body_z - 0.08 * np.linalg.norm(relative) * relative
+    relative = x[nq + 12:nq + 15] - wind  # the payload (no gust at the start place)
+    expected -= scenario.payload.drag_coefficient * np.linalg.norm(relative) * relative
+    assert rate == pytest.approx(expected, rel=1e-12, abs=1e-12)
+    calm = FormationModel(scenario_io.load('twin_lift').formation_params())
+    calm_acc, _ = calm.accelerations(0.0, x, speeds)
+    assert np.abs(calm_acc - acc).max() > 0.01  # the wind did something
+
+
+@pytest.mark.parametrize('cables', ['rigid', 'slack'])
+def test_the_engine_flies_the_wind_as_the_ros_path_does(cables):
+    scenario = dataclasses.replace(_windy('multi_lift'), cable_model=cables).with_duration(10.0)
+    engine = Engine(scenario)
+    engine.step(10 ** 6)
+    run = run_headless(scenario)
+    assert engine.finished[0]
+    assert np.array_equal(engine.state[0], run.simulator.state)
+
+
+def test_a_twin_lift_in_the_wind_trails_its_payload_downwind():
+    """30 s of the twin's mission in a 3 m/s wind along +x: the formation holds (max |g| under
+    the tolerance) and the payload hangs downwind of where it hangs in still air."""
+    windy = _windy('twin_lift', wind=(3.0, 0.0, 0.0)).with_duration(30.0)
+    still = scenario_io.load('twin_lift').with_duration(30.0)
+    places = []
+    for scenario in (windy, still):
+        engine = Engine(scenario)
+        record = engine.new_record(3000)
+        engine.step(3000, record)
+        assert engine.summary(0)['sim']['max_abs_constraint'] < \
+            scenario.simulation.constraint_tolerance
+        states = record.states[:, 0]
+        places.append(states[:, 12:15] - 0.5 * (states[:, 0:3] + states[:, 6:9]))
+    trail = places[0][1000:, 0] - places[1][1000:, 0]  # from 10 s on, along the wind
+    assert trail.mean() > 0.05
+
+
+@pytest.mark.parametrize('edit,message', [
+    (lambda d: d.update(wind={'velocity': [1.0, 2.0]}), 'wind.velocity'),
+    (lambda d: d.update(wind={'speed': 3.0}), 'wind.speed: unknown key'),
+    (lambda d: d['vehicle'].update(drag_coefficient=-0.1), 'vehicle.drag_coefficient'),
+    (lambda d: (d.update(wind={'velocity': [1.0, 0.0, 0.0]}),
+                d['simulation'].update(integrator='nullspace')),
+     'need simulation.integrator: baumgarte')])
+def test_wind_keys_are_validated(edit, message):
+    data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
+    edit(data)
+    with pytest.raises(scenario_io.ScenarioError, match=message):
+        scenario_io.loads(yaml.safe_dump(data), 'x.yaml')
+    assert scenario_io.load('twin_lift').wind == (0.0, 0.0, 0.0)

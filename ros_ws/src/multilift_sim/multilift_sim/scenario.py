@@ -128,6 +128,16 @@ class EventConfig:
 
 
 @dataclass(frozen=True)
+class TurbulenceConfig:
+    """Dryden turbulence on top of the steady wind (`wind.turbulence`, multilift_sim.turbulence):
+    components u (along the mean wind), v (to its left), w (up)."""
+    intensity: tuple[float, float, float]     # sigma_u, sigma_v, sigma_w [m/s]
+    length_scale: tuple[float, float, float]  # L_u, L_v, L_w [m]
+    airspeed: float                           # V [m/s]: how fast the field passes
+    seed: int                                 # of the series (a run's seed)
+
+
+@dataclass(frozen=True)
 class Scenario:
     name: str
     description: str
@@ -143,6 +153,7 @@ class Scenario:
     cable_model: str = 'rigid'       # one of CABLE_MODELS
     events: tuple[EventConfig, ...] = ()  # in time order
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world
+    turbulence: TurbulenceConfig | None = None
 
     @property
     def n_uavs(self) -> int:
@@ -437,6 +448,17 @@ def _scenario(data: Any, where: str) -> Scenario:
     events = _events(top, uavs, duration)
     w = top.section('wind', {})
     wind = w.vector('velocity', [0.0, 0.0, 0.0])  # steady, everywhere (issue 21)
+    turbulence = None
+    if w.has('turbulence'):
+        d = w.section('turbulence')
+        seed = d.raw('seed', 0)
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise d.fail('seed', seed, 'must be an integer >= 0')
+        turbulence = TurbulenceConfig(
+            intensity=d.vector('intensity', check=lambda v: v >= 0, rule='must be >= 0'),
+            length_scale=d.vector('length_scale', check=lambda v: v > 0, rule='must be > 0'),
+            airspeed=d.positive('airspeed'), seed=seed)
+        d.done()
     w.done()
 
     c = top.section('control')
@@ -483,11 +505,12 @@ def _scenario(data: Any, where: str) -> Scenario:
                         mission=MissionConfig(start=start, segments=tuple(segments),
                                               reference_filter_time=reference_filter_time),
                         formation=formation, warnings=tuple(warnings),
-                        cable_model=cable_model, events=events, wind=tuple(wind))
+                        cable_model=cable_model, events=events, wind=tuple(wind),
+                        turbulence=turbulence)
     _check_feasible(scenario)
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
-    if (any(wind) or any(u.vehicle.drag_coefficient for u in scenario.uavs)) and \
+    if (any(wind) or turbulence or any(u.vehicle.drag_coefficient for u in scenario.uavs)) and \
             sim.integrator != 'baumgarte':
         raise ScenarioError(f'{where}: wind and vehicle.drag_coefficient need '
                             f'simulation.integrator: baumgarte, got {sim.integrator!r}')

@@ -18,7 +18,7 @@ from multilift_sim.formulations import make_formulation
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_END_TICK, EVENT_KIND,
                                           EVENT_KINDS, EVENT_ROTOR, EVENT_TICK, EVENT_TIME,
-                                          EVENT_UAV, EVENT_VALUE,
+                                          EVENT_UAV, EVENT_VALUE, FORMATION_WIND,
                                           MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
@@ -28,6 +28,7 @@ from multilift_sim import kernels
 from multilift_sim.msgvalues import formation_event
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import RunStatistics
+from multilift_sim.turbulence import dryden_series
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
 
 
@@ -101,6 +102,18 @@ def event_array(scenario: Scenario) -> np.ndarray:
         else:
             rows[k, EVENT_VALUE] = event.effectiveness
     return rows
+
+
+def turbulence_array(scenario: Scenario) -> np.ndarray:
+    """The Dryden turbulence [m/s], world, at every control tick of the run, (ticks + 1, 3)
+    (`turbulence.dryden_series`; (0, 3) without `wind.turbulence`): tick k's is held over the
+    period from it, added to the steady wind."""
+    config = scenario.turbulence
+    if config is None:
+        return np.zeros((0, 3))
+    sim = scenario.simulation
+    return dryden_series(sim.tick_count + 1, 1.0 / sim.control_rate, config.intensity,
+                         config.length_scale, config.airspeed, scenario.wind, config.seed)
 
 
 def event_records(rows: np.ndarray) -> list[dict]:
@@ -184,6 +197,10 @@ class FormationSimulator:
         self.held = np.full((self.n, rotors), math.nan)
         self.held_saturated = np.zeros((self.n, rotors), dtype=bool)
         self._silences = any(e.type == 'controller_silence' for e in scenario.events)
+        # the wind of each period: the steady wind plus the turbulence of its tick
+        self._turbulence = turbulence_array(scenario)
+        self._steady_wind = np.array(scenario.wind, dtype=float)
+        self._set_wind()
         self._apply_events()
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
@@ -263,6 +280,7 @@ class FormationSimulator:
             self.stats.add_slack(self.taut, self.period_ns * 1e-9)
         self.tick += 1
         self._apply_events()
+        self._set_wind()
         self._check(self.t, (step.constraint, step.constraint_rate))
 
     def _held(self, speeds, saturated) -> tuple:
@@ -281,6 +299,13 @@ class FormationSimulator:
         counts = [u.vehicle.n_rotors for u in self.scenario.uavs]
         return ([self.held[i, :c].copy() for i, c in enumerate(counts)],
                 [self.held_saturated[i, :c].copy() for i, c in enumerate(counts)])
+
+    def _set_wind(self) -> None:
+        """The model's wind for the period from the current tick: the steady wind plus the
+        tick's turbulence (`turbulence_array`), as the engine's tick adds them."""
+        if len(self._turbulence):
+            self.model._formation[FORMATION_WIND:FORMATION_WIND + 3] = (
+                self._steady_wind + self._turbulence[self.tick])
 
     def happened_rows(self) -> np.ndarray:
         """The rows (physics.layout EVENT_*) of the events the current tick is the first to

@@ -24,7 +24,8 @@ from multilift_control.runtime import ThrustBook
 from multilift_sim.dynamics import FormationModel, actuator_array, constant_arrays
 from multilift_sim.physics.layout import UAV_MASS
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import cable_reach, event_array, initial_state, swing_sampling
+from multilift_sim.simulation import (cable_reach, event_array, initial_state, swing_sampling,
+                                      turbulence_array)
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
 
@@ -53,6 +54,7 @@ class FormationArrays(NamedTuple):
     cable_lengths: np.ndarray     # (B, n) [m]
     slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
     events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
+    turbulence: np.ndarray        # (B, ticks + 1 or 0, 3): the wind's turbulence by tick [m/s]
     # time and Algorithm 1's tolerances
     physics_dt: np.ndarray        # (B,) [s]
     physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
@@ -181,6 +183,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         actuators=actuator_array(params),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
         slack=scenario.cable_model == 'slack', events=event_array(scenario),
+        turbulence=turbulence_array(scenario),
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),

@@ -21,7 +21,8 @@ from multilift_control.laws.reference import mission_reference
 from multilift_sim.physics.actuators import actuated_period
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals
-from multilift_sim.physics.layout import EVENT_KIND, EVENT_UAV, KIND_ROTOR_EFFECTIVENESS
+from multilift_sim.physics.layout import (EVENT_KIND, EVENT_UAV, FORMATION_WIND,
+                                          KIND_ROTOR_EFFECTIVENESS)
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
                                                    run_add_gust_speed, run_add_slack,
@@ -139,9 +140,14 @@ def advance_formation(a, m, b, speeds, saturated, tension):
     held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
                   m.held_saturated[b])
     run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
+    formation = a.formation[b]
+    if a.turbulence.shape[1]:  # the steady wind plus this tick's turbulence, over the period
+        formation = formation.copy()
+        for j in range(3):
+            formation[FORMATION_WIND + j] += a.turbulence[b, m.tick[b], j]
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
-        a.uavs[b], a.gusts[b], a.formation[b], m.taut[b], m.released[b], a.slack[b],
+        a.uavs[b], a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
         a.physics_dt[b], a.physics_steps[b])
     for i in range(n):
         tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]

@@ -1,0 +1,93 @@
+"""Dryden turbulence (MIL-F-8785C; MIL-HDBK-1797 §B.4.8.2), the continuous von Karman
+approximation of the military specifications, as a seeded series of wind velocities at the
+control rate (issue 21 item 3). No ROS, no numba: the series is drawn once per run, before it
+flies, and the physics holds each sample over its control period (docs/wind.md).
+
+With airspeed V (the speed at which the frozen turbulence field passes the formation), length
+scales L and intensities sigma, the one-sided spectra of the three components, over the
+temporal frequency omega [rad/s], are
+
+    Phi_u(omega) = sigma_u^2 2 L_u / (pi V) / (1 + (L_u omega / V)^2)
+    Phi_v(omega) = sigma_v^2 L_v / (pi V) (1 + 3 (L_v omega / V)^2) / (1 + (L_v omega / V)^2)^2
+
+and Phi_w as Phi_v with L_w, sigma_w (`dryden_spectrum`). Each integrates to sigma^2. The
+components are the outputs of the specification's forming filters driven by white noise,
+H_u(s) ~ 1 / (1 + T s) and H_v(s) ~ (1 + sqrt(3) T s) / (1 + T s)^2 with T = L / V, sampled
+exactly (`dryden_series`): the states' transition e^(A dt) and the covariance the noise adds
+over a sample, Van Loan's matrix exponential, so the series' autocorrelation is the
+continuous process's at the samples and its variance sigma^2 whatever the rate.
+
+Axes: u along the mean wind's horizontal direction (world x when there is none), v horizontal
+to its left, w up (z up, world frame).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.linalg import expm, solve_continuous_lyapunov
+
+
+def dryden_spectrum(omega: np.ndarray, sigma: float, length: float, airspeed: float,
+                    lateral: bool) -> np.ndarray:
+    """One-sided PSD [(m/s)^2 / (rad/s)] of a Dryden component at omega [rad/s]: the
+    longitudinal form (u), or the lateral/vertical one (v, w) when `lateral`."""
+    x = (length * np.asarray(omega, dtype=float) / airspeed) ** 2
+    if lateral:
+        return sigma ** 2 * length / (math.pi * airspeed) * (1.0 + 3.0 * x) / (1.0 + x) ** 2
+    return sigma ** 2 * 2.0 * length / (math.pi * airspeed) / (1.0 + x)
+
+
+def _forming_filter(time_constant: float, lateral: bool) -> tuple[np.ndarray, np.ndarray,
+                                                                   np.ndarray]:
+    """(A, B, C) of the forming filter with time constant T [s] (unit gain at s = 0)."""
+    t = time_constant
+    if lateral:  # (1 + sqrt(3) T s) / (1 + T s)^2, controllable canonical form
+        return (np.array([[0.0, 1.0], [-1.0 / t ** 2, -2.0 / t]]), np.array([[0.0], [1.0]]),
+                np.array([[1.0 / t ** 2, math.sqrt(3.0) / t]]))
+    return np.array([[-1.0 / t]]), np.array([[1.0]]), np.array([[1.0 / t]])
+
+
+def _component(rng: np.random.Generator, samples: int, dt: float, sigma: float,
+               length: float, airspeed: float, lateral: bool) -> np.ndarray:
+    """`samples` values of one component, dt [s] apart, from the stationary process."""
+    if sigma == 0.0:
+        return np.zeros(samples)
+    a, b, c = _forming_filter(length / airspeed, lateral)
+    k = a.shape[0]
+    stationary = solve_continuous_lyapunov(a, -b @ b.T)  # A P + P A^T + B B^T = 0
+    gain = sigma / math.sqrt((c @ stationary @ c.T).item())
+    # Van Loan: expm([[-A, B B^T], [0, A^T]] dt) = [[., F^-1 Q], [0, F^T]]
+    block = np.zeros((2 * k, 2 * k))
+    block[:k, :k], block[:k, k:], block[k:, k:] = -a, b @ b.T, a.T
+    exp = expm(block * dt)
+    transition = exp[k:, k:].T
+    added = transition @ exp[:k, k:]
+    added = 0.5 * (added + added.T)
+    lower = np.linalg.cholesky(added + 1e-300 * np.eye(k))
+    state = np.linalg.cholesky(stationary) @ rng.standard_normal(k)
+    out = np.empty(samples)
+    noise = rng.standard_normal((samples, k))
+    for n in range(samples):
+        out[n] = gain * (c @ state).item()
+        state = transition @ state + lower @ noise[n]
+    return out
+
+
+def dryden_series(samples: int, dt: float, intensity, length_scale, airspeed: float,
+                  mean_wind, seed: int) -> np.ndarray:
+    """(samples, 3) turbulence velocities [m/s], world, dt [s] apart: components u, v, w of
+    `intensity` (sigma_u, sigma_v, sigma_w) [m/s] and `length_scale` (L_u, L_v, L_w) [m] at
+    `airspeed` V [m/s], u along `mean_wind`'s horizontal direction, drawn from
+    numpy.random.default_rng(seed) (the same seed, the same series)."""
+    rng = np.random.default_rng(seed)
+    components = [_component(rng, samples, dt, float(s), float(l), float(airspeed), lateral)
+                  for s, l, lateral in zip(intensity, length_scale, (False, True, True))]
+    heading = np.asarray(mean_wind, dtype=float)[:2]
+    norm = math.hypot(*heading)
+    along = heading / norm if norm > 0.0 else np.array([1.0, 0.0])
+    left = np.array([-along[1], along[0]])
+    out = np.zeros((samples, 3))
+    out[:, :2] = np.outer(components[0], along) + np.outer(components[1], left)
+    out[:, 2] = components[2]
+    return out

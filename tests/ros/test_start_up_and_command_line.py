@@ -49,7 +49,8 @@ def test_setup_filled_numba_s_cache_so_a_new_process_loads_and_does_not_compile(
     out = _a_tick_in_a_new_process(
         'auto', 'from multilift_control.engine import Engine\n'
                 'from multilift_control.engine.tick import run_ticks\n'
-                'law = kernels.compiled_module(kernels.PHYSICS).integrate_period\n'
+                'law = kernels.compiled_module("multilift_sim.physics.actuators")'
+                '.actuated_period\n'
                 'engine = Engine(scenario.load("twin_lift"))\n'
                 'engine.step(3)\n'
                 'print(kernels.enabled(), sim.t > 0, engine.memory.tick[0],\n'

@@ -9,7 +9,7 @@ README_TWIN = {  # README.md, "ROS interface", for n = 2
     '/formation/state': 'multilift_msgs/msg/FormationState',
     '/formation/snapshot': 'multilift_msgs/msg/FormationSnapshot',
     '/visualization/markers': 'visualization_msgs/msg/MarkerArray',
-    '/tf': 'tf2_msgs/msg/TFMessage', '/formation/events': 'multilift_msgs/msg/FormationEvent',
+    '/tf': 'tf2_msgs/msg/TFMessage',
     '/uav1/reference': 'multilift_msgs/msg/TrackingReference',
     '/uav1/odom': 'nav_msgs/msg/Odometry', '/uav2/odom': 'nav_msgs/msg/Odometry',
     '/uav1/rotor_cmd': 'multilift_msgs/msg/RotorCommand',
@@ -24,16 +24,19 @@ def test_run_topics_of_a_twin_lift_are_the_readme_table():
     listed = topics.run_topics(2)
     assert len(listed) == len(dict(listed))  # no topic twice
     assert dict(listed) == README_TWIN
+    # a scenario with events: /formation/events too
+    assert dict(topics.run_topics(2, events=True)) == {
+        **README_TWIN, '/formation/events': 'multilift_msgs/msg/FormationEvent'}
 
 
 def test_run_topics_grow_by_four_per_follower_and_three_for_the_leader():
-    assert len(topics.run_topics(1)) == 9 + 3
-    assert len(topics.run_topics(5)) == 9 + 3 + 4 * 4
+    assert len(topics.run_topics(1)) == 8 + 3
+    assert len(topics.run_topics(5)) == 8 + 3 + 4 * 4
     assert '/uav1/formation_error' not in dict(topics.run_topics(3))
 
 
 def test_every_run_topic_has_its_type_and_others_none():
-    for name, kind in topics.run_topics(3):
+    for name, kind in topics.run_topics(3, events=True):
         assert topics.topic_type(name) == kind
     for name in ('/chatter', '/uav0/odom', '/uav1/odom/x', '/uav1/cmd', 'uav1/odom'):
         assert topics.topic_type(name) is None

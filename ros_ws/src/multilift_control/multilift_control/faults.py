@@ -138,4 +138,6 @@ class FaultReallocation:
             if what == 'mixer' and mixer is not None:
                 mixer.rows[:] = values[:mixer.rows.shape[0]]
             elif what == 'targets' and constraints is not None:
-                constraints.targets = values.copy()
+                targets = values.copy()  # read-only, as VirtualConstraints makes it: the laws
+                targets.flags.writeable = False  # keep their compiled signature
+                constraints.targets = targets

@@ -46,7 +46,9 @@ UAV_TYPES = {ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
 RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
              PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
-             MARKERS: MARKER_ARRAY_TYPE, TF: TF_TYPE, EVENTS: FORMATION_EVENT_TYPE}
+             MARKERS: MARKER_ARRAY_TYPE, TF: TF_TYPE}
+# the topic of a run whose scenario has `events:` (run_topics(events=True))
+EVENT_TYPES = {EVENTS: FORMATION_EVENT_TYPE}
 
 _UAV_TOPIC = re.compile(r'^/uav([1-9][0-9]*)/(' + '|'.join(UAV_TYPES) + r')$')
 
@@ -76,17 +78,19 @@ def parse_uav_topic(topic: str) -> tuple[int, str] | None:
 
 def topic_type(topic: str) -> str | None:
     """The type a multilift topic has (`pkg/msg/Type`), or None for a name not of a run."""
-    if topic in RUN_TYPES:
-        return RUN_TYPES[topic]
+    if topic in RUN_TYPES or topic in EVENT_TYPES:
+        return {**RUN_TYPES, **EVENT_TYPES}[topic]
     parsed = parse_uav_topic(topic)
     return UAV_TYPES[parsed[1]] if parsed else None
 
 
-def run_topics(n_uavs: int, controllers: bool = True) -> list[tuple[str, str]]:
+def run_topics(n_uavs: int, controllers: bool = True,
+               events: bool = False) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
-    which has no reference, set-points or formation errors)."""
-    topics = list(RUN_TYPES.items())
+    which has no reference, set-points or formation errors); with `events` (a scenario with
+    `events:`), /formation/events."""
+    topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else [])
     if controllers:
         topics.append((REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE))
     for i in range(1, n_uavs + 1):

@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.linalg import expm, solve_continuous_lyapunov
 
 
 def dryden_spectrum(omega: np.ndarray, sigma: float, length: float, airspeed: float,
@@ -53,6 +52,8 @@ def _component(rng: np.random.Generator, samples: int, dt: float, sigma: float,
     """`samples` values of one component, dt [s] apart, from the stationary process."""
     if sigma == 0.0:
         return np.zeros(samples)
+    # scipy on demand: a run without turbulence (every kernel load) imports none of it
+    from scipy.linalg import expm, solve_continuous_lyapunov
     a, b, c = _forming_filter(length / airspeed, lateral)
     k = a.shape[0]
     stationary = solve_continuous_lyapunov(a, -b @ b.T)  # A P + P A^T + B B^T = 0

@@ -202,8 +202,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         # for the recorder to hear its rotor commands before t = 0
         ours = {f'/uav{i}/{leaf}' for i in external
                 for leaf in ('rotor_cmd', 'reference', 'attitude_setpoint', 'formation_error')}
-        topics = [f'{name}|{kind}' for name, kind in run_topics(scenario.n_uavs)
-                  if name not in ours]
+        topics = [f'{name}|{kind}' for name, kind in
+                  run_topics(scenario.n_uavs, events=bool(scenario.events)) if name not in ours]
         recorder = Child('recorder_node', [str(recorder_exe), *_ros_args(
             {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder')
         children.append(recorder)

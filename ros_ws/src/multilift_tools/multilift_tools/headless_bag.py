@@ -45,7 +45,7 @@ Progress = Callable[[float, float], None]
 
 def _add_topics(scenario: Scenario, writer: BagWriter, controllers: bool = True) -> None:
     qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
-    for topic, kind in run_topics(scenario.n_uavs, controllers):
+    for topic, kind in run_topics(scenario.n_uavs, controllers, bool(scenario.events)):
         writer.add_topic(topic, kind, qos)
 
 

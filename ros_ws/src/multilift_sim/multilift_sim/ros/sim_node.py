@@ -87,12 +87,14 @@ class SimNode(Node):
         self.marker_pub = self.create_publisher(MarkerArray, '/visualization/markers',
                                                 PUBLISHER_QOS)
         self.tf_pub = self.create_publisher(TFMessage, '/tf', PUBLISHER_QOS)
-        self.events_pub = self.create_publisher(FormationEvent, EVENTS, PUBLISHER_QOS)
+        # /formation/events only where the scenario has events (topics.run_topics)
+        events = [self.create_publisher(FormationEvent, EVENTS, PUBLISHER_QOS)] \
+            if scenario.events else []
         # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
-            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, self.events_pub,
+            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.commands: list[RotorCommand | None] = [None] * n
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own

@@ -79,7 +79,7 @@ def _both_paths(name: str, duration: float):
 
 
 def test_the_engine_and_the_ros_path_reallocate_alike():
-    _, engine, run = _both_paths('hexa_rotor_failure', 31.0)
+    _, engine, run = _both_paths('hexa_rotor_failure', 30.2)
     assert np.array_equal(engine.memory.mixers[0, 0], run.runtimes[0].leader.cascade.mixer.rows)
     assert not np.array_equal(engine.memory.mixers[0, 0], engine._initial.mixers[0, 0])
 
@@ -147,9 +147,9 @@ def test_v3_uav_loss_the_twin_left_delivers_the_payload():
 
 
 def test_the_engine_and_the_ros_path_take_the_new_offsets_alike():
-    scenario, engine, run = _both_paths('v3_uav_loss', 62.0)
-    schedule = target_schedule(scenario)  # the controllers answered the state at tick 6199
+    scenario, engine, run = _both_paths('v3_uav_loss', 60.3)
+    schedule = target_schedule(scenario)  # the controllers answered the state at tick 6029
     for runtime in run.runtimes[1:]:
-        assert np.array_equal(runtime.follower.constraints.targets, schedule[199, 1:])
-    assert schedule[200, 0] == 6200 and np.array_equal(engine.memory.targets[0],
-                                                         schedule[200, 1:])
+        assert np.array_equal(runtime.follower.constraints.targets, schedule[29, 1:])
+    assert schedule[30, 0] == 6030 and np.array_equal(engine.memory.targets[0],
+                                                        schedule[30, 1:])

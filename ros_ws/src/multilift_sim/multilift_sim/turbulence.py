@@ -15,7 +15,8 @@ components are the outputs of the specification's forming filters driven by whit
 H_u(s) ~ 1 / (1 + T s) and H_v(s) ~ (1 + sqrt(3) T s) / (1 + T s)^2 with T = L / V, sampled
 exactly (`dryden_series`): the states' transition e^(A dt) and the covariance the noise adds
 over a sample, Van Loan's matrix exponential, so the series' autocorrelation is the
-continuous process's at the samples and its variance sigma^2 whatever the rate.
+continuous process's at the samples and its variance sigma^2 whatever the rate (the
+recursion run as linear filters, scipy.signal.lfilter).
 
 Axes: u along the mean wind's horizontal direction (world x when there is none), v horizontal
 to its left, w up (z up, world frame).
@@ -54,6 +55,7 @@ def _component(rng: np.random.Generator, samples: int, dt: float, sigma: float,
         return np.zeros(samples)
     # scipy on demand: a run without turbulence (every kernel load) imports none of it
     from scipy.linalg import expm, solve_continuous_lyapunov
+    from scipy.signal import lfilter
     a, b, c = _forming_filter(length / airspeed, lateral)
     k = a.shape[0]
     stationary = solve_continuous_lyapunov(a, -b @ b.T)  # A P + P A^T + B B^T = 0
@@ -66,13 +68,23 @@ def _component(rng: np.random.Generator, samples: int, dt: float, sigma: float,
     added = transition @ exp[:k, k:]
     added = 0.5 * (added + added.T)
     lower = np.linalg.cholesky(added + 1e-300 * np.eye(k))
-    state = np.linalg.cholesky(stationary) @ rng.standard_normal(k)
-    out = np.empty(samples)
-    noise = rng.standard_normal((samples, k))
-    for n in range(samples):
-        out[n] = gain * (c @ state).item()
-        state = transition @ state + lower @ noise[n]
-    return out
+    # the recursion x_{n+1} = F x_n + L e_n (e white, unit) from the stationary x_0, as linear
+    # filters: started from rest one sample earlier with the input L^-1 x_0, so its state
+    # there is x_0; y = g c x through c (zI - F)^-1 L, whose denominator is det(zI - F)
+    start = np.linalg.cholesky(stationary) @ rng.standard_normal(k)
+    inputs = np.vstack([np.linalg.solve(lower, start), rng.standard_normal((samples, k))])
+    if k == 1:
+        denominator = np.array([1.0, -transition[0, 0]])
+        adjugate = np.zeros((1, 1))
+    else:  # adj(zI - F) = z I + [[-F11, F01], [F10, -F00]]
+        denominator = np.array([1.0, -np.trace(transition), np.linalg.det(transition)])
+        adjugate = np.array([[-transition[1, 1], transition[0, 1]],
+                             [transition[1, 0], -transition[0, 0]]])
+    out = np.zeros(samples + 1)
+    for j in range(k):
+        numerator = [0.0, (c @ lower[:, j]).item(), (c @ adjugate @ lower[:, j]).item()][:k + 1]
+        out += lfilter(numerator, denominator, inputs[:, j])
+    return gain * out[1:]
 
 
 def dryden_series(samples: int, dt: float, intensity, length_scale, airspeed: float,

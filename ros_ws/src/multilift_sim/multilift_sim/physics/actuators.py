@@ -101,20 +101,20 @@ def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, u
     that go slack (`slack`; taut (n,) bool updated, a `released` (n,) bool cable never taut
     again). `rotors` (n, rotors) holds each rotor's
     speed [rad/s] at x (NaN: never commanded, it starts at its first command) and is moved to
-    the period's end. Returns (the state at the end, the multipliers [N/m] at x, g [m^2] and
+    the period's end; with instant rotors (`instant`) it is not kept (they are their
+    commands). Returns (the state at the end, the multipliers [N/m] at x, g [m^2] and
     g_dot [m^2/s] at the end); x is not written."""
     n, count = commands.shape
+    wrenches = np.empty((n, WRENCH_COLUMNS))
+    if instant(actuators):  # the rotors are their commands (`rotors` not kept)
+        rotor_wrenches(allocation, commands, effectiveness, wrenches)
+        if slack:
+            return slack_period(x, wrenches, uavs, gusts, formation, taut, released, dt, steps)
+        return rigid_period(x, wrenches, uavs, gusts, formation, taut, dt, steps)
     for i in range(n):
         for r in range(count):
             if math.isnan(rotors[i, r]):
                 rotors[i, r] = commands[i, r]
-    wrenches = np.empty((n, WRENCH_COLUMNS))
-    if instant(actuators):
-        rotor_wrenches(allocation, commands, effectiveness, wrenches)
-        rotors[:, :] = commands
-        if slack:
-            return slack_period(x, wrenches, uavs, gusts, formation, taut, released, dt, steps)
-        return rigid_period(x, wrenches, uavs, gusts, formation, taut, dt, steps)
     speeds = np.empty((n, count))
     state = x.copy()
     first = np.zeros(n)

@@ -53,17 +53,25 @@ def fault_mixers(scenario: Scenario) -> np.ndarray:
     return out
 
 
+def _initial_targets(scenario: Scenario) -> tuple[VirtualConstraints | None, np.ndarray]:
+    """(the formation's VirtualConstraints, a copy of their targets before any event), or
+    (None, no targets) without a formation."""
+    if scenario.formation is None or scenario.n_uavs < 2:
+        return None, np.zeros(0)
+    constraints = VirtualConstraints(FormationGeometry.from_config(scenario.formation,
+                                                                   scenario.n_uavs))
+    return constraints, np.array(constraints.targets)
+
+
 def release_targets(scenario: Scenario) -> np.ndarray:
     """(k, m): for each event row (`simulation.event_array`) the virtual-constraint targets
     (`VirtualConstraints.targets`) the formation has after it (every earlier release kept; see
     the module docstring); the targets before it for the other kinds."""
     rows = event_array(scenario)
-    if scenario.formation is None or scenario.n_uavs < 2:
-        return np.zeros((len(rows), 0))
-    constraints = VirtualConstraints(FormationGeometry.from_config(scenario.formation,
-                                                                   scenario.n_uavs))
-    targets = np.array(constraints.targets)
+    constraints, targets = _initial_targets(scenario)
     out = np.empty((len(rows), len(targets)))
+    if constraints is None:
+        return out
     holding = np.ones(scenario.n_uavs, dtype=bool)  # whose cables hold the payload
     lengths = [u.cable_length for u in scenario.uavs]
     for k, row in enumerate(rows):
@@ -96,9 +104,7 @@ def target_schedule(scenario: Scenario) -> np.ndarray:
     out = []
     if final.shape[1] == 0:
         return np.zeros((0, 1 + final.shape[1]))
-    constraints = VirtualConstraints(FormationGeometry.from_config(scenario.formation,
-                                                                   scenario.n_uavs))
-    previous = np.array(constraints.targets)
+    _, previous = _initial_targets(scenario)
     ticks = max(1, int(round(RELEASE_TRANSITION * scenario.simulation.control_rate)))
     for k, row in enumerate(rows):
         if int(row[EVENT_KIND]) != KIND_CABLE_RELEASE or np.array_equal(final[k], previous):

@@ -287,6 +287,11 @@ class FormationModel:
         """Which cables are constraints, (n,) bool: the model's own array."""
         return self._taut
 
+    def set_wind(self, velocity: np.ndarray) -> None:
+        """The wind [m/s], world, the model integrates in from now on (the steady wind plus a
+        period's turbulence: simulation.turbulence_array)."""
+        self._formation[FORMATION_WIND:FORMATION_WIND + 3] = velocity
+
     # ------------------------------------------------------------------------- physics
     def _physics_functions(self) -> dict[str, Callable]:
         """The physics functions this model calls, by name (numba dispatchers)."""

@@ -508,19 +508,17 @@ def _scenario(data: Any, where: str) -> Scenario:
                         cable_model=cable_model, events=events, wind=tuple(wind),
                         turbulence=turbulence)
     _check_feasible(scenario)
+    # what only the engine's DAE (physics/) models: refused with another formulation
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
-    if (any(wind) or turbulence or any(u.vehicle.drag_coefficient for u in scenario.uavs)) and \
-            sim.integrator != 'baumgarte':
-        raise ScenarioError(f'{where}: wind and vehicle.drag_coefficient need '
-                            f'simulation.integrator: baumgarte, got {sim.integrator!r}')
-    if events and sim.integrator != 'baumgarte':
-        raise ScenarioError(f'{where}: events need simulation.integrator: baumgarte, got '
-                            f'{sim.integrator!r}')
-    if lagging and sim.integrator != 'baumgarte':
-        raise ScenarioError(f'{where}: vehicle.motor_time_constant / motor_rate_limit (uav'
-                            f'{lagging[0]}) need simulation.integrator: baumgarte, got '
-                            f'{sim.integrator!r}')
+    windy = any(wind) or turbulence is not None or any(u.vehicle.drag_coefficient
+                                                       for u in scenario.uavs)
+    for used, what in ((windy, 'wind and vehicle.drag_coefficient'), (events, 'events'),
+                       (lagging, f'vehicle.motor_time_constant / motor_rate_limit '
+                                 f'(uav{lagging[0] if lagging else 0})')):
+        if used and sim.integrator != 'baumgarte':
+            raise ScenarioError(f'{where}: {what} need simulation.integrator: baumgarte, got '
+                                f'{sim.integrator!r}')
     if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')

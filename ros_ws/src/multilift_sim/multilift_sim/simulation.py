@@ -18,7 +18,7 @@ from multilift_sim.formulations import make_formulation
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_END_TICK, EVENT_KIND,
                                           EVENT_KINDS, EVENT_ROTOR, EVENT_TICK, EVENT_TIME,
-                                          EVENT_UAV, EVENT_VALUE, FORMATION_WIND,
+                                          EVENT_UAV, EVENT_VALUE,
                                           MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
@@ -304,8 +304,7 @@ class FormationSimulator:
         """The model's wind for the period from the current tick: the steady wind plus the
         tick's turbulence (`turbulence_array`), as the engine's tick adds them."""
         if len(self._turbulence):
-            self.model._formation[FORMATION_WIND:FORMATION_WIND + 3] = (
-                self._steady_wind + self._turbulence[self.tick])
+            self.model.set_wind(self._steady_wind + self._turbulence[self.tick])
 
     def happened_rows(self) -> np.ndarray:
         """The rows (physics.layout EVENT_*) of the events the current tick is the first to

@@ -29,7 +29,7 @@ from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bagyaml import OfferedQos, qos_yaml
 from multilift_sim.formulations import make_formulation
-from multilift_sim.physics.layout import EVENT_TICK, FORMATION_WIND
+from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
@@ -141,8 +141,7 @@ class EngineBag:
         model.effectiveness[:] = memory.effectiveness[0]
         turbulence = engine.arrays.turbulence[0]
         if len(turbulence):  # the wind at the last tick, as FormationSimulator holds it
-            model._formation[FORMATION_WIND:FORMATION_WIND + 3] = (
-                np.array(scenario.wind, dtype=float) + turbulence[tick])
+            model.set_wind(np.array(scenario.wind, dtype=float) + turbulence[tick])
         held = list(self._held.reshape(n, -1)) if self._held is not None else None
         tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),

@@ -22,6 +22,7 @@ from multilift_control.controllers import make_controller
 from multilift_control.faults import FaultReallocation
 from multilift_control.formation import FormationFollower
 from multilift_control.laws.follower import lift_vectors
+from multilift_control.laws.layout import UAV_BODY_RATES, UAV_EULER, UAV_POSITION, UAV_VELOCITY
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.mission import Reference
 from multilift_sim.scenario import Scenario
@@ -174,9 +175,13 @@ def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
 
 
 def uav_states(snapshot: Snapshot) -> FormationStates:
-    """What the controllers measure of the formation at the snapshot's tick."""
-    return FormationStates(UavState(u.position, u.velocity, u.euler, u.body_rates)
-                           for u in snapshot.uavs)
+    """What the controllers measure of the formation at the snapshot's tick (its
+    `measured` rows: the state, or with `sensors:` the sensors' measurement)."""
+    return FormationStates(UavState(row[UAV_POSITION:UAV_POSITION + 3],
+                                    row[UAV_VELOCITY:UAV_VELOCITY + 3],
+                                    row[UAV_EULER:UAV_EULER + 3],
+                                    row[UAV_BODY_RATES:UAV_BODY_RATES + 3])
+                           for row in snapshot.measured)
 
 
 def prepare_node_laws(scenario: Scenario, index: int) -> None:

@@ -13,7 +13,8 @@ import numpy as np
 
 from multilift_sim.physics.layout import (EVENT_KIND, EVENT_KINDS, EVENT_ROTOR, EVENT_TIME,
                                           EVENT_UAV, EVENT_VALUE, KIND_CONTROLLER_SILENCE,
-                                          KIND_ROTOR_EFFECTIVENESS)
+                                          KIND_ROTOR_EFFECTIVENESS, MEASURED_BODY_RATES,
+                                          MEASURED_EULER, MEASURED_POSITION, MEASURED_VELOCITY)
 
 
 WORLD_FRAME = 'world'
@@ -22,6 +23,9 @@ PAYLOAD_FRAME = 'payload'
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 IDENTITY: Quat = (0.0, 0.0, 0.0, 1.0)
+# a FormationSnapshot's per-UAV blocks, 3 numbers per UAV each, in its order: position,
+# velocity, euler, body rates (their slots in a measured state, physics.layout MEASURED_*)
+SNAPSHOT_BLOCKS = (MEASURED_POSITION, MEASURED_VELOCITY, MEASURED_EULER, MEASURED_BODY_RATES)
 
 
 def uav_frame(index: int) -> str:
@@ -75,17 +79,14 @@ def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | N
                        ) -> tuple[np.ndarray, ...]:
     """The arrays of a multilift_msgs/FormationSnapshot from a simulation.Snapshot and the
     rotor speeds applied up to it (None at t = 0): (position, velocity, euler, body_rates)
-    3 per UAV, payload position and velocity, previous rotor speeds UAV by UAV (empty at
-    t = 0)."""
-    uavs = snapshot.uavs
+    3 per UAV, what the controllers receive (its `measured` rows), payload position and
+    velocity, previous rotor speeds UAV by UAV (empty at t = 0)."""
+    measured = snapshot.measured  # what the controllers receive (physics.sensors)
     previous = (np.concatenate(previous_rotor_speeds).astype(float)
                 if previous_rotor_speeds is not None else np.empty(0))
-    return (np.concatenate([u.position for u in uavs]),
-            np.concatenate([u.velocity for u in uavs]),
-            np.concatenate([u.euler for u in uavs]),
-            np.concatenate([u.body_rates for u in uavs]),
-            np.asarray(snapshot.payload_position, dtype=float),
-            np.asarray(snapshot.payload_velocity, dtype=float), previous)
+    return tuple(measured[:, block:block + 3].reshape(-1) for block in SNAPSHOT_BLOCKS) + (
+        np.asarray(snapshot.payload_position, dtype=float),
+        np.asarray(snapshot.payload_velocity, dtype=float), previous)
 
 
 FormationEventValues = tuple[str, int, int, float, float, str]

@@ -21,7 +21,7 @@ from multilift_sim.dynamics import FormationParams
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
-from multilift_sim.physics.layout import EVENT_KINDS
+from multilift_sim.physics.layout import EVENT_KINDS, SENSED_QUANTITIES
 
 
 class ScenarioError(ValueError):
@@ -138,6 +138,23 @@ class TurbulenceConfig:
 
 
 @dataclass(frozen=True)
+class SensorConfig:
+    """What the controllers receive of each UAV (`sensors:`, multilift_sim.sensors,
+    docs/sensors.md): per quantity of SENSED_QUANTITIES (position [m], velocity [m/s],
+    attitude [rad], body_rate [rad/s]) its white noise and bias random walk."""
+    noise: tuple[float, ...]         # standard deviation of the white noise [unit]
+    bias: tuple[float, ...]          # intensity of the bias random walk [unit / sqrt(s)]
+    rate: float                      # samples per second [Hz]; divides control_rate
+    latency_ticks: int               # control ticks from a sample to its arrival
+    dropout: float                   # probability a sample is lost, in [0, 1)
+    seed: int                        # of the errors (a run's seed)
+
+    def every(self, control_rate: float) -> int:
+        """Control ticks between two samples."""
+        return int(round(control_rate / self.rate))
+
+
+@dataclass(frozen=True)
 class Scenario:
     name: str
     description: str
@@ -154,6 +171,7 @@ class Scenario:
     events: tuple[EventConfig, ...] = ()  # in time order
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world
     turbulence: TurbulenceConfig | None = None
+    sensors: SensorConfig | None = None  # None: the controllers read the exact state
 
     @property
     def n_uavs(self) -> int:
@@ -251,6 +269,13 @@ class _Section:
         if check is not None and not all(check(v) for v in out):
             raise self.fail(name, value, rule)
         return out
+
+    def count(self, name: str, default: Any = ...) -> int:
+        """An integer >= 0 (a seed, a number of ticks)."""
+        value = self.raw(name, default)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise self.fail(name, value, 'must be an integer >= 0')
+        return value
 
     def text(self, name: str, default: Any = ..., choices: tuple[str, ...] | None = None) -> str:
         value = self.raw(name, default)
@@ -451,15 +476,13 @@ def _scenario(data: Any, where: str) -> Scenario:
     turbulence = None
     if w.has('turbulence'):
         d = w.section('turbulence')
-        seed = d.raw('seed', 0)
-        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise d.fail('seed', seed, 'must be an integer >= 0')
         turbulence = TurbulenceConfig(
             intensity=d.vector('intensity', check=lambda v: v >= 0, rule='must be >= 0'),
             length_scale=d.vector('length_scale', check=lambda v: v > 0, rule='must be > 0'),
-            airspeed=d.positive('airspeed'), seed=seed)
+            airspeed=d.positive('airspeed'), seed=d.count('seed', 0))
         d.done()
     w.done()
+    sensors = _sensors(top.section('sensors'), sim) if top.has('sensors') else None
 
     c = top.section('control')
     mode = c.text('mode', choices=CONTROL_MODES)
@@ -506,7 +529,7 @@ def _scenario(data: Any, where: str) -> Scenario:
                                               reference_filter_time=reference_filter_time),
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, events=events, wind=tuple(wind),
-                        turbulence=turbulence)
+                        turbulence=turbulence, sensors=sensors)
     _check_feasible(scenario)
     # what only the engine's DAE (physics/) models: refused with another formulation
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
@@ -523,6 +546,28 @@ def _scenario(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario
+
+
+def _sensors(d: _Section, sim: SimulationConfig) -> SensorConfig:
+    """The `sensors:` section, validated: per quantity `{name}_noise` and `{name}_bias`
+    (default 0), the rate (default the control rate, which it must divide), the latency in
+    ticks, the dropout probability and the seed."""
+    noise = tuple(d.non_negative(f'{q}_noise', 0.0) for q in SENSED_QUANTITIES)
+    bias = tuple(d.non_negative(f'{q}_bias', 0.0) for q in SENSED_QUANTITIES)
+    control_rate = sim.control_rate
+    rate = d.number('rate', control_rate, lambda v: 0 < v <= control_rate,
+                    f'must be > 0 and <= simulation.control_rate ({control_rate:g})')
+    ratio = control_rate / rate
+    if abs(ratio - round(ratio)) > 1e-9:
+        raise d.fail('rate', rate, f'must divide simulation.control_rate ({control_rate:g}) '
+                     'into a whole number of ticks')
+    config = SensorConfig(noise=noise, bias=bias, rate=rate,
+                          latency_ticks=d.count('latency_ticks', 0),
+                          dropout=d.number('dropout', 0.0, lambda v: 0 <= v < 1,
+                                           'must be within [0, 1)'),
+                          seed=d.count('seed', 0))
+    d.done()
+    return config
 
 
 def _events(top: _Section, uavs: list[UavConfig], duration: float) -> tuple[EventConfig, ...]:

@@ -19,14 +19,16 @@ from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_END_TICK, EVENT_KIND,
                                           EVENT_KINDS, EVENT_ROTOR, EVENT_TICK, EVENT_TIME,
                                           EVENT_UAV, EVENT_VALUE,
-                                          MEASURED_BODY_RATES, MEASURED_EULER,
+                                          MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
                                           ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
 from multilift_sim.physics.measurement import odometry_states
+from multilift_sim.physics.sensors import sensed_states
 from multilift_sim import kernels
 from multilift_sim.msgvalues import formation_event
 from multilift_sim.scenario import Scenario
+from multilift_sim.sensors import sensor_errors
 from multilift_sim.statistics import RunStatistics
 from multilift_sim.turbulence import dryden_series
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
@@ -55,6 +57,9 @@ class Snapshot:
     payload_position: np.ndarray  # world [m]
     payload_velocity: np.ndarray  # world [m/s]
     odometry: np.ndarray  # every UAV's row (n, ODOMETRY_COLUMNS), physics.layout ODOMETRY_*
+    # what the controllers receive of every UAV (n, MEASURED_COLUMNS): the odometry's
+    # MEASURED_* slots, or with `sensors:` their measurement (physics.sensors)
+    measured: np.ndarray
 
 
 def stop_message(status: int, cable: int, value: float, t: float, sim) -> str:
@@ -114,6 +119,39 @@ def turbulence_array(scenario: Scenario) -> np.ndarray:
     sim = scenario.simulation
     return dryden_series(sim.tick_count + 1, 1.0 / sim.control_rate, config.intensity,
                          config.length_scale, config.airspeed, scenario.wind, config.seed)
+
+
+@dataclass(frozen=True)
+class SensorArrays:
+    """A run's sensors as `physics.sensors.sensed_states` reads them (`sensors:`): every
+    sample's errors and arrivals (`sensors.sensor_errors`), ticks between samples and from a
+    sample to its arrival. Without sensors, no samples."""
+    errors: np.ndarray       # (S, n, MEASURED_COLUMNS) [the slots' units]
+    delivered: np.ndarray    # (S, n) bool
+    every: int               # control ticks between two samples
+    latency: int             # control ticks from a sample to its arrival
+
+    @property
+    def on(self) -> bool:
+        return len(self.errors) > 0
+
+    def memory(self) -> tuple[np.ndarray, np.ndarray]:
+        """Fresh (history (latency + 1, n, MEASURED_COLUMNS), seen (n, MEASURED_COLUMNS):
+        NaN, nothing received yet) for a run's start."""
+        n = self.errors.shape[1]
+        return (np.zeros((self.latency + 1, n, MEASURED_COLUMNS)),
+                np.full((n, MEASURED_COLUMNS), math.nan))
+
+
+def sensor_arrays(scenario: Scenario) -> SensorArrays:
+    """The scenario's `sensors:` as arrays (none without them)."""
+    config, sim, n = scenario.sensors, scenario.simulation, scenario.n_uavs
+    if config is None:
+        return SensorArrays(np.zeros((0, n, MEASURED_COLUMNS)), np.zeros((0, n), dtype=bool),
+                            1, 0)
+    errors, delivered = sensor_errors(config, n, sim.tick_count, sim.control_rate)
+    return SensorArrays(errors, delivered, config.every(sim.control_rate),
+                        config.latency_ticks)
 
 
 def event_records(rows: np.ndarray) -> list[dict]:
@@ -201,6 +239,9 @@ class FormationSimulator:
         self._turbulence = turbulence_array(scenario)
         self._steady_wind = np.array(scenario.wind, dtype=float)
         self._set_wind()
+        # what the controllers receive (physics.sensors): its arrays and memory
+        self.sensors = sensor_arrays(scenario)
+        self._sensor_history, self._sensor_seen = self.sensors.memory()
         self._apply_events()
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
         self._uniform_rotors = rotor_counts.pop() if len(rotor_counts) == 1 else None
@@ -221,12 +262,19 @@ class FormationSimulator:
     def snapshot(self) -> Snapshot:
         """The formation at the current tick: every UAV's numbers from one call of
         physics.measurement.odometry_states, viewed from a fresh array (none of the
-        simulator's state)."""
+        simulator's state), and what the controllers receive of them (with `sensors:`,
+        physics.sensors.sensed_states; call it once a tick, or more: the same result)."""
         n = self.n
         nq = 6 * n + 3
         rows = np.empty((1, n, ODOMETRY_COLUMNS))
         odometry_states(self.state.reshape(1, -1), n, rows)
         odometry = rows[0]
+        measured = odometry[:, :MEASURED_COLUMNS].copy()
+        sensors = self.sensors
+        if sensors.on:
+            kernels.runnable(sensed_states)(
+                measured, self.tick, sensors.errors, sensors.delivered, sensors.every,
+                sensors.latency, self._sensor_history, self._sensor_seen)
         uavs = tuple(UavSnapshot(
             position=row[MEASURED_POSITION:MEASURED_POSITION + 3],
             velocity=row[MEASURED_VELOCITY:MEASURED_VELOCITY + 3],
@@ -236,7 +284,7 @@ class FormationSimulator:
             body_velocity=row[ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3],
             orientation=row[ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4]) for row in odometry)
         return Snapshot(self.t_ns, uavs, self.state[6 * n:nq].copy(),
-                        self.state[nq + 6 * n:].copy(), odometry)
+                        self.state[nq + 6 * n:].copy(), odometry, measured)
 
     @property
     def taut(self) -> np.ndarray:

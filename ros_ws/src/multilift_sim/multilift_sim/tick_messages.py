@@ -14,18 +14,18 @@ from typing import Sequence
 import numpy as np
 
 from multilift_sim import cdr
-from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, formation_event, formation_snapshot,
-                                     uav_frame, vec3)
-from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
-                                          MEASURED_POSITION, MEASURED_VELOCITY,
-                                          ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
-                                          ODOMETRY_QUATERNION)
-from multilift_sim.physics.measurement import odometry_states
+from multilift_sim import kernels
+from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, SNAPSHOT_BLOCKS, formation_event,
+                                     formation_snapshot, uav_frame, vec3)
+from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS,
+                                          MEASURED_POSITION, ODOMETRY_BODY_VELOCITY,
+                                          ODOMETRY_COLUMNS, ODOMETRY_QUATERNION)
+from multilift_sim.physics.measurement import odometry_rows, odometry_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.scene import FormationScene
 from multilift_sim.simulation import Snapshot
 from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE, MARKERS,
-                                  PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, uav_topic)
+                                  MEASURED_ODOM, PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
 _ZERO = (0.0, 0.0, 0.0)
@@ -35,8 +35,6 @@ ODOMETRY_NUMBERS = np.r_[MEASURED_POSITION:MEASURED_POSITION + 3,
                          ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4,
                          ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3,
                          MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3]
-# the FormationSnapshot's per-UAV blocks, each 3 per UAV: position, velocity, euler, body rates
-_SNAPSHOT_BLOCKS = (MEASURED_POSITION, MEASURED_VELOCITY, MEASURED_EULER, MEASURED_BODY_RATES)
 
 
 class SimulatorMessages:
@@ -48,6 +46,9 @@ class SimulatorMessages:
         self._snapshot = cdr.FormationSnapshot([u.vehicle.n_rotors for u in scenario.uavs])
         self._odometry = [(uav_topic(i, ODOM), cdr.Odometry(uav_frame(i)))
                           for i in range(1, n + 1)]
+        # what the controllers receive, UAV by UAV, where the scenario has `sensors:`
+        self._measured = [(uav_topic(i, MEASURED_ODOM), cdr.Odometry(uav_frame(i)))
+                          for i in range(1, n + 1)] if scenario.sensors is not None else []
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
         self._gust = cdr.Vector3Stamped()
         self._tf = cdr.TFMessage([uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME])
@@ -59,30 +60,39 @@ class SimulatorMessages:
     def state(self, snap: Snapshot, gust: Sequence[float],
               applied: Sequence[np.ndarray] | None, last: bool = False) -> list[Message]:
         """The state at the tick of `snap`, in the order the node sends it: /clock, then
-        /formation/snapshot (what the controllers wait for; `applied`: the rotor speeds held
-        up to this tick, None at t = 0; none at the run's `last` tick, which no controller
-        answers), then for users, tools and bags every /uav{i}/odom, /payload/odom,
+        /formation/snapshot (what the controllers wait for: what they receive of the state;
+        `applied`: the rotor speeds held up to this tick, None at t = 0; none at the run's
+        `last` tick, which no controller answers), then for users, tools and bags every
+        /uav{i}/odom (the state), with `sensors:` every /uav{i}/measured_odom, /payload/odom,
         /payload/gust (`gust`: the air velocity at the payload [m/s]) and /tf."""
         snapshot = None if last else formation_snapshot(snap, applied)
         uavs = snap.odometry[:, ODOMETRY_NUMBERS].tolist()
+        measured = measured_odometry(snap.measured[None])[0].tolist() if self._measured \
+            else None
         return self.state_of(
             snap.t_ns, None if snapshot is None else np.concatenate(snapshot).tolist(),
             None if snapshot is None else len(snapshot[-1]), uavs,
-            snap.payload_position.tolist(), snap.payload_velocity.tolist(), vec3(gust))
+            snap.payload_position.tolist(), snap.payload_velocity.tolist(), vec3(gust),
+            measured)
 
     def state_of(self, t_ns: int, snapshot: list[float] | None, previous: int | None,
                  uavs: Sequence[Sequence[float]], payload_position: Sequence[float],
-                 payload_velocity: Sequence[float], gust: Sequence[float]) -> list[Message]:
+                 payload_velocity: Sequence[float], gust: Sequence[float],
+                 measured: Sequence[Sequence[float]] | None = None) -> list[Message]:
         """`state` from plain numbers (the one packing of both): `snapshot` the
         FormationSnapshot's numbers in a row (`cdr.FormationSnapshot.pack_row`; None at the
         last tick) with `previous` rotor speeds at its end, per UAV its odometry's 13 numbers
         (position, orientation (x, y, z, w), body-frame velocity, body rates: msgvalues
-        .odometry), the payload's position and velocity and the gust, world [m, m/s]."""
+        .odometry) and (with `sensors:`) those of what its controllers receive, the payload's
+        position and velocity and the gust, world [m, m/s]."""
         out = [(CLOCK, self._clock.pack(t_ns))]
         if snapshot is not None:
             out.append((FORMATION_SNAPSHOT, self._snapshot.pack_row(t_ns, snapshot, previous)))
         for uav, (topic, packer) in zip(uavs, self._odometry):
             out.append((topic, packer.pack_row(t_ns, uav)))
+        if measured is not None:
+            for uav, (topic, packer) in zip(measured, self._measured):
+                out.append((topic, packer.pack_row(t_ns, uav)))
         out.append((PAYLOAD_ODOM, self._payload.pack(t_ns, payload_position, IDENTITY,
                                                      payload_velocity, _ZERO)))
         out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *gust)))
@@ -121,16 +131,30 @@ class SimulatorMessages:
         return MARKERS, self._markers.pack(t_ns)
 
 
-def state_rows(states: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+def state_rows(states: np.ndarray, n: int, measured: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray]:
     """The numbers `SimulatorMessages.state_of` takes, for K formation states (K, 2 (6n + 3))
     of n UAVs at once: (the FormationSnapshot rows (K, 12 n + 6) without the rotor speeds,
     every UAV's odometry row (K, n, 13)). One call of physics.measurement.odometry_states,
     which `FormationSimulator.snapshot` calls too: the same bits tick by tick
-    (tests/unit/test_headless_bag.py)."""
+    (tests/unit/test_headless_bag.py). The snapshot carries what the controllers received,
+    `measured` (K, n, MEASURED_COLUMNS), where given (the engine's record), else the state's."""
     k, nq = states.shape[0], 6 * n + 3
     rows = np.empty((k, n, ODOMETRY_COLUMNS))
     odometry_states(np.ascontiguousarray(states), n, rows)
+    received = rows if measured is None else measured
     snapshot = np.concatenate(
-        [rows[..., block:block + 3].reshape(k, 3 * n) for block in _SNAPSHOT_BLOCKS]
+        [received[..., block:block + 3].reshape(k, 3 * n) for block in SNAPSHOT_BLOCKS]
         + [states[:, 6 * n:nq], states[:, nq + 6 * n:]], axis=1)
     return snapshot, rows[..., ODOMETRY_NUMBERS]
+
+
+def measured_odometry(measured: np.ndarray) -> np.ndarray:
+    """The odometry's 13 numbers (K, n, 13) (`SimulatorMessages.state_of`'s `measured`) of
+    what the controllers receive, (K, n, MEASURED_COLUMNS) (physics.measurement.odometry_rows:
+    the attitude and body-frame velocity of the measurement)."""
+    k, n = measured.shape[:2]
+    rows = np.zeros((k, n, ODOMETRY_COLUMNS))
+    rows[..., :MEASURED_COLUMNS] = measured
+    kernels.runnable(odometry_rows)(rows)
+    return rows[..., ODOMETRY_NUMBERS]

@@ -35,12 +35,13 @@ EVENTS = '/formation/events'            # the scenario's events as they happen
 
 # leaves of the per-UAV topics /uav{i}/{leaf}
 ODOM = 'odom'                           # UAV i's state (every UAV)
+MEASURED_ODOM = 'measured_odom'         # what UAV i's controllers receive (with `sensors:`)
 ROTOR_CMD = 'rotor_cmd'                 # UAV i's rotor speeds (every UAV)
 ATTITUDE_SETPOINT = 'attitude_setpoint'  # UAV i's outer-loop output (every UAV)
 REFERENCE = 'reference'                 # the mission reference (the leader only)
 FORMATION_ERROR = 'formation_error'     # follower i's rows of g_vc (followers only)
 
-UAV_TYPES = {ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
+UAV_TYPES = {ODOM: ODOMETRY_TYPE, MEASURED_ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
              ATTITUDE_SETPOINT: ATTITUDE_SETPOINT_TYPE, REFERENCE: TRACKING_REFERENCE_TYPE,
              FORMATION_ERROR: FORMATION_ERROR_TYPE}
 RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
@@ -61,13 +62,15 @@ def uav_topic(index: int, leaf: str) -> str:
 REFERENCE_TOPIC = uav_topic(1, REFERENCE)
 
 
-def state_topics(n_uavs: int) -> list[str]:
+def state_topics(n_uavs: int, sensors: bool = False) -> list[str]:
     """The topics carrying the simulator's state at t, any of which a controller may read to
-    answer it (every UAV's odometry, the snapshot our controllers read, the payload's odometry,
-    /tf): before t = 0 the simulator waits for an external controller to subscribe to one
-    (`SimNode.missing_peers`). Not /clock: every node with use_sim_time reads it."""
-    return ([FORMATION_SNAPSHOT] + [uav_topic(i, ODOM) for i in range(1, n_uavs + 1)]
-            + [PAYLOAD_ODOM, TF])
+    answer it (every UAV's odometry, with `sensors` what the controllers receive of it, the
+    snapshot our controllers read, the payload's odometry, /tf): before t = 0 the simulator
+    waits for an external controller to subscribe to one (`SimNode.missing_peers`). Not
+    /clock: every node with use_sim_time reads it."""
+    leaves = (ODOM, MEASURED_ODOM) if sensors else (ODOM,)
+    return ([FORMATION_SNAPSHOT] + [uav_topic(i, leaf) for i in range(1, n_uavs + 1)
+                                    for leaf in leaves] + [PAYLOAD_ODOM, TF])
 
 
 def parse_uav_topic(topic: str) -> tuple[int, str] | None:
@@ -84,12 +87,13 @@ def topic_type(topic: str) -> str | None:
     return UAV_TYPES[parsed[1]] if parsed else None
 
 
-def run_topics(n_uavs: int, controllers: bool = True,
-               events: bool = False) -> list[tuple[str, str]]:
+def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
+               sensors: bool = False) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
     which has no reference, set-points or formation errors); with `events` (a scenario with
-    `events:`), /formation/events."""
+    `events:`), /formation/events; with `sensors` (a scenario with `sensors:`), every
+    /uav{i}/measured_odom."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else [])
     if controllers:
         topics.append((REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE))
@@ -97,9 +101,18 @@ def run_topics(n_uavs: int, controllers: bool = True,
         topics += [(uav_topic(i, leaf), UAV_TYPES[leaf])
                    for leaf in ((ODOM, ROTOR_CMD, ATTITUDE_SETPOINT) if controllers
                                 else (ODOM, ROTOR_CMD))]
+        if sensors:
+            topics.append((uav_topic(i, MEASURED_ODOM), ODOMETRY_TYPE))
         if i > 1 and controllers:
             topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
     return topics
+
+
+def scenario_topics(scenario, controllers: bool = True) -> list[tuple[str, str]]:
+    """`run_topics` of a scenario (multilift_sim.scenario.Scenario): its n, and the topics its
+    `events:` and `sensors:` add."""
+    return run_topics(scenario.n_uavs, controllers, bool(scenario.events),
+                      scenario.sensors is not None)
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

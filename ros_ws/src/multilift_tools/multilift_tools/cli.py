@@ -26,7 +26,7 @@ from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.fastdds import LIVE_VIEW_ANNOUNCEMENT, use_fastdds_profile
 from multilift_sim.ros.shared_memory import remove_before_start
 from multilift_tools.launcher import Child, Supervisor, find_executable
-from multilift_sim.topics import parse_external, run_topics
+from multilift_sim.topics import parse_external, scenario_topics
 
 
 def _ros_args(params: dict) -> list[str]:
@@ -203,7 +203,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         ours = {f'/uav{i}/{leaf}' for i in external
                 for leaf in ('rotor_cmd', 'reference', 'attitude_setpoint', 'formation_error')}
         topics = [f'{name}|{kind}' for name, kind in
-                  run_topics(scenario.n_uavs, events=bool(scenario.events)) if name not in ours]
+                  scenario_topics(scenario) if name not in ours]
         recorder = Child('recorder_node', [str(recorder_exe), *_ros_args(
             {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder')
         children.append(recorder)

@@ -33,8 +33,8 @@ from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
-from multilift_sim.tick_messages import SimulatorMessages, state_rows
-from multilift_sim.topics import MARKER_DECIMATION, run_topics
+from multilift_sim.tick_messages import SimulatorMessages, measured_odometry, state_rows
+from multilift_sim.topics import MARKER_DECIMATION, scenario_topics
 
 # ticks per compiled call (and between two progress reports): 2.5 s of a 100 Hz mission
 CHUNK_TICKS = 250
@@ -45,7 +45,7 @@ Progress = Callable[[float, float], None]
 
 def _add_topics(scenario: Scenario, writer: BagWriter, controllers: bool = True) -> None:
     qos = qos_yaml([OfferedQos(history='keep_last', depth=100)])
-    for topic, kind in run_topics(scenario.n_uavs, controllers, bool(scenario.events)):
+    for topic, kind in scenario_topics(scenario, controllers):
         writer.add_topic(topic, kind, qos)
 
 
@@ -69,6 +69,7 @@ class EngineBag:
         self._own_rows = arrays.own_rows[0].tolist()
         self._reference = int(arrays.leader_mode[0]) == MODE_CASCADE
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
+        self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
 
     def ticks(self, first: int, record: TickRecord, count: int) -> None:
         """Write ticks first .. first + count - 1 of formation 0 from `record`'s rows."""
@@ -76,7 +77,10 @@ class EngineBag:
             return
         n, period, rows = self._n, self._period_ns, self._own_rows
         states = record.states[:count, 0]
-        snapshots, odometry = state_rows(states, n)
+        received = record.measured[:count, 0]  # what the controllers received
+        snapshots, odometry = state_rows(states, n, received)
+        measured = measured_odometry(received).tolist() if self._sensors \
+            else [None] * count
         speeds = record.speeds[:count, 0]
         flat = speeds.reshape(count, -1)
         if self._held is None:  # from t = 0: no rotor speeds held yet
@@ -106,7 +110,7 @@ class EngineBag:
             t_ns = tick * period
             messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
                                           odometry[k], payload_position[k],
-                                          payload_velocity[k], gusts[k])
+                                          payload_velocity[k], gusts[k], measured[k])
             messages += self._events_at(tick, t_ns)
             for i in range(n):
                 if not self._controllers:
@@ -130,9 +134,11 @@ class EngineBag:
         _, odometry = state_rows(state[None], n)
         odometry = odometry[0].tolist()
         payload_position = state[6 * n:6 * n + 3].tolist()
+        measured = measured_odometry(engine.measured()[:1])[0].tolist() if self._sensors \
+            else None
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
                                              state[12 * n + 3:12 * n + 6].tolist(),
-                                             memory.gust[0].tolist())
+                                             memory.gust[0].tolist(), measured)
                     + self._events_at(tick, t_ns), t_ns)
         scenario = self._scenario
         model = make_formulation(scenario.simulation.integrator, scenario.formation_params(),

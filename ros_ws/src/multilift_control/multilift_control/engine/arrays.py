@@ -24,8 +24,8 @@ from multilift_control.runtime import ThrustBook
 from multilift_sim.dynamics import FormationModel, actuator_array, constant_arrays
 from multilift_sim.physics.layout import UAV_MASS
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import (cable_reach, event_array, initial_state, swing_sampling,
-                                      turbulence_array)
+from multilift_sim.simulation import (cable_reach, event_array, initial_state, sensor_arrays,
+                                      swing_sampling, turbulence_array)
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
 
@@ -55,6 +55,11 @@ class FormationArrays(NamedTuple):
     slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
     events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
     turbulence: np.ndarray        # (B, ticks + 1 or 0, 3): the wind's turbulence by tick [m/s]
+    # what the controllers receive (`sensors:`; simulation.SensorArrays, physics.sensors)
+    sensor_errors: np.ndarray     # (B, S or 0, n, MEASURED_COLUMNS): each sample's error
+    sensor_delivered: np.ndarray  # (B, S or 0, n) bool: whether the sample arrives
+    sensor_every: np.ndarray      # (B,) int: control ticks between two samples
+    sensor_latency: np.ndarray    # (B,) int: control ticks from a sample to its arrival
     # time and Algorithm 1's tolerances
     physics_dt: np.ndarray        # (B,) [s]
     physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
@@ -107,6 +112,8 @@ class FormationMemory(NamedTuple):
     follower_memory: np.ndarray   # (B, n, FOLLOWER_MEMORY_SIZE)
     thrusts: np.ndarray           # (B, n): the thrust book u_T,j [N]
     gust: np.ndarray              # (B, 3): the air velocity at the payload [m/s], world
+    sensor_history: np.ndarray    # (B, latency + 1, n, MEASURED_COLUMNS): the last exact states
+    sensor_seen: np.ndarray       # (B, n, MEASURED_COLUMNS): what the controllers hold (NaN: none)
     run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
     tracking: np.ndarray          # (B, TRACKING_SIZE): the leader's tracking error
     formation_errors: np.ndarray  # (B, n, FORMATION_SIZE): each follower's (row 0 unused)
@@ -178,12 +185,16 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         if f.law_p.shape == (3, m):  # linear rows (else the law solves each tick)
             law_p[i], law_q[i] = f.law_p, f.law_q
     model = FormationModel(params)
+    sensors = sensor_arrays(scenario)
+    sensor_history, sensor_seen = sensors.memory()
     arrays = dict(
         uavs=uavs, gusts=gusts, formation=formation, allocation=model.allocation,
         actuators=actuator_array(params),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
         slack=scenario.cable_model == 'slack', events=event_array(scenario),
         turbulence=turbulence_array(scenario),
+        sensor_errors=sensors.errors, sensor_delivered=sensors.delivered,
+        sensor_every=sensors.every, sensor_latency=sensors.latency,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),
@@ -212,6 +223,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         cascade_memory=np.stack([c.memory for c in cascades]),
         follower_memory=follower_memory,
         thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float), gust=np.zeros(3),
+        sensor_history=sensor_history, sensor_seen=sensor_seen,
         run=RunStatistics(n).run, tracking=TrackingStatistics().acc,
         formation_errors=np.stack([FormationErrorStatistics().acc for _ in range(n)]))
     return arrays, memory

@@ -24,6 +24,7 @@ from multilift_sim.physics.formation_dae import air_velocity, residuals
 from multilift_sim.physics.layout import (EVENT_KIND, EVENT_UAV, FORMATION_WIND,
                                           KIND_ROTOR_EFFECTIVENESS)
 from multilift_sim.physics.measurement import measured_states
+from multilift_sim.physics.sensors import sensed_states
 from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
                                                    run_add_gust_speed, run_add_slack,
                                                    run_add_tensions, run_check, tracking_add)
@@ -165,13 +166,25 @@ def advance_formation(a, m, b, speeds, saturated, tension):
 
 
 @jit
+def measure(a, m, b, states):
+    """What formation b's controllers receive of its UAVs at its current tick, into states
+    (n, UAV_STATE_SIZE): the measured states (seed Eq. 2.7), with `sensors:` as its sensors
+    deliver them (`physics.sensors.sensed_states`)."""
+    measured_states(m.state[b], states.shape[0], states)
+    if a.sensor_errors.shape[1]:
+        sensed_states(states, m.tick[b], a.sensor_errors[b], a.sensor_delivered[b],
+                      a.sensor_every[b], a.sensor_latency[b], m.sensor_history[b],
+                      m.sensor_seen[b])
+
+
+@jit
 def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference, errors,
                    rates, tension):
-    """One control tick of formation b: measure, answer, hold the speeds over the control
-    period (RK4), then check; the tension T_i = 2 l_i lambda_i [N] at the tick into tension."""
-    n = states.shape[0]
+    """One control tick of formation b: measure (`measure`), answer, hold the speeds over the
+    control period (RK4), then check; the tension T_i = 2 l_i lambda_i [N] at the tick into
+    tension."""
     t = m.tick[b] * a.period_ns[b] * 1e-9
-    measured_states(m.state[b], n, states)
+    measure(a, m, b, states)
     answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
                      errors, rates)
     advance_formation(a, m, b, speeds, saturated, tension)
@@ -179,10 +192,10 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
 
 @jit
 def measure_all(a, m, states):
-    """Every formation's measured states (B, n, UAV_STATE_SIZE) at its current tick."""
-    n = a.uavs.shape[1]
+    """What every formation's controllers receive (B, n, UAV_STATE_SIZE) at its current tick
+    (`measure`)."""
     for b in range(m.state.shape[0]):
-        measured_states(m.state[b], n, states[b])
+        measure(a, m, b, states[b])
 
 
 @jit

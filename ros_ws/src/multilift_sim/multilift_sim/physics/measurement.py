@@ -43,15 +43,23 @@ def measured_states(x, n, out):
 def odometry_states(states, n, out):
     """Every UAV's odometry row into out (K, n, ODOMETRY_COLUMNS) for K formation states
     (K, 2 (6n + 3)) (FormationSimulator.snapshot: K = 1; the headless bag: a chunk's ticks):
-    its measured state (`measured_states`), then
+    its measured state (`measured_states`), then the rest (`odometry_rows`)."""
+    for k in range(states.shape[0]):
+        measured_states(states[k], n, out[k])
+    odometry_rows(out)
+
+
+@jit
+def odometry_rows(out):
+    """The ODOMETRY_* slots of every row of out (K, n, ODOMETRY_COLUMNS) from its MEASURED_*
+    slots (a state's, or the sensors' measurement of it, /uav{i}/measured_odom):
     - R = Rz(psi) Ry(theta) Rx(phi), body -> world (seed Eq. 2.6), row by row;
     - its velocity in the body frame R^T r_i_dot [m/s] (what nav_msgs/Odometry's twist holds),
       each element the sum (R_0j v_x + R_1j v_y) + R_2j v_z;
     - the unit quaternion (x, y, z, w) of R from the half angles."""
-    for k in range(states.shape[0]):
+    for k in range(out.shape[0]):
         rows = out[k]
-        measured_states(states[k], n, rows)
-        for i in range(n):
+        for i in range(rows.shape[0]):
             phi = rows[i, MEASURED_EULER]
             theta = rows[i, MEASURED_EULER + 1]
             psi = rows[i, MEASURED_EULER + 2]

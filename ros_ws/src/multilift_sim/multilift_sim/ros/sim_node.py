@@ -38,8 +38,8 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import (EVENTS, MARKER_DECIMATION, ODOM, parse_external, state_topics,
-                                   uav_topic)
+from multilift_sim.topics import (EVENTS, MARKER_DECIMATION, MEASURED_ODOM, ODOM,
+                                   parse_external, state_topics, uav_topic)
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
 from multilift_sim.tick_messages import SimulatorMessages
@@ -90,11 +90,16 @@ class SimNode(Node):
         # /formation/events only where the scenario has events (topics.run_topics)
         events = [self.create_publisher(FormationEvent, EVENTS, PUBLISHER_QOS)] \
             if scenario.events else []
+        # /uav{i}/measured_odom, what the controllers receive, where it has `sensors:`
+        self.measured_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, MEASURED_ODOM),
+                                                    PUBLISHER_QOS)
+                              for i in range(n)] if scenario.sensors is not None else []
         # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
             self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events,
+            *self.measured_pubs,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.commands: list[RotorCommand | None] = [None] * n
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
@@ -147,14 +152,14 @@ class SimNode(Node):
             return recorder_missing(self, [self.clock_pub, self.payload_pub, self.formation_pub,
                                            self.snapshot_pub, self.gust_pub, self.marker_pub,
                                            self.tf_pub,
-                                           *self.odom_pubs])
+                                           *self.odom_pubs, *self.measured_pubs])
         return None
 
     def _reads_state(self, command_topic: str) -> bool:
         """Whether a node publishing `command_topic` subscribes to one of the simulator's state
         topics. The graph lists a node's subscriptions once our participant discovered them,
         which is when our writers match them."""
-        wanted = set(state_topics(self.sim.n))
+        wanted = set(state_topics(self.sim.n, self.scenario.sensors is not None))
         for info in self.get_publishers_info_by_topic(command_topic):
             if not info.node_namespace.startswith('/'):
                 continue  # the writer is known, its node not yet (_NODE_NAMESPACE_UNKNOWN_)
@@ -170,7 +175,8 @@ class SimNode(Node):
     def _state_topics_text(self, index: int) -> str:
         """The state topics in words for UAV `index`: its own odometry first."""
         own = uav_topic(index, ODOM)
-        others = [t for t in state_topics(self.sim.n) if t != own]
+        others = [t for t in state_topics(self.sim.n, self.scenario.sensors is not None)
+                  if t != own]
         return ', '.join([own] + others)
 
     def publish_state(self) -> Snapshot:

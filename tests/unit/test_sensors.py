@@ -1,0 +1,208 @@
+"""Sensors (`sensors:`, issue 21 item 2; docs/sensors.md): the errors against their definition
+over many samples (white noise's deviation, the bias random walk's growing variance and
+independent steps, the dropout rate), the delivery (update rate, latency in ticks, dropouts held)
+against an oracle written here, one seed one series, validation, and the same measurement in the
+engine and the per-object (ROS) path, to the bit and byte for byte in bags."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from conftest import SCENARIOS
+from multilift_control.engine import Engine
+from multilift_control.headless import run_headless
+from multilift_sim import kernels
+from multilift_sim import scenario as scenario_io
+from multilift_sim.physics.layout import MEASURED_COLUMNS, SENSED_BLOCKS, SENSED_QUANTITIES
+from multilift_sim.physics.sensors import sensed_states
+from multilift_sim.sensors import sensor_errors
+from multilift_sim.simulation import FormationSimulator
+from multilift_sim.topics import scenario_topics
+from multilift_tools.headless_bag import _record_per_object, record_headless
+
+
+def _config(**keys) -> scenario_io.SensorConfig:
+    defaults = dict(noise=(0.0,) * 4, bias=(0.0,) * 4, rate=100.0, latency_ticks=0,
+                    dropout=0.0, seed=0)
+    return scenario_io.SensorConfig(**{**defaults, **keys})
+
+
+def _with_sensors(name: str, duration: float, sensors: dict) -> scenario_io.Scenario:
+    data = yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
+    data['simulation']['duration'] = duration
+    data['sensors'] = sensors
+    return scenario_io.loads(yaml.safe_dump(data))
+
+
+def test_white_noise_has_the_configured_deviation_per_quantity():
+    sigmas = (0.02, 0.05, 0.003, 0.01)
+    errors, delivered = sensor_errors(_config(noise=sigmas, seed=4), 3, 20_000, 100.0)
+    assert errors.shape == (20_001, 3, MEASURED_COLUMNS) and delivered.all()
+    for block, sigma in zip(SENSED_BLOCKS, sigmas):
+        values = errors[:, :, block:block + 3].ravel()  # 180,003 draws
+        # the sample deviation within 1 % (its own standard error is 0.17 %), the mean ~0
+        assert abs(values.std() / sigma - 1.0) < 0.01
+        assert abs(values.mean()) < 5 * sigma / math.sqrt(values.size)
+        # white: neighbouring samples uncorrelated
+        flat = errors[:, 0, block]
+        assert abs(np.corrcoef(flat[1:], flat[:-1])[0, 1]) < 0.03
+
+
+def test_the_bias_walks_as_a_wiener_process_of_its_intensity():
+    """Var b(t) = sigma_b^2 t, over 4000 independent UAVs sampled at 20 Hz, and its steps
+    independent of each other with variance sigma_b^2 dt."""
+    sigma_b, rate = 0.1, 20.0
+    errors, _ = sensor_errors(_config(bias=(sigma_b, 0.0, 0.0, 0.0), rate=rate, seed=9), 4000,
+                              400, 100.0)  # 400 ticks at 100 Hz: samples every 5 ticks, 81
+    assert errors.shape[0] == 81
+    bias = errors[:, :, 0]
+    assert np.array_equal(bias[0], np.zeros(4000))  # b_0 = 0
+    for s in (10, 40, 80):
+        t = s / rate
+        assert abs(bias[s].var() / (sigma_b ** 2 * t) - 1.0) < 0.07  # 4000 walks: 2.2 % s.e.
+    steps = np.diff(bias, axis=0)
+    assert abs(steps.var() / (sigma_b ** 2 / rate) - 1.0) < 0.01
+    assert abs(np.corrcoef(steps[1:].ravel(), steps[:-1].ravel())[0, 1]) < 0.01
+    assert np.array_equal(errors[:, :, 3:], np.zeros_like(errors[:, :, 3:]))  # velocity quiet
+
+
+def test_samples_drop_at_the_configured_rate_and_a_seed_is_one_series():
+    config = _config(noise=(0.01,) * 4, bias=(0.01,) * 4, dropout=0.2, seed=5)
+    errors, delivered = sensor_errors(config, 4, 50_000, 100.0)
+    lost = 1.0 - delivered.mean()
+    assert abs(lost - 0.2) < 4 * math.sqrt(0.2 * 0.8 / delivered.size)
+    again = sensor_errors(config, 4, 50_000, 100.0)
+    assert np.array_equal(errors, again[0]) and np.array_equal(delivered, again[1])
+    other = sensor_errors(_config(noise=(0.01,) * 4, bias=(0.01,) * 4, dropout=0.2, seed=6),
+                          4, 50_000, 100.0)
+    assert not np.array_equal(errors, other[0])
+
+
+def _oracle(exact: np.ndarray, errors: np.ndarray, delivered: np.ndarray, every: int,
+            latency: int) -> np.ndarray:
+    """What the controllers hold at each tick, from the definition: the last sample that has
+    arrived (taken at a tick j = s * every with j + latency <= k, and delivered; sample 0 at
+    once), with its error."""
+    ticks, n, _ = exact.shape
+    out = np.empty_like(exact)
+    for k in range(ticks):
+        for i in range(n):
+            arrived = [j for j in range(0, k - latency + 1, every)
+                       if delivered[j // every, i]]
+            j = max(arrived) if arrived else 0
+            out[k, i] = exact[j, i] + errors[j // every, i]
+    return out
+
+
+@pytest.mark.parametrize('every,latency', [(1, 0), (1, 3), (4, 0), (3, 5)])
+def test_delivery_follows_rate_latency_and_dropouts(every, latency):
+    """Both runs of sensed_states (compiled and its source) against the oracle above, tick by
+    tick, on exact states that change every tick; calling twice a tick changes nothing."""
+    rng = np.random.default_rng(1)
+    ticks, n = 60, 2
+    exact = rng.standard_normal((ticks, n, MEASURED_COLUMNS))
+    samples = (ticks - 1) // every + 1
+    errors = rng.standard_normal((samples, n, MEASURED_COLUMNS)) * 0.01
+    delivered = rng.random((samples, n)) > 0.3
+    delivered[0] = False  # the first sample arrives anyway
+    expected = _oracle(exact, errors, delivered, every, latency)
+    for function in (sensed_states, kernels.uncompiled(sensed_states)):
+        history = np.zeros((latency + 1, n, MEASURED_COLUMNS))
+        seen = np.full((n, MEASURED_COLUMNS), math.nan)
+        for k in range(ticks):
+            for _ in range(2):
+                states = exact[k].copy()
+                function(states, k, errors, delivered, every, latency, history, seen)
+                assert np.array_equal(states, expected[k]), (k, function)
+
+
+def test_the_controllers_see_the_state_latency_ticks_late():
+    """A step response through the simulator: with latency L and no noise, what the
+    controllers receive at tick k is the state at tick k - L exactly (the state at 0 before)."""
+    scenario = _with_sensors('twin_lift', 0.3, {'latency_ticks': 4})
+    simulator = FormationSimulator(scenario)
+    exact, received = [], []
+    speeds = [np.full(4, 1900.0), np.full(4, 1950.0)]
+    while not simulator.finished:
+        snap = simulator.snapshot()
+        exact.append(snap.odometry[:, :MEASURED_COLUMNS].copy())
+        received.append(snap.measured.copy())
+        simulator.advance(speeds, [np.zeros(4, bool)] * 2)
+    exact, received = np.array(exact), np.array(received)
+    assert np.array_equal(received[4:], exact[:-4])
+    assert np.array_equal(received[:4], np.repeat(exact[:1], 4, axis=0))
+    assert not np.array_equal(exact[4], exact[0])
+
+
+@pytest.mark.parametrize('sensors,message', [
+    ({'rate': 30.0}, r'sensors\.rate: 30\.0 must divide simulation\.control_rate \(100\)'),
+    ({'rate': 200.0}, r'sensors\.rate: 200\.0 must be > 0 and <= simulation\.control_rate'),
+    ({'dropout': 1.0}, r'sensors\.dropout: 1\.0 must be within \[0, 1\)'),
+    ({'latency_ticks': 1.5}, r'sensors\.latency_ticks: 1\.5 must be an integer >= 0'),
+    ({'seed': -1}, r'sensors\.seed: -1 must be an integer >= 0'),
+    ({'position_noise': -0.1}, r'sensors\.position_noise: -0\.1 must be >= 0'),
+    ({'gps_noise': 0.1}, r'sensors\.gps_noise: unknown key')])
+def test_bad_sensors_name_key_and_rule(sensors, message):
+    with pytest.raises(scenario_io.ScenarioError, match=message):
+        _with_sensors('twin_lift', 1.0, sensors)
+
+
+def test_every_quantity_has_its_keys_and_silent_sensors_change_nothing():
+    keys = {f'{q}_{kind}': 0.0 for q in SENSED_QUANTITIES for kind in ('noise', 'bias')}
+    quiet = _with_sensors('twin_lift', 1.0, dict(keys, seed=3))
+    assert quiet.sensors.noise == (0.0,) * 4 and quiet.sensors.every(100.0) == 1
+    plain = scenario_io.load('twin_lift').with_duration(1.0)
+    assert plain.sensors is None
+    a, b = Engine(quiet), Engine(plain)
+    a.step(100)
+    b.step(100)
+    assert np.array_equal(a.state, b.state)
+
+
+def test_the_engine_and_the_ros_path_receive_the_same_measurements():
+    scenario = _with_sensors('circle3', 2.0, {
+        'position_noise': 0.005, 'velocity_noise': 0.01, 'attitude_noise': 0.001,
+        'body_rate_noise': 0.003, 'position_bias': 0.01, 'rate': 50.0, 'latency_ticks': 3,
+        'dropout': 0.1, 'seed': 11})
+    engine = Engine(scenario)
+    record = engine.new_record(200)
+    engine.step(200, record)
+    received = []
+    run = run_headless(scenario, lambda sim, snap, answers: received.append(snap.measured))
+    assert np.array_equal(engine.state[0], run.simulator.state)
+    assert np.array_equal(record.measured[:, 0], np.array(received[:200]))
+    # what they received is not the state: the error is there, and about its size
+    exact = record.states[:, 0, :3]
+    error = record.measured[100:, 0, 0, :3] - exact[100:]
+    assert 0.002 < np.abs(error).mean() < 0.05
+    summary = run.summary()
+    del summary['sim']['wall_time']
+    assert engine.summary(0) == summary
+
+
+def test_bags_carry_the_state_and_what_the_controllers_received(tmp_path):
+    """The engine's headless bag is the per-object path's byte for byte; it has a
+    /uav{i}/measured_odom per UAV beside /uav{i}/odom, and the two differ."""
+    from rosbags.highlevel import AnyReader
+
+    scenario = _with_sensors('twin_lift', 1.0, {'position_noise': 0.01, 'seed': 2,
+                                                'latency_ticks': 1})
+    record_headless(scenario, tmp_path / 'engine' / 'bag')
+    _record_per_object(scenario, tmp_path / 'objects' / 'bag')
+    for path in (tmp_path / 'engine' / 'bag').iterdir():
+        assert path.read_bytes() == (tmp_path / 'objects' / 'bag' / path.name).read_bytes()
+    assert ('/uav2/measured_odom', 'nav_msgs/msg/Odometry') in scenario_topics(scenario)
+    with AnyReader([tmp_path / 'engine' / 'bag']) as reader:
+        topics = {c.topic: c.msgcount for c in reader.connections}
+        assert topics['/uav1/measured_odom'] == topics['/uav1/odom'] == 101
+        wanted = [c for c in reader.connections if c.topic in ('/uav1/odom',
+                                                               '/uav1/measured_odom')]
+        x = {'/uav1/odom': [], '/uav1/measured_odom': []}
+        for connection, _, raw in reader.messages(wanted):
+            x[connection.topic].append(
+                reader.deserialize(raw, connection.msgtype).pose.pose.position.x)
+    difference = np.array(x['/uav1/measured_odom'])[1:] - np.array(x['/uav1/odom'])[:-1]
+    assert 0.004 < difference.std() < 0.02  # one tick late, 0.01 m of noise

@@ -204,3 +204,23 @@ def test_hexa_rotor_failure_through_ros_is_the_headless_run(tmp_path):
     speeds = headless.rotor_speeds(1)
     after = headless.topic('/uav1/rotor_cmd').t >= 1.0
     assert (speeds[after, 0] == 0.0).all() and (speeds[~after, 0] > 1000.0).all()
+
+
+def test_sensors_fly_alike_through_ros_and_headless(tmp_path):
+    """`twin_lift_sensors` (docs/sensors.md) through the ROS nodes and headless: the controllers
+    receive the same measurements (the snapshot, every /uav{i}/measured_odom) and fly the same
+    states to rounding; the measurements are not the state; the summary records the seed."""
+    import json
+
+    ros_run, headless_run = _ros_and_headless(tmp_path, 'twin_lift_sensors', '2.0',
+                                              'seeds            sensors 1')
+    for i in (1, 2):
+        ros, headless = (run.topic(f'/uav{i}/measured_odom') for run in (ros_run, headless_run))
+        assert len(ros.t) == len(headless.t) == 201
+        assert np.abs(ros['position'] - headless['position']).max() < 1e-9
+        state = headless_run.topic(f'/uav{i}/odom')
+        error = headless['position'] - state['position']
+        assert 1e-3 < np.abs(error).max() < 0.1
+    for mode in ('ros', 'headless'):
+        summary = json.loads((tmp_path / mode / 'summary.json').read_text())
+        assert summary['sim']['seeds'] == {'sensors': 1}

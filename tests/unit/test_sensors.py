@@ -181,6 +181,7 @@ def test_the_engine_and_the_ros_path_receive_the_same_measurements():
     summary = run.summary()
     del summary['sim']['wall_time']
     assert engine.summary(0) == summary
+    assert summary['sim']['seeds'] == {'sensors': 11}  # the run's seed, recorded
 
 
 def test_bags_carry_the_state_and_what_the_controllers_received(tmp_path):
@@ -206,3 +207,17 @@ def test_bags_carry_the_state_and_what_the_controllers_received(tmp_path):
                 reader.deserialize(raw, connection.msgtype).pose.pose.position.x)
     difference = np.array(x['/uav1/measured_odom'])[1:] - np.array(x['/uav1/odom'])[:-1]
     assert 0.004 < difference.std() < 0.02  # one tick late, 0.01 m of noise
+
+
+def test_a_sweep_can_sample_a_sensor_key_the_scenario_does_not_have():
+    """`sweep --sample sensors.position_noise=...` on a scenario without `sensors:` (issue 21
+    item 6): the section is made, and the noise changes the run."""
+    from multilift_tools import campaign
+    source, base = campaign.load_base('twin_lift')
+    path = campaign.parse_key('sensors.position_noise', '--sample')
+    rows = [campaign.run_one(source, base, [('sensors.position_noise', path, noise)],
+                             duration=3.0) for noise in (0.0, 0.02)]
+    assert [row['status'] for row in rows] == ['ok', 'ok']
+    exact = campaign.run_one(source, base, [], duration=3.0)
+    assert rows[0]['tracking_error_rms'] == exact['tracking_error_rms']
+    assert rows[1]['tracking_error_rms'] != exact['tracking_error_rms']

@@ -24,7 +24,7 @@ from multilift_control.engine.arrays import engine_flies
 from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answer_tick,
                                        formation_runtimes, uav_states)
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot
+from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, run_seeds
 
 # on_tick(simulator, snapshot at t, every controller's answer to it: none at the last tick)
 TickObserver = Callable[[FormationSimulator, Snapshot, list[ControllerAnswer]], None]
@@ -43,7 +43,8 @@ class HeadlessRun:
         """The run's statistics as `run` reports them: {'sim': ..., 'leader': ...,
         'follower2': ...} (the same keys and definitions the nodes leave)."""
         sim = dict(self.simulator.stats.as_dict(), wall_time=self.wall_time, error=self.error,
-                   scenario=self.scenario.name, events=self.simulator.events_summary())
+                   scenario=self.scenario.name, events=self.simulator.events_summary(),
+                   seeds=run_seeds(self.scenario))
         return {'sim': sim, **{r.name: r.summary() for r in self.runtimes}}
 
 

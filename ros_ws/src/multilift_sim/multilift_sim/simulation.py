@@ -154,6 +154,17 @@ def sensor_arrays(scenario: Scenario) -> SensorArrays:
                         config.latency_ticks)
 
 
+def run_seeds(scenario: Scenario) -> dict[str, int]:
+    """The seeds a run's random draws come from, by what they draw (`sensors`, `turbulence`),
+    as its summary records them: none where it draws nothing."""
+    seeds = {}
+    if scenario.sensors is not None:
+        seeds['sensors'] = scenario.sensors.seed
+    if scenario.turbulence is not None:
+        seeds['turbulence'] = scenario.turbulence.seed
+    return seeds
+
+
 def event_records(rows: np.ndarray) -> list[dict]:
     """Event rows (physics.layout EVENT_*) as a run's summary lists them: each with its
     scheduled time [s], type, uav (from 1), rotor (from 1; 0: none), value and description

@@ -13,7 +13,7 @@ from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAIN
 from multilift_control.laws.layout import REFERENCE_SIZE, UAV_STATE_SIZE
 from multilift_sim.dynamics import StateLayout
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import event_records, stop_message
+from multilift_sim.simulation import event_records, run_seeds, stop_message
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
@@ -221,7 +221,7 @@ class Engine:
             sim['wall_time'] = wall_time
         happened = event_records(self.arrays.events[b, :self.memory.next_event[b]])
         out = {'sim': dict(sim, error=self.stop_reason(b), scenario=self.scenarios[b].name,
-                           events=happened),
+                           events=happened, seeds=run_seeds(self.scenarios[b])),
                'leader': leader.as_dict()}
         for i in range(1, self.n_uavs):
             follower = FormationErrorStatistics()

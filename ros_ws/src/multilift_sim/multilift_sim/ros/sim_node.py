@@ -41,7 +41,7 @@ from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import (EVENTS, MARKER_DECIMATION, MEASURED_ODOM, ODOM,
                                    parse_external, state_topics, uav_topic)
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
-                                      TickCables)
+                                      TickCables, run_seeds)
 from multilift_sim.tick_messages import SimulatorMessages
 
 
@@ -256,7 +256,8 @@ class SimNode(Node):
             self._progress(wall)
         stats = self.sim.stats.as_dict()
         stats.update(wall_time=wall, error=error, scenario=self.scenario.name,
-                     events=self.sim.events_summary())
+                     events=self.sim.events_summary(),
+                     seeds=run_seeds(self.scenario))
         write_summary(self.summary_dir, 'sim', stats)
 
 

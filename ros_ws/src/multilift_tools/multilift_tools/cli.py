@@ -122,6 +122,9 @@ def _summary(name: str, data: dict, bag: Path | None, scenario) -> None:
                          'place under the UAVs)')
         if scenario.gusts:
             lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} m/s')
+        if sim.get('seeds'):
+            lines.append('  seeds            ' + ', '.join(
+                f'{what} {seed}' for what, seed in sim['seeds'].items()))
         for event in sim.get('events', []):
             lines.append(f'  event at {event["time"]:g} s   {event["description"]}')
     leader = data.get('leader')

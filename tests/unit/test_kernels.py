@@ -152,7 +152,7 @@ def test_runnable_follows_the_kernel_variable(monkeypatch):
     ('GUST_', 'GUST_COLUMNS', {'GUST_CENTER': 2, 'GUST_DIRECTION': 3}),
     ('FORMATION_', 'FORMATION_SCALARS', {'FORMATION_WIND': 3}),
     ('ACTUATOR_', 'ACTUATOR_COLUMNS', {}),
-    ('EVENT_', 'EVENT_COLUMNS', {}),
+    ('EVENT_', 'EVENT_COLUMNS', {'EVENT_VELOCITY': 3}),
     ('CABLE_', 'CABLE_COLUMNS', {'CABLE_OFFSET': 3, 'CABLE_THRUST': 3}),
     ('WRENCH_', 'WRENCH_COLUMNS', {'WRENCH_TORQUE': 3}),
     ('WORK_', 'WORK_ROWS', {}),

@@ -115,7 +115,7 @@ def test_dryden_turbulence_flies_alike_in_both_paths_and_bags():
     import tempfile
     from pathlib import Path
 
-    from multilift_sim.simulation import turbulence_array
+    from multilift_sim.simulation import wind_series
     from multilift_tools.headless_bag import _record_per_object, record_headless
 
     def gusty(seed: int) -> scenario_io.Scenario:
@@ -127,7 +127,7 @@ def test_dryden_turbulence_flies_alike_in_both_paths_and_bags():
         data['vehicle']['drag_coefficient'] = 0.08
         return scenario_io.loads(yaml.safe_dump(data))
     scenario = gusty(1)
-    series = turbulence_array(scenario)
+    series = wind_series(scenario)
     assert series.shape == (301, 3) and series.std() > 0.1
     engine = Engine(scenario)
     engine.step(10 ** 6)
@@ -141,3 +141,55 @@ def test_dryden_turbulence_flies_alike_in_both_paths_and_bags():
         _record_per_object(scenario, Path(tmp) / 'objects' / 'bag')
         assert (Path(tmp) / 'engine' / 'bag' / 'bag_0.mcap').read_bytes() == \
             (Path(tmp) / 'objects' / 'bag' / 'bag_0.mcap').read_bytes()
+
+
+def test_a_gust_s_period_means_carry_its_whole_impulse():
+    """gust_profile_mean: 0 outside the gust, the 1-cosine's peak 1 at its middle, and over any
+    periods covering it the means sum to D / 2 per period (the profile's integral, in closed
+    form: the wind's impulse over the gust is exact however the periods cut it)."""
+    from multilift_sim.simulation import gust_profile_mean
+
+    period, onset, duration = 0.01, 1.234, 2.5
+    starts = np.arange(0, 500) * period
+    means = gust_profile_mean(starts, period, onset, duration)
+    assert np.abs(means.sum() * period - duration / 2).max() < 1e-12
+    assert means[:123].tolist() == [0.0] * 123 and means[374:].tolist() == [0.0] * 126
+    middle = int((onset + duration / 2) / period)
+    assert abs(means[middle] - 1.0) < 1e-3
+    # a coarse grid (periods longer than the gust) still carries all of it
+    coarse = gust_profile_mean(np.arange(0, 5) * 1.0, 1.0, onset, duration)
+    assert abs(coarse.sum() - duration / 2) < 1e-12
+
+
+def test_a_gust_event_blows_through_the_formation_alike_in_both_paths():
+    """`events: [{type: gust, ...}]`: nothing changes before its onset; the payload and the
+    UAVs (with drag) are pushed downwind; the engine and the per-object path to the bit; the
+    event is named in the summary; validation names a zero gust."""
+    def gusty(**gust) -> scenario_io.Scenario:
+        data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
+        data['simulation']['duration'] = 6.0
+        data['vehicle']['drag_coefficient'] = 0.08
+        data['events'] = [{'time': 2.0, 'type': 'gust', 'velocity': [0.0, 6.0, 0.0],
+                           'duration': 2.0, **gust}]
+        return scenario_io.loads(yaml.safe_dump(data))
+    scenario = gusty()
+    calm = dataclasses.replace(scenario, events=())
+    engine, still = Engine(scenario), Engine(calm)
+    record, still_record = engine.new_record(600), still.new_record(600)
+    engine.step(600, record)
+    still.step(600, still_record)
+    assert np.array_equal(record.states[:201], still_record.states[:201])
+    n = 2
+    drift = record.states[:, 0, :6 * n + 3] - still_record.states[:, 0, :6 * n + 3]
+    payload_y = drift[:, 6 * n + 1]
+    assert payload_y[400] > 0.05  # pushed along +y by the end of the gust
+    run = run_headless(scenario)
+    assert np.array_equal(engine.state[0], run.simulator.state)
+    events = run.summary()['sim']['events']
+    assert events == engine.summary(0)['sim']['events']
+    assert events[0]['type'] == 'gust' and events[0]['uav'] == 0
+    assert events[0]['description'] == 'gust of 6 m/s (0, 6, 0) for 2 s (1-cosine)'
+    with pytest.raises(scenario_io.ScenarioError, match='velocity.*must not be zero'):
+        gusty(velocity=[0.0, 0.0, 0.0])
+    with pytest.raises(scenario_io.ScenarioError, match='uav: unknown key'):
+        gusty(uav=1)

@@ -289,7 +289,7 @@ class FormationModel:
 
     def set_wind(self, velocity: np.ndarray) -> None:
         """The wind [m/s], world, the model integrates in from now on (the steady wind plus a
-        period's turbulence: simulation.turbulence_array)."""
+        period's unsteady wind: simulation.wind_series)."""
         self._formation[FORMATION_WIND:FORMATION_WIND + 3] = velocity
 
     # ------------------------------------------------------------------------- physics

@@ -11,8 +11,9 @@ from typing import Sequence
 
 import numpy as np
 
-from multilift_sim.physics.layout import (EVENT_KIND, EVENT_KINDS, EVENT_ROTOR, EVENT_TIME,
-                                          EVENT_UAV, EVENT_VALUE, KIND_CONTROLLER_SILENCE,
+from multilift_sim.physics.layout import (EVENT_DURATION, EVENT_KIND, EVENT_KINDS, EVENT_ROTOR,
+                                          EVENT_TIME, EVENT_UAV, EVENT_VALUE, EVENT_VELOCITY,
+                                          KIND_CONTROLLER_SILENCE, KIND_GUST,
                                           KIND_ROTOR_EFFECTIVENESS, MEASURED_BODY_RATES,
                                           MEASURED_EULER, MEASURED_POSITION, MEASURED_VELOCITY)
 
@@ -104,6 +105,11 @@ def formation_event(row: Sequence[float]) -> FormationEventValues:
         rotor, value = 0, float(row[EVENT_VALUE])
         text = (f'uav{uav} controller silent for {value:g} s (the simulator holds its last '
                 'command)')
+    elif kind == KIND_GUST:  # the formation's air: no UAV
+        uav, rotor, value = 0, 0, float(row[EVENT_VALUE])
+        velocity = ', '.join(f'{v:g}' for v in row[EVENT_VELOCITY:EVENT_VELOCITY + 3])
+        text = (f'gust of {value:.3g} m/s ({velocity}) for {float(row[EVENT_DURATION]):g} s '
+                '(1-cosine)')
     else:  # cable_release
         rotor, value = 0, 0.0
         text = f'uav{uav} releases its cable'

@@ -121,10 +121,12 @@ class EventConfig:
     after its time (physics.events)."""
     time: float                      # [s]
     type: str                        # one of physics.layout.EVENT_KINDS
-    uav: int                         # the UAV it concerns, from 1 (1 = the leader)
+    uav: int                         # the UAV it concerns, from 1 (1 = the leader); gust: 0
     rotor: int = 0                   # rotor_effectiveness: the rotor, from 1; else 0
     effectiveness: float = 1.0       # rotor_effectiveness: its share of thrust, in [0, 1]
-    duration: float = 0.0            # controller_silence: how long no command arrives [s]
+    duration: float = 0.0            # controller_silence: how long no command arrives [s];
+    #                                  gust: how long it blows [s]
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)  # gust: its peak [m/s], world
 
 
 @dataclass(frozen=True)
@@ -579,6 +581,14 @@ def _events(top: _Section, uavs: list[UavConfig], duration: float) -> tuple[Even
         time = e.number('time', ..., lambda v: 0 <= v < duration,
                         f'must be >= 0 and before the run\'s end ({duration:g} s)')
         kind = e.text('type', choices=EVENT_KINDS)
+        if kind == 'gust':  # the whole formation's air: no UAV
+            velocity = e.vector('velocity')
+            if not any(velocity):
+                raise e.fail('velocity', list(velocity), 'must not be zero')
+            events.append(EventConfig(time=time, type=kind, uav=0, velocity=velocity,
+                                      duration=e.positive('duration')))
+            e.done()
+            continue
         uav = e.raw('uav')
         if isinstance(uav, bool) or not isinstance(uav, int) or not 1 <= uav <= len(uavs):
             raise e.fail('uav', uav, f'must be a UAV from 1 to {len(uavs)}')

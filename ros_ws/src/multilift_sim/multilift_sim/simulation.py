@@ -16,7 +16,8 @@ from multilift_sim.formation_geometry import (hanging_payload, nominal_positions
                                               swing_about_uav_axis)
 from multilift_sim.formulations import make_formulation
 from multilift_sim.physics.events import apply_events, held_commands
-from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_END_TICK, EVENT_KIND,
+from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_DURATION, EVENT_END_TICK,
+                                          EVENT_KIND, EVENT_VELOCITY,
                                           EVENT_KINDS, EVENT_ROTOR, EVENT_TICK, EVENT_TIME,
                                           EVENT_UAV, EVENT_VALUE,
                                           MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
@@ -104,21 +105,49 @@ def event_array(scenario: Scenario) -> np.ndarray:
         if event.type == 'controller_silence':
             rows[k, EVENT_VALUE] = event.duration
             rows[k, EVENT_END_TICK] = math.ceil((event.time + event.duration) * rate - 1e-9)
+        elif event.type == 'gust':
+            rows[k, EVENT_VALUE] = math.sqrt(sum(v * v for v in event.velocity))
+            rows[k, EVENT_DURATION] = event.duration
+            rows[k, EVENT_VELOCITY:EVENT_VELOCITY + 3] = event.velocity
         else:
             rows[k, EVENT_VALUE] = event.effectiveness
     return rows
 
 
-def turbulence_array(scenario: Scenario) -> np.ndarray:
-    """The Dryden turbulence [m/s], world, at every control tick of the run, (ticks + 1, 3)
-    (`turbulence.dryden_series`; (0, 3) without `wind.turbulence`): tick k's is held over the
-    period from it, added to the steady wind."""
-    config = scenario.turbulence
-    if config is None:
-        return np.zeros((0, 3))
+def wind_series(scenario: Scenario) -> np.ndarray:
+    """The unsteady wind [m/s], world, of every control period of the run, (ticks + 1, 3), or
+    (0, 3) where the wind is steady: tick k's is held over the period from it, added to the
+    steady wind. The Dryden turbulence sampled at the tick (`turbulence.dryden_series`,
+    `wind.turbulence`) plus the gust events' 1-cosine profiles averaged over the period
+    (`gust_profile_mean`, docs/wind.md)."""
     sim = scenario.simulation
-    return dryden_series(sim.tick_count + 1, 1.0 / sim.control_rate, config.intensity,
-                         config.length_scale, config.airspeed, scenario.wind, config.seed)
+    gusts = [e for e in scenario.events if e.type == 'gust']
+    if scenario.turbulence is None and not gusts:
+        return np.zeros((0, 3))
+    series = np.zeros((sim.tick_count + 1, 3))
+    config = scenario.turbulence
+    if config is not None:
+        series += dryden_series(sim.tick_count + 1, 1.0 / sim.control_rate, config.intensity,
+                                config.length_scale, config.airspeed, scenario.wind,
+                                config.seed)
+    starts = np.arange(sim.tick_count + 1) / sim.control_rate
+    for gust in gusts:
+        series += np.outer(gust_profile_mean(starts, 1.0 / sim.control_rate, gust.time,
+                                             gust.duration), gust.velocity)
+    return series
+
+
+def gust_profile_mean(starts: np.ndarray, period: float, onset: float,
+                      duration: float) -> np.ndarray:
+    """The mean over each period [s, s + period] (starts (K,) [s]) of a 1-cosine gust's
+    profile p(t) = (1 - cos(2 pi (t - onset) / D)) / 2 for onset <= t <= onset + D, 0 outside
+    (the time form of seed Eq. 2.55's 1-cosine shape): its integral over the period's overlap
+    with the gust, in closed form, divided by the period."""
+    a = np.clip(starts, onset, onset + duration)
+    b = np.clip(starts + period, onset, onset + duration)
+    w = 2.0 * math.pi / duration
+    integral = 0.5 * (b - a) - (np.sin(w * (b - onset)) - np.sin(w * (a - onset))) / (2.0 * w)
+    return integral / period
 
 
 @dataclass(frozen=True)
@@ -246,8 +275,8 @@ class FormationSimulator:
         self.held = np.full((self.n, rotors), math.nan)
         self.held_saturated = np.zeros((self.n, rotors), dtype=bool)
         self._silences = any(e.type == 'controller_silence' for e in scenario.events)
-        # the wind of each period: the steady wind plus the turbulence of its tick
-        self._turbulence = turbulence_array(scenario)
+        # the wind of each period: the steady wind plus the unsteady wind of its tick
+        self._wind_series = wind_series(scenario)
         self._steady_wind = np.array(scenario.wind, dtype=float)
         self._set_wind()
         # what the controllers receive (physics.sensors): its arrays and memory
@@ -361,9 +390,9 @@ class FormationSimulator:
 
     def _set_wind(self) -> None:
         """The model's wind for the period from the current tick: the steady wind plus the
-        tick's turbulence (`turbulence_array`), as the engine's tick adds them."""
-        if len(self._turbulence):
-            self.model.set_wind(self._steady_wind + self._turbulence[self.tick])
+        tick's unsteady wind (`wind_series`), as the engine's tick adds them."""
+        if len(self._wind_series):
+            self.model.set_wind(self._steady_wind + self._wind_series[self.tick])
 
     def happened_rows(self) -> np.ndarray:
         """The rows (physics.layout EVENT_*) of the events the current tick is the first to

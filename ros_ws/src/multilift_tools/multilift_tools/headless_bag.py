@@ -145,9 +145,9 @@ class EngineBag:
                                  scenario.cable_model)
         model.taut[:] = memory.taut[0]  # released cables (events), slack ones
         model.effectiveness[:] = memory.effectiveness[0]
-        turbulence = engine.arrays.turbulence[0]
-        if len(turbulence):  # the wind at the last tick, as FormationSimulator holds it
-            model.set_wind(np.array(scenario.wind, dtype=float) + turbulence[tick])
+        unsteady = engine.arrays.wind_series[0]
+        if len(unsteady):  # the wind at the last tick, as FormationSimulator holds it
+            model.set_wind(np.array(scenario.wind, dtype=float) + unsteady[tick])
         held = list(self._held.reshape(n, -1)) if self._held is not None else None
         tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),

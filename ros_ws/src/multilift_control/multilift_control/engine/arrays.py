@@ -25,7 +25,7 @@ from multilift_sim.dynamics import FormationModel, actuator_array, constant_arra
 from multilift_sim.physics.layout import UAV_MASS
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (cable_reach, event_array, initial_state, sensor_arrays,
-                                      swing_sampling, turbulence_array)
+                                      swing_sampling, wind_series)
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
 
@@ -54,7 +54,7 @@ class FormationArrays(NamedTuple):
     cable_lengths: np.ndarray     # (B, n) [m]
     slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
     events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
-    turbulence: np.ndarray        # (B, ticks + 1 or 0, 3): the wind's turbulence by tick [m/s]
+    wind_series: np.ndarray       # (B, ticks + 1 or 0, 3): the unsteady wind by tick [m/s]
     # what the controllers receive (`sensors:`; simulation.SensorArrays, physics.sensors)
     sensor_errors: np.ndarray     # (B, S or 0, n, MEASURED_COLUMNS): each sample's error
     sensor_delivered: np.ndarray  # (B, S or 0, n) bool: whether the sample arrives
@@ -192,7 +192,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         actuators=actuator_array(params),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
         slack=scenario.cable_model == 'slack', events=event_array(scenario),
-        turbulence=turbulence_array(scenario),
+        wind_series=wind_series(scenario),
         sensor_errors=sensors.errors, sensor_delivered=sensors.delivered,
         sensor_every=sensors.every, sensor_latency=sensors.latency,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,

@@ -142,10 +142,10 @@ def advance_formation(a, m, b, speeds, saturated, tension):
                   m.held_saturated[b])
     run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
     formation = a.formation[b]
-    if a.turbulence.shape[1]:  # the steady wind plus this tick's turbulence, over the period
+    if a.wind_series.shape[1]:  # the steady wind plus the tick's unsteady wind, over the period
         formation = formation.copy()
         for j in range(3):
-            formation[FORMATION_WIND + j] += a.turbulence[b, m.tick[b], j]
+            formation[FORMATION_WIND + j] += a.wind_series[b, m.tick[b], j]
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
         a.uavs[b], a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],

@@ -53,18 +53,23 @@ ACTUATOR_COLUMNS = 2
 
 # -- an event of the scenario's `events:` (rows of (k, EVENT_COLUMNS) in time order;
 # physics.events) and the kinds it can be: the one registry, which scenario validation reads --
-EVENT_KINDS = ('rotor_effectiveness', 'cable_release', 'controller_silence')
+EVENT_KINDS = ('rotor_effectiveness', 'cable_release', 'controller_silence', 'gust')
 KIND_ROTOR_EFFECTIVENESS = 0    # a rotor's thrust and moment scale by EVENT_VALUE from then on
 KIND_CABLE_RELEASE = 1          # UAV EVENT_UAV's cable lets go of the payload for good
 KIND_CONTROLLER_SILENCE = 2     # UAV EVENT_UAV's commands do not arrive until EVENT_END_TICK
+KIND_GUST = 3                   # a 1-cosine gust of the whole formation's air (EVENT_UAV -1),
+#                                 in the run's wind series (multilift_sim.wind_series)
 EVENT_TICK = 0              # the control tick it happens at (the first at or after its time)
 EVENT_TIME = 1              # the time the scenario gives [s]
 EVENT_KIND = 2              # KIND_*: its index in EVENT_KINDS
 EVENT_UAV = 3               # the UAV it concerns, from 0
 EVENT_ROTOR = 4             # the rotor, from 0 (rotor_effectiveness; else 0)
-EVENT_VALUE = 5             # rotor_effectiveness: its new effectiveness; silence: seconds
+EVENT_VALUE = 5             # rotor_effectiveness: its new effectiveness; silence: seconds;
+#                             gust: its peak speed [m/s]
 EVENT_END_TICK = 6          # controller_silence: the first tick whose command arrives again
-EVENT_COLUMNS = 7
+EVENT_DURATION = 7          # gust: how long it blows [s]
+EVENT_VELOCITY = 8          # gust: its peak velocity [m/s], world (3)
+EVENT_COLUMNS = 11
 
 # -- a gust (seed Eq. 2.55; disturbances.Gust) ------------------------------------------------
 GUST_CENTER = 0             # (x, y) of its centre [m], world (2 slots)

@@ -193,3 +193,37 @@ def test_a_gust_event_blows_through_the_formation_alike_in_both_paths():
         gusty(velocity=[0.0, 0.0, 0.0])
     with pytest.raises(scenario_io.ScenarioError, match='uav: unknown key'):
         gusty(uav=1)
+
+
+def test_the_wind_is_on_a_topic_where_the_air_moves_everywhere(tmp_path):
+    """/formation/wind (geometry_msgs/Vector3Stamped) in a run with a steady wind and a gust
+    event: at every tick the steady wind plus the gust's mean over the period from it; the
+    engine's bag and the per-object path's alike to the byte; none in a still-air run."""
+    from rosbags.highlevel import AnyReader
+
+    from multilift_sim.simulation import gust_profile_mean
+    from multilift_sim.topics import WIND, scenario_topics
+    from multilift_tools.headless_bag import _record_per_object, record_headless
+
+    data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
+    data['simulation']['duration'] = 2.0
+    data['wind'] = {'velocity': [1.0, 0.0, 0.0]}
+    data['events'] = [{'time': 0.5, 'type': 'gust', 'velocity': [0.0, 3.0, 0.0],
+                       'duration': 1.0}]
+    scenario = scenario_io.loads(yaml.safe_dump(data))
+    assert scenario.has_wind and (WIND, 'geometry_msgs/msg/Vector3Stamped') in \
+        scenario_topics(scenario)
+    assert WIND not in dict(scenario_topics(scenario_io.load('twin_lift')))
+    record_headless(scenario, tmp_path / 'engine' / 'bag')
+    _record_per_object(scenario, tmp_path / 'objects' / 'bag')
+    assert (tmp_path / 'engine' / 'bag' / 'bag_0.mcap').read_bytes() == \
+        (tmp_path / 'objects' / 'bag' / 'bag_0.mcap').read_bytes()
+    with AnyReader([tmp_path / 'engine' / 'bag']) as reader:
+        wanted = [c for c in reader.connections if c.topic == WIND]
+        winds = np.array([[m.vector.x, m.vector.y, m.vector.z] for m in (
+            reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages(wanted))])
+    assert winds.shape == (201, 3)
+    expected_y = 3.0 * gust_profile_mean(np.arange(201) * 0.01, 0.01, 0.5, 1.0)
+    assert np.array_equal(winds[:, 0], np.ones(201)) and np.array_equal(winds[:, 2],
+                                                                        np.zeros(201))
+    assert np.abs(winds[:, 1] - expected_y).max() < 1e-12 and winds[:, 1].max() > 2.99

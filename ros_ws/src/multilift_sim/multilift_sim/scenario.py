@@ -179,6 +179,13 @@ class Scenario:
     def n_uavs(self) -> int:
         return len(self.uavs)
 
+    @property
+    def has_wind(self) -> bool:
+        """Whether the air moves everywhere (a steady wind, turbulence or a gust event:
+        /formation/wind carries it), beyond the seed's gusts at places."""
+        return (any(self.wind) or self.turbulence is not None
+                or any(e.type == 'gust' for e in self.events))
+
     def formation_params(self, baumgarte_alpha: float | None = None,
                          baumgarte_beta: float | None = None) -> FormationParams:
         """Physics parameters of the formation DAE (optionally other Baumgarte gains)."""

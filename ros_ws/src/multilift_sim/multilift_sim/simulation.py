@@ -392,7 +392,14 @@ class FormationSimulator:
         """The model's wind for the period from the current tick: the steady wind plus the
         tick's unsteady wind (`wind_series`), as the engine's tick adds them."""
         if len(self._wind_series):
-            self.model.set_wind(self._steady_wind + self._wind_series[self.tick])
+            self.model.set_wind(self.wind)
+
+    @property
+    def wind(self) -> np.ndarray:
+        """The air's velocity everywhere over the period from the current tick [m/s], world:
+        the steady wind plus the tick's unsteady wind (`wind_series`)."""
+        return self._steady_wind + (self._wind_series[self.tick] if len(self._wind_series)
+                                    else 0.0)
 
     def happened_rows(self) -> np.ndarray:
         """The rows (physics.layout EVENT_*) of the events the current tick is the first to

@@ -25,7 +25,8 @@ from multilift_sim.scenario import Scenario
 from multilift_sim.scene import FormationScene
 from multilift_sim.simulation import Snapshot
 from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE, MARKERS,
-                                  MEASURED_ODOM, PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, uav_topic)
+                                  MEASURED_ODOM, PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, WIND,
+                                  uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
 _ZERO = (0.0, 0.0, 0.0)
@@ -51,6 +52,7 @@ class SimulatorMessages:
                           for i in range(1, n + 1)] if scenario.sensors is not None else []
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
         self._gust = cdr.Vector3Stamped()
+        self._wind = cdr.Vector3Stamped() if scenario.has_wind else None  # /formation/wind
         self._tf = cdr.TFMessage([uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME])
         self._state = cdr.formation_state(n)
         self._scene = FormationScene(scenario)
@@ -58,13 +60,16 @@ class SimulatorMessages:
         self._event = cdr.FormationEvent()
 
     def state(self, snap: Snapshot, gust: Sequence[float],
-              applied: Sequence[np.ndarray] | None, last: bool = False) -> list[Message]:
+              applied: Sequence[np.ndarray] | None, last: bool = False,
+              wind: Sequence[float] | None = None) -> list[Message]:
         """The state at the tick of `snap`, in the order the node sends it: /clock, then
         /formation/snapshot (what the controllers wait for: what they receive of the state;
         `applied`: the rotor speeds held up to this tick, None at t = 0; none at the run's
         `last` tick, which no controller answers), then for users, tools and bags every
         /uav{i}/odom (the state), with `sensors:` every /uav{i}/measured_odom, /payload/odom,
-        /payload/gust (`gust`: the air velocity at the payload [m/s]) and /tf."""
+        /payload/gust (`gust`: the seed's gusts' air velocity at the payload [m/s]), where the
+        air moves everywhere /formation/wind (`wind` [m/s], world, over the period from the
+        tick), and /tf."""
         snapshot = None if last else formation_snapshot(snap, applied)
         uavs = snap.odometry[:, ODOMETRY_NUMBERS].tolist()
         measured = measured_odometry(snap.measured[None])[0].tolist() if self._measured \
@@ -73,18 +78,20 @@ class SimulatorMessages:
             snap.t_ns, None if snapshot is None else np.concatenate(snapshot).tolist(),
             None if snapshot is None else len(snapshot[-1]), uavs,
             snap.payload_position.tolist(), snap.payload_velocity.tolist(), vec3(gust),
-            measured)
+            measured, None if wind is None else vec3(wind))
 
     def state_of(self, t_ns: int, snapshot: list[float] | None, previous: int | None,
                  uavs: Sequence[Sequence[float]], payload_position: Sequence[float],
                  payload_velocity: Sequence[float], gust: Sequence[float],
-                 measured: Sequence[Sequence[float]] | None = None) -> list[Message]:
+                 measured: Sequence[Sequence[float]] | None = None,
+                 wind: Sequence[float] | None = None) -> list[Message]:
         """`state` from plain numbers (the one packing of both): `snapshot` the
         FormationSnapshot's numbers in a row (`cdr.FormationSnapshot.pack_row`; None at the
         last tick) with `previous` rotor speeds at its end, per UAV its odometry's 13 numbers
         (position, orientation (x, y, z, w), body-frame velocity, body rates: msgvalues
         .odometry) and (with `sensors:`) those of what its controllers receive, the payload's
-        position and velocity and the gust, world [m, m/s]."""
+        position and velocity, the gust and (where the air moves everywhere) the wind, world
+        [m, m/s]."""
         out = [(CLOCK, self._clock.pack(t_ns))]
         if snapshot is not None:
             out.append((FORMATION_SNAPSHOT, self._snapshot.pack_row(t_ns, snapshot, previous)))
@@ -96,6 +103,8 @@ class SimulatorMessages:
         out.append((PAYLOAD_ODOM, self._payload.pack(t_ns, payload_position, IDENTITY,
                                                      payload_velocity, _ZERO)))
         out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *gust)))
+        if self._wind is not None:
+            out.append((WIND, self._wind.pack(t_ns, *wind)))
         out.append((TF, self._tf.pack(t_ns, [u[:3] for u in uavs] + [payload_position],
                                       [u[3:7] for u in uavs] + [IDENTITY])))
         return out

@@ -32,6 +32,7 @@ MARKERS = '/visualization/markers'      # the formation drawn for RViz / Foxglov
 MARKER_DECIMATION = 10                  # MARKERS every this many control ticks
 TF = '/tf'                              # world -> uav{i}/base_link, world -> payload
 EVENTS = '/formation/events'            # the scenario's events as they happen
+WIND = '/formation/wind'                # the air's velocity everywhere [m/s], world
 
 # leaves of the per-UAV topics /uav{i}/{leaf}
 ODOM = 'odom'                           # UAV i's state (every UAV)
@@ -50,6 +51,8 @@ RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              MARKERS: MARKER_ARRAY_TYPE, TF: TF_TYPE}
 # the topic of a run whose scenario has `events:` (run_topics(events=True))
 EVENT_TYPES = {EVENTS: FORMATION_EVENT_TYPE}
+# the topic of a run whose air moves everywhere (run_topics(wind=True), Scenario.has_wind)
+WIND_TYPES = {WIND: VECTOR3_STAMPED_TYPE}
 
 _UAV_TOPIC = re.compile(r'^/uav([1-9][0-9]*)/(' + '|'.join(UAV_TYPES) + r')$')
 
@@ -81,20 +84,21 @@ def parse_uav_topic(topic: str) -> tuple[int, str] | None:
 
 def topic_type(topic: str) -> str | None:
     """The type a multilift topic has (`pkg/msg/Type`), or None for a name not of a run."""
-    if topic in RUN_TYPES or topic in EVENT_TYPES:
-        return {**RUN_TYPES, **EVENT_TYPES}[topic]
+    if topic in RUN_TYPES or topic in EVENT_TYPES or topic in WIND_TYPES:
+        return {**RUN_TYPES, **EVENT_TYPES, **WIND_TYPES}[topic]
     parsed = parse_uav_topic(topic)
     return UAV_TYPES[parsed[1]] if parsed else None
 
 
 def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
-               sensors: bool = False) -> list[tuple[str, str]]:
+               sensors: bool = False, wind: bool = False) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
     which has no reference, set-points or formation errors); with `events` (a scenario with
     `events:`), /formation/events; with `sensors` (a scenario with `sensors:`), every
-    /uav{i}/measured_odom."""
-    topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else [])
+    /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind."""
+    topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
+        list(WIND_TYPES.items()) if wind else [])
     if controllers:
         topics.append((REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE))
     for i in range(1, n_uavs + 1):
@@ -110,9 +114,9 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
 
 def scenario_topics(scenario, controllers: bool = True) -> list[tuple[str, str]]:
     """`run_topics` of a scenario (multilift_sim.scenario.Scenario): its n, and the topics its
-    `events:` and `sensors:` add."""
+    `events:`, `sensors:` and wind add."""
     return run_topics(scenario.n_uavs, controllers, bool(scenario.events),
-                      scenario.sensors is not None)
+                      scenario.sensors is not None, scenario.has_wind)
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

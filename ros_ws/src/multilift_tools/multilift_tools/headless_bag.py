@@ -70,6 +70,13 @@ class EngineBag:
         self._reference = int(arrays.leader_mode[0]) == MODE_CASCADE
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
+        # /formation/wind by tick: the steady wind plus the unsteady wind series (or none)
+        self._wind = None
+        if scenario.has_wind:
+            steady = np.array(scenario.wind, dtype=float)
+            unsteady = arrays.wind_series[0]
+            self._wind = (steady + unsteady if len(unsteady)
+                          else np.tile(steady, (int(arrays.tick_count[0]) + 1, 1)))
 
     def ticks(self, first: int, record: TickRecord, count: int) -> None:
         """Write ticks first .. first + count - 1 of formation 0 from `record`'s rows."""
@@ -80,6 +87,8 @@ class EngineBag:
         received = record.measured[:count, 0]  # what the controllers received
         snapshots, odometry = state_rows(states, n, received)
         measured = measured_odometry(received).tolist() if self._sensors \
+            else [None] * count
+        winds = self._wind[first:first + count].tolist() if self._wind is not None \
             else [None] * count
         speeds = record.speeds[:count, 0]
         flat = speeds.reshape(count, -1)
@@ -110,7 +119,8 @@ class EngineBag:
             t_ns = tick * period
             messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
                                           odometry[k], payload_position[k],
-                                          payload_velocity[k], gusts[k], measured[k])
+                                          payload_velocity[k], gusts[k], measured[k],
+                                          winds[k])
             messages += self._events_at(tick, t_ns)
             for i in range(n):
                 if not self._controllers:
@@ -138,7 +148,9 @@ class EngineBag:
             else None
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
                                              state[12 * n + 3:12 * n + 6].tolist(),
-                                             memory.gust[0].tolist(), measured)
+                                             memory.gust[0].tolist(), measured,
+                                             None if self._wind is None
+                                             else self._wind[tick].tolist())
                     + self._events_at(tick, t_ns), t_ns)
         scenario = self._scenario
         model = make_formulation(scenario.simulation.integrator, scenario.formation_params(),
@@ -194,7 +206,7 @@ class HeadlessBag:
         tick, whose cables are those of the commands held since the tick before)."""
         self.finish_pending(sim)
         messages = self._simulator.state(snap, sim.payload_gust, self._applied,
-                                         last=sim.finished)
+                                         last=sim.finished, wind=sim.wind)
         messages += self._simulator.events(snap.t_ns, sim.happened_rows())
         if answers:
             self._applied = [a.output.rotor_speeds for a in answers]

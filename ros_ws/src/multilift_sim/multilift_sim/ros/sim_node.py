@@ -38,7 +38,7 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import (EVENTS, MARKER_DECIMATION, MEASURED_ODOM, ODOM,
+from multilift_sim.topics import (EVENTS, MARKER_DECIMATION, MEASURED_ODOM, ODOM, WIND,
                                    parse_external, state_topics, uav_topic)
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables, run_seeds)
@@ -90,6 +90,9 @@ class SimNode(Node):
         # /formation/events only where the scenario has events (topics.run_topics)
         events = [self.create_publisher(FormationEvent, EVENTS, PUBLISHER_QOS)] \
             if scenario.events else []
+        # /formation/wind where the air moves everywhere
+        winds = [self.create_publisher(Vector3Stamped, WIND, PUBLISHER_QOS)] \
+            if scenario.has_wind else []
         # /uav{i}/measured_odom, what the controllers receive, where it has `sensors:`
         self.measured_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, MEASURED_ODOM),
                                                     PUBLISHER_QOS)
@@ -98,7 +101,7 @@ class SimNode(Node):
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
-            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events,
+            self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events, *winds,
             *self.measured_pubs,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.commands: list[RotorCommand | None] = [None] * n
@@ -185,7 +188,7 @@ class SimNode(Node):
         the snapshot."""
         snap = self.sim.snapshot()
         self.outputs.send(self.packer.state(snap, self.sim.payload_gust, self.applied,
-                                            last=self.sim.finished))
+                                            last=self.sim.finished, wind=self.sim.wind))
         if self.sim.happened:  # the scenario's events this state is the first to show
             self.outputs.send(self.packer.events(snap.t_ns, self.sim.happened_rows()))
         return snap

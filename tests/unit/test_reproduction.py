@@ -14,8 +14,9 @@ import re
 import pytest
 
 from conftest import ROOT
-from multilift_tools.reproduce import (SEED_EIGENVALUE, SEED_PERIOD, SEED_RELEASE, TABLE_HEAD,
-                                         render_row, render_table, single_lift_table)
+from multilift_tools.report.seed import SEED_EIGENVALUE, SEED_PERIOD, SEED_RELEASE
+from multilift_tools.report.single_lift import (TABLE_HEAD, render_row, render_table,
+                                                single_lift_table)
 
 REPORT = ROOT / 'docs' / 'reproduction.md'
 SINGLE_LIFT_HEADING = '### Single-lift (§2.8.1, §4.1): `reproduce.single_lift_table()`'

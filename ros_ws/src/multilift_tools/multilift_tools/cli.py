@@ -366,7 +366,7 @@ DELEGATED = {
               'each'),
     'plot-sweep': ('multilift_tools.plot_sweep', 'plot_sweep_main',
                    'figures and the worst runs of a sweep table'),
-    'reproduce': ('multilift_tools.reproduce', 'reproduce_main',
+    'reproduce': ('multilift_tools.report.command', 'reproduce_main',
                   "the seed's §2.8 and Ch. 4 results, figures and docs/reproduction.md"),
 }
 

@@ -1,5 +1,5 @@
 """The one renderer of docs/reproduction.md: `templates/reproduction.md` (markdown with
-`str.format` placeholders) filled from a reproduce_report.Report of typed measurements.
+`str.format` placeholders) filled from a numbers.Report of typed measurements.
 
 The template reads the measurements' fields with their units' formats (`{tl.max_g:.1e}` is the
 twin-lift's max |g| [m²]) and the scenarios' own facts (`{sc_twin.simulation.physics_rate:g}`);
@@ -21,12 +21,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from multilift_tools.reproduce import (MULTI, SEED_EIGENVALUE, SEED_PERIOD, SEED_RELEASE,
-                                         SMALL_RELEASE_DEG, SWING, TWIN, render_table,
-                                         vector_text)
+from multilift_tools.report.seed import (MULTI, SEED_EIGENVALUE, SEED_PERIOD, SEED_RELEASE,
+                                           SWING, TWIN)
+from multilift_tools.report.single_lift import SMALL_RELEASE_DEG, render_table, vector_text
 
 if TYPE_CHECKING:
-    from multilift_tools.reproduce_report import Report
+    from multilift_tools.report.numbers import Report
 
 TEMPLATE = Path(__file__).parent / 'templates' / 'reproduction.md'
 _WORDS = ('no', 'one', 'two', 'three', 'four', 'five', 'six', 'seven', 'eight', 'nine', 'ten',
@@ -61,7 +61,8 @@ def _figure_head(number: str, caption: str, file: str) -> str:
 def _texts(r: Report, fx: SimpleNamespace) -> SimpleNamespace:
     """What the template needs beyond a field and a format (see the module docstring)."""
     from multilift_sim.frames import world_to_seed_vector
-    from multilift_tools.reproduce_report import CASES, STEADY, CRUISE
+    from multilift_tools.report.cases import CASES
+    from multilift_tools.report.measure import STEADY, CRUISE
 
     s, tl, ml, sw = r.single, r.twin, r.multi, r.swing
     swing_sc, twin_sc, multi_sc = r.setup.swing, r.setup.twin, r.setup.multi
@@ -171,8 +172,9 @@ def _texts(r: Report, fx: SimpleNamespace) -> SimpleNamespace:
 
 def render_report(r: Report, template: str | None = None) -> str:
     """docs/reproduction.md as text: TEMPLATE (or `template`) filled from `r`."""
-    from multilift_tools.reproduce_report import (AFTER_GUST, AFTER_SWITCH, CLIMB_START,
-                                                    HOVER_TAIL, LATE, SEED_CAPTIONS)
+    from multilift_tools.report.measure import (AFTER_GUST, AFTER_SWITCH, CLIMB_START,
+                                                HOVER_TAIL, LATE)
+    from multilift_tools.report.seed import SEED_CAPTIONS
     fx = SimpleNamespace(
         swing=SWING, twin=TWIN, multi=MULTI, cmd_swing=_cmd_run(SWING), cmd_twin=_cmd_run(TWIN),
         cmd_multi=_cmd_run(MULTI),

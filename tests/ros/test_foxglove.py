@@ -29,7 +29,9 @@ from rclpy.serialization import deserialize_message
 from websockets.sync.client import connect
 
 from multilift_sim import msgdefs
-from multilift_tools.foxglove_bridge import SUBPROTOCOL, is_bridged, stamp_ns
+from multilift_tools.foxglove.bridge import is_bridged
+from multilift_tools.foxglove.server import SUBPROTOCOL
+from multilift_tools.foxglove.stamps import stamp_ns
 
 from conftest import ROOT, next_domain
 DOMAIN = next_domain()
@@ -43,9 +45,9 @@ TIMEOUT = 30.0  # [s] discovery, advertisement and first messages, on a loaded m
 
 def bridge_command(*args: str) -> list[str]:
     cli = (ROOT / 'ros_ws' / 'src' / 'multilift_tools' / 'multilift_tools' / 'cli.py').read_text()
-    if 'foxglove_bridge' in cli:
+    if 'foxglove.command' in cli:
         return [str(ROOT / 'scripts' / 'multilift'), 'foxglove', *args]
-    return [sys.executable, '-c', 'import sys; from multilift_tools.foxglove_bridge import '
+    return [sys.executable, '-c', 'import sys; from multilift_tools.foxglove.command import '
             'foxglove_main; sys.exit(foxglove_main(sys.argv[1:]))', *args]
 
 
@@ -257,7 +259,7 @@ def _check_layout(layout: dict, scenario) -> set[str]:
 
 def test_the_shipped_layout_is_the_twin_lift_layout():
     from multilift_sim import scenario as scenario_io
-    from multilift_tools.foxglove_layout import layout
+    from multilift_tools.foxglove.layout import layout
     twin = scenario_io.load('twin_lift')
     shipped = json.loads((ROOT / 'docs' / 'foxglove_layout.json').read_text())
     assert shipped == json.loads(json.dumps(layout(twin)))

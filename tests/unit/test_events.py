@@ -167,7 +167,7 @@ def test_a_headless_bag_carries_the_events_to_plots_and_layout(tmp_path, monkeyp
     from multilift_tools import figures
     from multilift_tools.bagdata import load_run
     from multilift_tools.figures import FIGURES, make_plots
-    from multilift_tools.foxglove_layout import layout
+    from multilift_tools.foxglove.layout import layout
     from multilift_tools.headless_bag import record_headless
     from multilift_tools.plot_style import EVENT_COLOR, Context, plt
     scenario = _with_events('twin_lift', 2.5, [

@@ -359,7 +359,7 @@ DELEGATED = {
     'study': ('multilift_tools.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
     'bag': ('multilift_tools.bag_tools', 'bag_main',
             'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),
-    'foxglove': ('multilift_tools.foxglove_bridge', 'foxglove_main',
+    'foxglove': ('multilift_tools.foxglove.command', 'foxglove_main',
                  'serve the live graph to Foxglove over WebSocket (ws://localhost:8765)'),
     'sweep': ('multilift_tools.sweep', 'sweep_main',
               'a campaign of headless runs (grid and sampled) on a Dask cluster, a table row '

@@ -293,7 +293,8 @@ def _bag_state(bag: Path, recorder: Child) -> str:
     received after its last flush, `flush_period` 1 s at most, is lost)."""
     if (bag / 'metadata.yaml').is_file():
         return f'bag closed at {bag}'
-    from multilift_tools.bag_tools import BagToolError, reindex
+    from multilift_tools.bags.reindex import reindex
+    from multilift_tools.bags.summary import BagToolError
     print(f'warning: {recorder.name} ended ({recorder.exit_text()}) without closing the bag '
           f'(its log: {recorder.log_path})', file=sys.stderr)
     try:
@@ -357,7 +358,7 @@ DELEGATED = {
     'modal': ('multilift_tools.modal_cli', 'modal_main',
               'eigenvalues and pendulum periods at the static equilibrium (seed §2.8)'),
     'study': ('multilift_tools.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
-    'bag': ('multilift_tools.bag_tools', 'bag_main',
+    'bag': ('multilift_tools.bags.command', 'bag_main',
             'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),
     'foxglove': ('multilift_tools.foxglove.command', 'foxglove_main',
                  'serve the live graph to Foxglove over WebSocket (ws://localhost:8765)'),

@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 from multilift_tools import campaign as cp
-from multilift_tools import sweep
+from multilift_tools.campaign import sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 BEGIN = '<!-- sweep_throughput: begin -->'

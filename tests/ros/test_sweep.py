@@ -29,8 +29,8 @@ from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
 from multilift_sim.statistics import summary_row
 from multilift_tools import campaign as cp
-from multilift_tools.plot_sweep import plot_sweep_main
-from multilift_tools.sweep import sweep_main
+from multilift_tools.campaign.plot_sweep import plot_sweep_main
+from multilift_tools.campaign.sweep import sweep_main
 
 PYTHON = str(ROOT / '.venv' / 'bin' / 'python')
 DASK = str(ROOT / '.venv' / 'bin' / 'dask')

@@ -362,10 +362,10 @@ DELEGATED = {
             'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),
     'foxglove': ('multilift_tools.foxglove.command', 'foxglove_main',
                  'serve the live graph to Foxglove over WebSocket (ws://localhost:8765)'),
-    'sweep': ('multilift_tools.sweep', 'sweep_main',
+    'sweep': ('multilift_tools.campaign.sweep', 'sweep_main',
               'a campaign of headless runs (grid and sampled) on a Dask cluster, a table row '
               'each'),
-    'plot-sweep': ('multilift_tools.plot_sweep', 'plot_sweep_main',
+    'plot-sweep': ('multilift_tools.campaign.plot_sweep', 'plot_sweep_main',
                    'figures and the worst runs of a sweep table'),
     'reproduce': ('multilift_tools.report.command', 'reproduce_main',
                   "the seed's §2.8 and Ch. 4 results, figures and docs/reproduction.md"),

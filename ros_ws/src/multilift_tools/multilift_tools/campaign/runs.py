@@ -1,0 +1,149 @@
+"""The runs of a campaign, flown headless: one run (`run_one`, what a Dask worker unpickles: a
+top-level function with plain arguments) or a task's runs as engine batches (`run_chunk`), each
+a result {status, message, STATISTICS..., wall_time, bag} and never raising for the run's own
+faults.
+"""
+from __future__ import annotations
+
+import math
+import shutil
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from multilift_sim import scenario as scenario_io
+from multilift_sim.statistics import summary_row
+from multilift_tools.campaign.spec import SweepError, _label, edited
+
+# run statistics, in table order (`run_statistics_row`; units in the docstring of sweep)
+STATISTICS = tuple(summary_row({}))
+STATUSES = ('ok', 'stopped', 'error')
+
+
+def run_statistics_row(scenario, bag: Path | None = None) -> tuple[dict[str, Any], str]:
+    """Fly `scenario` headless (recording to `bag` when given): (its statistics, keyed as
+    STATISTICS, None where a figure does not apply; why it stopped, '' when it reached t_max).
+    Other exceptions propagate. The one place a row's statistics come from: the run's summary
+    through `multilift_sim.statistics.summary_row`, what `run` reports."""
+    from multilift_control.headless import fly
+
+    if bag is None:
+        run = fly(scenario, raise_on_stop=False)
+    else:
+        from multilift_tools.headless_bag import record_headless
+        run = record_headless(scenario, bag, raise_on_stop=False)
+    return _statistics(run.summary()), run.error or ''
+
+
+def _statistics(summary: dict) -> dict[str, Any]:
+    return {k: _plain(v) for k, v in summary_row(summary).items()}
+
+
+def _plain(value: Any) -> Any:
+    """numpy scalars as Python numbers (the table's types), non-finite as None."""
+    if isinstance(value, (np.floating, float)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _scenario(source: str, base: dict, edits: list, duration: float | None):
+    """The run's scenario: the base with its edits (checked by the loader) and duration."""
+    data = edited(base, [tuple(e) for e in edits])
+    scenario = scenario_io.loads(yaml.safe_dump(data, sort_keys=False), _label(source, edits))
+    return scenario if duration is None else scenario.with_duration(duration)
+
+
+def _result(stats: dict | None = None, stopped: str = '', error: BaseException | None = None,
+            wall_time: float | None = None, bag: str | None = None) -> dict[str, Any]:
+    """A run's result {status, message, STATISTICS..., wall_time, bag}."""
+    out: dict[str, Any] = {'status': 'ok', 'message': '', **dict.fromkeys(STATISTICS)}
+    if stats is not None:
+        out.update(stats)
+    if stopped:
+        out.update(status='stopped', message=stopped)
+    if error is not None:
+        out.update(status='error', message=error_message(error))
+    out['message'] = out['message'].replace('\n', ' ')
+    out['wall_time'] = None if wall_time is None else round(wall_time, 3)
+    out['bag'] = bag
+    return out
+
+
+def run_one(source: str, base: dict, edits: list, duration: float | None = None,
+            bag: str | None = None) -> dict[str, Any]:
+    """One run, never raising for the run's own faults: {status, message, STATISTICS...,
+    wall_time, bag}. `edits` are (key, path, value) for `apply_edit`; the drawn values are
+    checked here (a rejected value is status `error` with the loader's line). A top-level
+    function with plain arguments: what a Dask worker unpickles."""
+    start = time.perf_counter()
+    try:
+        scenario = _scenario(source, base, edits, duration)
+        bag_path = None
+        if bag is not None:
+            bag_path = Path(bag)
+            if bag_path.exists():  # a partial bag of this run from a worker that died
+                shutil.rmtree(bag_path)
+            bag_path.parent.mkdir(parents=True, exist_ok=True)
+        stats, stopped = run_statistics_row(scenario, bag_path)
+    except Exception as exc:  # noqa: BLE001 - one run's crash is that row's error
+        return _result(error=exc, wall_time=time.perf_counter() - start, bag=bag)
+    return _result(stats, stopped, wall_time=time.perf_counter() - start, bag=bag)
+
+
+def run_chunk(source: str, base: dict, runs: list[tuple[list, str | None]],
+              duration: float | None = None) -> list[dict[str, Any]]:
+    """Several runs in one task, each result as `run_one`'s (in `runs` order): the runs
+    without a bag flown together, one engine batch per shape of formation
+    (`multilift_control.headless.fly_batch`: a batch gives each formation the numbers it gets
+    alone), a run's wall time its share of its batch's; runs with a bag, and what the engine
+    does not fly (`engine.arrays.not_flown`), one by one. `runs`:
+    (edits, bag or None) each. A batch that raises is flown again run by run, so a fault is
+    the row of the run that has it."""
+    from multilift_control.engine.arrays import engine_flies, shape_groups
+    from multilift_control.headless import fly_batch
+
+    results: list[dict[str, Any] | None] = [None] * len(runs)
+    flights = []  # (position in runs, scenario)
+    for k, (edits, bag) in enumerate(runs):
+        if bag is not None:
+            results[k] = run_one(source, base, edits, duration, bag)
+            continue
+        start = time.perf_counter()
+        try:
+            scenario = _scenario(source, base, edits, duration)
+        except Exception as exc:  # noqa: BLE001 - a rejected value is that row's error
+            results[k] = _result(error=exc, wall_time=time.perf_counter() - start)
+            continue
+        if engine_flies(scenario):
+            flights.append((k, scenario))
+        else:  # another integrator: tick by tick
+            results[k] = run_one(source, base, edits, duration)
+    for group in shape_groups([scenario for _, scenario in flights]):
+        members = [flights[i] for i in group]
+        start = time.perf_counter()
+        try:
+            flown = fly_batch([scenario for _, scenario in members])
+        except Exception:  # noqa: BLE001 - find the run at fault: one by one
+            for k, _ in members:
+                results[k] = run_one(source, base, runs[k][0], duration)
+            continue
+        share = (time.perf_counter() - start) / len(members)
+        for (k, _), run in zip(members, flown):
+            results[k] = _result(_statistics(run.summary()), run.error or '', wall_time=share)
+    return results
+
+
+def error_message(exc: BaseException) -> str:
+    """One line: the exception's type and text, and where it was raised (file:line)."""
+    where = ''
+    tb = traceback.extract_tb(exc.__traceback__) if exc.__traceback__ else []
+    if tb and not isinstance(exc, (scenario_io.ScenarioError, SweepError)):
+        frame = tb[-1]
+        where = f' (at {Path(frame.filename).name}:{frame.lineno})'
+    return f'{type(exc).__name__}: {exc}{where}'.replace('\n', ' ')

@@ -26,7 +26,8 @@ from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.fastdds import LIVE_VIEW_ANNOUNCEMENT, use_fastdds_profile
 from multilift_sim.ros.shared_memory import remove_before_start
 from multilift_tools.launcher import Child, Supervisor, find_executable
-from multilift_sim.topics import parse_external, scenario_topics
+from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_ERROR, REFERENCE, ROTOR_CMD,
+                                   parse_external, scenario_topics)
 
 
 def _ros_args(params: dict) -> list[str]:
@@ -204,7 +205,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         # every topic of the graph, with the QoS their publishers offer); the simulator waits
         # for the recorder to hear its rotor commands before t = 0
         ours = {f'/uav{i}/{leaf}' for i in external
-                for leaf in ('rotor_cmd', 'reference', 'attitude_setpoint', 'formation_error')}
+                for leaf in (ROTOR_CMD, REFERENCE, ATTITUDE_SETPOINT, FORMATION_ERROR)}
         topics = [f'{name}|{kind}' for name, kind in
                   scenario_topics(scenario) if name not in ours]
         recorder = Child('recorder_node', [str(recorder_exe), *_ros_args(

@@ -26,7 +26,7 @@ from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
                                       RawPublishers, controller_peers_missing, ns_from_stamp,
                                       run_nodes)
-from multilift_sim.topics import uav_topic
+from multilift_sim.topics import ATTITUDE_SETPOINT, FORMATION_ERROR, ROTOR_CMD, uav_topic
 
 
 class FollowerNode(Node):
@@ -53,15 +53,15 @@ class FollowerNode(Node):
         self.read_snapshot = SnapshotReader(scenario)
         self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
                                  SUBSCRIBER_QOS, raw=True)
-        self.create_subscription(RotorCommand, uav_topic(1, 'rotor_cmd'), self.on_leader,
+        self.create_subscription(RotorCommand, uav_topic(1, ROTOR_CMD), self.on_leader,
                                  SUBSCRIBER_QOS)
         i = self.index
-        self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(i, 'rotor_cmd'),
+        self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(i, ROTOR_CMD),
                                              PUBLISHER_QOS)
         self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
-                                                  uav_topic(i, 'attitude_setpoint'), PUBLISHER_QOS)
+                                                  uav_topic(i, ATTITUDE_SETPOINT), PUBLISHER_QOS)
         self.error_pub = self.create_publisher(VirtualConstraintError,
-                                               uav_topic(i, 'formation_error'), PUBLISHER_QOS)
+                                               uav_topic(i, FORMATION_ERROR), PUBLISHER_QOS)
         self.outputs = RawPublishers(self.cmd_pub, self.setpoint_pub, self.error_pub,
                                      confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
 

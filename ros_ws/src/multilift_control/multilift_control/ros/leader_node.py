@@ -20,7 +20,7 @@ from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
                                       RawPublishers, controller_peers_missing, run_nodes)
-from multilift_sim.topics import uav_topic
+from multilift_sim.topics import ATTITUDE_SETPOINT, REFERENCE, ROTOR_CMD, uav_topic
 
 
 class LeaderNode(Node):
@@ -36,12 +36,12 @@ class LeaderNode(Node):
         prepare_node_laws(scenario, 0)  # before our topics appear
         self.runtime = ControllerRuntime(scenario, 0)
         self.packer = AnswerMessages(scenario)  # the answer as CDR bytes
-        self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(1, 'rotor_cmd'),
+        self.cmd_pub = self.create_publisher(RotorCommand, uav_topic(1, ROTOR_CMD),
                                              PUBLISHER_QOS)
-        self.ref_pub = self.create_publisher(TrackingReference, uav_topic(1, 'reference'),
+        self.ref_pub = self.create_publisher(TrackingReference, uav_topic(1, REFERENCE),
                                              PUBLISHER_QOS)
         self.setpoint_pub = self.create_publisher(AttitudeSetpoint,
-                                                  uav_topic(1, 'attitude_setpoint'), PUBLISHER_QOS)
+                                                  uav_topic(1, ATTITUDE_SETPOINT), PUBLISHER_QOS)
         self.outputs = RawPublishers(self.cmd_pub, self.ref_pub, self.setpoint_pub,
                                      confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.read_snapshot = SnapshotReader(scenario)

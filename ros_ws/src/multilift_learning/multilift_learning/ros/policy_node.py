@@ -29,7 +29,7 @@ from multilift_sim import cdr
 from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
                                       RawPublishers, controller_peers_missing, run_node,
                                       serve_controllers)
-from multilift_sim.topics import FORMATION_SNAPSHOT, FORMATION_STATE, uav_topic
+from multilift_sim.topics import FORMATION_SNAPSHOT, FORMATION_STATE, ROTOR_CMD, uav_topic
 
 Policy = Callable[[np.ndarray], np.ndarray]
 
@@ -71,7 +71,7 @@ class PolicyNode(Node):
         self.packer = AnswerMessages(scenario)
         self.snapshot = cdr.FormationSnapshot([u.vehicle.n_rotors for u in scenario.uavs])
         self.tension = np.zeros((1, n))
-        self.cmd_pubs = [self.create_publisher(RotorCommand, uav_topic(i, 'rotor_cmd'),
+        self.cmd_pubs = [self.create_publisher(RotorCommand, uav_topic(i, ROTOR_CMD),
                                                PUBLISHER_QOS) for i in range(1, n + 1)]
         self.outputs = RawPublishers(*self.cmd_pubs,
                                      confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)

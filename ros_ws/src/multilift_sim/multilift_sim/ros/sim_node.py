@@ -38,8 +38,10 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import (EVENTS, MARKER_DECIMATION, MEASURED_ODOM, ODOM, WIND,
-                                   parse_external, state_topics, uav_topic)
+from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE,
+                                   MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
+                                   PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, parse_external,
+                                   state_topics, uav_topic)
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables, run_seeds)
 from multilift_sim.tick_messages import SimulatorMessages
@@ -74,19 +76,18 @@ class SimNode(Node):
             self.external = parse_external(external, n)
         except ValueError as error:
             raise Fatal(f'parameter "external": {error}') from None
-        self.clock_pub = self.create_publisher(Clock, '/clock', PUBLISHER_QOS)
-        self.odom_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, 'odom'), PUBLISHER_QOS)
+        self.clock_pub = self.create_publisher(Clock, CLOCK, PUBLISHER_QOS)
+        self.odom_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, ODOM), PUBLISHER_QOS)
                           for i in range(n)]
-        self.payload_pub = self.create_publisher(Odometry, '/payload/odom', PUBLISHER_QOS)
-        self.snapshot_pub = self.create_publisher(FormationSnapshot, '/formation/snapshot',
+        self.payload_pub = self.create_publisher(Odometry, PAYLOAD_ODOM, PUBLISHER_QOS)
+        self.snapshot_pub = self.create_publisher(FormationSnapshot, FORMATION_SNAPSHOT,
                                                   PUBLISHER_QOS)
         self.applied: list[np.ndarray] | None = None  # rotor speeds held up to this tick
-        self.formation_pub = self.create_publisher(FormationState, '/formation/state',
+        self.formation_pub = self.create_publisher(FormationState, FORMATION_STATE,
                                                    PUBLISHER_QOS)
-        self.gust_pub = self.create_publisher(Vector3Stamped, '/payload/gust', PUBLISHER_QOS)
-        self.marker_pub = self.create_publisher(MarkerArray, '/visualization/markers',
-                                                PUBLISHER_QOS)
-        self.tf_pub = self.create_publisher(TFMessage, '/tf', PUBLISHER_QOS)
+        self.gust_pub = self.create_publisher(Vector3Stamped, PAYLOAD_GUST, PUBLISHER_QOS)
+        self.marker_pub = self.create_publisher(MarkerArray, MARKERS, PUBLISHER_QOS)
+        self.tf_pub = self.create_publisher(TFMessage, TF, PUBLISHER_QOS)
         # /formation/events only where the scenario has events (topics.run_topics)
         events = [self.create_publisher(FormationEvent, EVENTS, PUBLISHER_QOS)] \
             if scenario.events else []
@@ -108,7 +109,7 @@ class SimNode(Node):
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)
         self.cmd_subs = [AdaptiveSubscription(
-            self, RotorCommand, uav_topic(i + 1, 'rotor_cmd'),
+            self, RotorCommand, uav_topic(i + 1, ROTOR_CMD),
             lambda msg, i=i: self._on_command(i, msg), depth=PUBLISHER_QOS.depth,
             durability=DurabilityPolicy.VOLATILE if i + 1 in self.external else None)
             for i in range(n)]
@@ -124,7 +125,7 @@ class SimNode(Node):
         missing = []
         for i, sub in enumerate(self.cmd_subs):
             sub.adapt()
-            topic = uav_topic(i + 1, 'rotor_cmd')
+            topic = uav_topic(i + 1, ROTOR_CMD)
             if i + 1 not in self.external:
                 if sub.subscription.get_publisher_count() < 1:
                     missing.append(f'a controller publishing {topic}')

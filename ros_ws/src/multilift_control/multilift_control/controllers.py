@@ -14,7 +14,7 @@ from multilift_control.cascade import (CascadeController, ControlOutput, UavStat
                                        balancing_rotor_speed)
 from multilift_control.laws.cascade import leader_update
 from multilift_control.mission import MissionPath, Reference
-from multilift_sim.scenario import Scenario
+from multilift_sim.scenario import CONTROL_MODES, Scenario
 
 
 class Controller(Protocol):
@@ -62,7 +62,12 @@ class MissionLeader:
         return ControlOutput(*out), Reference.of(reference)
 
 
+# the leader's controller by `control.mode`: the names are the scenario's registry
+# (multilift_sim.scenario.CONTROL_MODES, which validation reads), in its order
 LEADER_CONTROLLERS = {'cascade': MissionLeader, 'constant_rotor_speed': ConstantRotorSpeed}
+if tuple(LEADER_CONTROLLERS) != CONTROL_MODES:
+    raise ImportError(f'LEADER_CONTROLLERS {tuple(LEADER_CONTROLLERS)} must be the scenario\'s '
+                      f'control modes {CONTROL_MODES}')
 
 
 def make_controller(scenario: Scenario, index: int) -> Controller:

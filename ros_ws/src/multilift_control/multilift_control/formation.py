@@ -35,7 +35,7 @@ from multilift_sim import formation_geometry  # start places and the V offsets v
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario import ControlConfig
 
-GEOMETRIES = ('linear', 'distance', 'v', 'circle')  # seed Table 3.1 rows
+GEOMETRIES = formation_geometry.FORMATION_GEOMETRIES  # seed Table 3.1: the one registry
 
 OWN_THRUST = ('commanded', 'measured')  # where a follower's u_i comes from (FormationFollower)
 _COND_LIMIT = 1e10  # cond(J M^-1 J^T) above which the linear law takes its pseudo-inverse

@@ -27,29 +27,50 @@ def v_offset(index: int, distance: float, half_angle: float) -> np.ndarray:
     return seed_to_world_vector(seed)
 
 
+def _linear_place(i: int, n: int, offsets, distance: float, half_angle: float) -> np.ndarray:
+    """r_i - r_1 = -offset_i."""
+    return -np.asarray(offsets[i - 1], dtype=float)
+
+
+def _v_place(i: int, n: int, offsets, distance: float, half_angle: float) -> np.ndarray:
+    """r_i - r_1 = v_1i."""
+    return v_offset(i + 1, distance, half_angle)
+
+
+def _distance_place(i: int, n: int, offsets, distance: float, half_angle: float) -> np.ndarray:
+    """Evenly on the rear half-circle of radius d about the leader."""
+    angle = math.pi / 2 + math.pi * i / n
+    return distance * np.array([math.cos(angle), math.sin(angle), 0.0])
+
+
+def _circle_place(i: int, n: int, offsets, distance: float, half_angle: float) -> np.ndarray:
+    """A vertex of the regular polygon of side d whose vertex 0 is the leader."""
+    radius = distance / (2 * math.sin(math.pi / n))
+    angle = 2 * math.pi * i / n
+    return radius * np.array([math.cos(angle) - 1.0, math.sin(angle), 0.0])
+
+
+# The formation geometries of seed Table 3.1, by the name `formation.geometry` takes: the one
+# registry (scenario validation and the followers' constraint rows read its names), each
+# follower i's nominal place relative to the leader r_i - r_1 [m], world
+NOMINAL_PLACES = {'linear': _linear_place, 'distance': _distance_place, 'v': _v_place,
+                  'circle': _circle_place}
+FORMATION_GEOMETRIES = tuple(NOMINAL_PLACES)
+
+
 def nominal_positions(geometry: str, n: int, leader_position, offsets=(), distance: float = 0.0,
                       half_angle: float = 0.0) -> np.ndarray:
-    """(n, 3) positions [m] with every virtual constraint satisfied, all at the leader's height.
-
-    linear: r_i = r_1 - offset_i; v: r_i = r_1 + v_1i; distance: followers evenly on the rear
-    half-circle of radius d; circle: a regular polygon of side d with the leader a vertex.
-    """
+    """(n, 3) positions [m] with every virtual constraint satisfied, all at the leader's height
+    (`NOMINAL_PLACES`: linear r_i = r_1 - offset_i; v: r_i = r_1 + v_1i; distance: followers
+    evenly on the rear half-circle of radius d; circle: a regular polygon of side d with the
+    leader a vertex)."""
+    if geometry not in NOMINAL_PLACES:
+        raise ValueError(f'unknown formation geometry {geometry!r}')
+    place = NOMINAL_PLACES[geometry]
     leader = np.asarray(leader_position, dtype=float)
     out = np.tile(leader, (n, 1))
     for i in range(1, n):
-        if geometry == 'linear':
-            out[i] = leader - np.asarray(offsets[i - 1], dtype=float)
-        elif geometry == 'v':
-            out[i] = leader + v_offset(i + 1, distance, half_angle)
-        elif geometry == 'distance':
-            angle = math.pi / 2 + math.pi * i / n
-            out[i] = leader + distance * np.array([math.cos(angle), math.sin(angle), 0.0])
-        elif geometry == 'circle':
-            radius = distance / (2 * math.sin(math.pi / n))
-            angle = 2 * math.pi * i / n
-            out[i] = leader + radius * np.array([math.cos(angle) - 1.0, math.sin(angle), 0.0])
-        else:
-            raise ValueError(f'unknown formation geometry {geometry!r}')
+        out[i] = leader + place(i, n, offsets, distance, half_angle)
     return out
 
 

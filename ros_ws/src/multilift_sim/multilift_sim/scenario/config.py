@@ -1,0 +1,214 @@
+"""The scenario as frozen dataclasses (`Scenario` and its sections), and the rules every
+duration keeps: what `scenario.parse` builds from a file, validated once. World frame (z up),
+SI units."""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+from multilift_sim.disturbances import Gust
+from multilift_sim.dynamics import FormationParams
+from multilift_sim.formation_geometry import FORMATION_GEOMETRIES  # noqa: F401 (the registry)
+from multilift_sim.multirotor import MultirotorParams
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be run; the message says where and why."""
+
+
+CONTROL_MODES = ('cascade', 'constant_rotor_speed')
+CABLE_MODELS = ('rigid', 'slack')  # the seed's two-way rod; pulls only (multilift_sim.slack)
+
+
+@dataclass(frozen=True)
+class SimulationConfig:
+    duration: float                  # t_max [s]
+    physics_rate: float              # RK4 steps per second [Hz]
+    control_rate: float              # control ticks per second [Hz]; divides physics_rate
+    gravity: float                   # [m/s^2]
+    baumgarte_alpha: float           # alpha_f of seed Eq. 2.59 [1/s]
+    baumgarte_beta: float            # beta_f of seed Eq. 2.59 [1/s]
+    constraint_tolerance: float      # eps_g of Algorithm 1 [m^2]
+    constraint_rate_tolerance: float  # eps_gdot of Algorithm 1 [m^2/s]
+    command_timeout: float           # wall time the simulator waits for a rotor command [s]
+    integrator: str = 'baumgarte'    # 'baumgarte' (Eq. 2.59-2.70) or 'nullspace' (Eq. 2.71-2.72)
+
+    @property
+    def physics_steps_per_tick(self) -> int:
+        return int(round(self.physics_rate / self.control_rate))
+
+    @property
+    def control_period(self) -> float:
+        """Time between control ticks [s]."""
+        return 1.0 / self.control_rate
+
+    @property
+    def tick_count(self) -> int:
+        """Number of control periods in the run."""
+        return int(round(self.duration * self.control_rate))
+
+
+@dataclass(frozen=True)
+class UavConfig:
+    vehicle: MultirotorParams
+    cable_length: float              # l_i [m]
+    position: tuple[float, float, float]  # initial position, world [m]
+    yaw: float                       # initial yaw [rad]
+
+
+@dataclass(frozen=True)
+class PayloadConfig:
+    mass: float                      # m_p [kg]
+    drag_coefficient: float          # c_pd of seed Eq. 2.53 [kg/m]
+    alpha: float                     # release angle alpha of seed Eq. 2.33 [rad] (n = 1)
+    beta: float                      # release angle beta of seed Eq. 2.33 [rad] (n = 1)
+    swing: float                     # release angle out of the UAVs-payload plane [rad] (n = 2)
+
+
+@dataclass(frozen=True)
+class FormationConfig:
+    """Virtual constraints the followers keep (seed §3.2, Table 3.1), world frame."""
+    geometry: str                    # 'linear', 'distance', 'v' or 'circle'
+    offsets: tuple[tuple[float, float, float], ...]  # linear: r_1 - r_i per follower [m]
+    distance: float                  # d [m] (distance, v, circle)
+    half_angle: float                # gamma [rad] (v: vertex angle 2 gamma)
+    alpha_vc: float                  # formation derivative gain (Table 4.2) [1/s]
+    beta_vc: float                   # formation proportional gain (Table 4.2) [1/s]
+
+
+@dataclass(frozen=True)
+class ControlConfig:
+    mode: str                        # 'cascade' or 'constant_rotor_speed'
+    constant_rotor_speed: float | None  # [rad/s]; None = balance the total weight
+    position_kp: tuple[float, float, float]  # [1/s^2]
+    position_kd: tuple[float, float, float]  # [1/s]
+    position_ki: tuple[float, float, float]  # [1/s^3]
+    attitude_kp: tuple[float, float, float]  # [1/s^2]
+    attitude_kd: tuple[float, float, float]  # [1/s]
+    max_tilt: float                  # [rad]
+
+
+@dataclass(frozen=True)
+class MissionSegment:
+    velocity: tuple[float, float, float]  # leader reference velocity, world [m/s]
+    end_time: float                  # the segment ends at this simulated time [s]
+
+
+@dataclass(frozen=True)
+class MissionConfig:
+    start: tuple[float, float, float]  # reference position at t = 0, world [m]
+    segments: tuple[MissionSegment, ...]
+    # tau of the leader's reference prefilter [s] (not in the seed; 0 = the raw corners)
+    reference_filter_time: float = 0.0
+
+
+@dataclass(frozen=True)
+class EventConfig:
+    """One of the scenario's `events:` (issue 21), applied at the first control tick at or
+    after its time (physics.events)."""
+    time: float                      # [s]
+    type: str                        # one of physics.layout.EVENT_KINDS
+    uav: int                         # the UAV it concerns, from 1 (1 = the leader); gust: 0
+    rotor: int = 0                   # rotor_effectiveness: the rotor, from 1; else 0
+    effectiveness: float = 1.0       # rotor_effectiveness: its share of thrust, in [0, 1]
+    duration: float = 0.0            # controller_silence: how long no command arrives [s];
+    #                                  gust: how long it blows [s]
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)  # gust: its peak [m/s], world
+
+
+@dataclass(frozen=True)
+class TurbulenceConfig:
+    """Dryden turbulence on top of the steady wind (`wind.turbulence`, multilift_sim.turbulence):
+    components u (along the mean wind), v (to its left), w (up)."""
+    intensity: tuple[float, float, float]     # sigma_u, sigma_v, sigma_w [m/s]
+    length_scale: tuple[float, float, float]  # L_u, L_v, L_w [m]
+    airspeed: float                           # V [m/s]: how fast the field passes
+    seed: int                                 # of the series (a run's seed)
+
+
+@dataclass(frozen=True)
+class SensorConfig:
+    """What the controllers receive of each UAV (`sensors:`, multilift_sim.sensors,
+    docs/sensors.md): per quantity of SENSED_QUANTITIES (position [m], velocity [m/s],
+    attitude [rad], body_rate [rad/s]) its white noise and bias random walk."""
+    noise: tuple[float, ...]         # standard deviation of the white noise [unit]
+    bias: tuple[float, ...]          # intensity of the bias random walk [unit / sqrt(s)]
+    rate: float                      # samples per second [Hz]; divides control_rate
+    latency_ticks: int               # control ticks from a sample to its arrival
+    dropout: float                   # probability a sample is lost, in [0, 1)
+    seed: int                        # of the errors (a run's seed)
+
+    def every(self, control_rate: float) -> int:
+        """Control ticks between two samples."""
+        return int(round(control_rate / self.rate))
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    description: str
+    source: str                      # the file it came from
+    simulation: SimulationConfig
+    uavs: tuple[UavConfig, ...]
+    payload: PayloadConfig
+    gusts: tuple[Gust, ...]
+    control: ControlConfig
+    mission: MissionConfig
+    formation: FormationConfig | None = None
+    warnings: tuple[str, ...] = field(default=())
+    cable_model: str = 'rigid'       # one of CABLE_MODELS
+    events: tuple[EventConfig, ...] = ()  # in time order
+    wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world
+    turbulence: TurbulenceConfig | None = None
+    sensors: SensorConfig | None = None  # None: the controllers read the exact state
+
+    @property
+    def n_uavs(self) -> int:
+        return len(self.uavs)
+
+    @property
+    def has_wind(self) -> bool:
+        """Whether the air moves everywhere (a steady wind, turbulence or a gust event:
+        /formation/wind carries it), beyond the seed's gusts at places."""
+        return (any(self.wind) or self.turbulence is not None
+                or any(e.type == 'gust' for e in self.events))
+
+    def formation_params(self, baumgarte_alpha: float | None = None,
+                         baumgarte_beta: float | None = None) -> FormationParams:
+        """Physics parameters of the formation DAE (optionally other Baumgarte gains)."""
+        sim = self.simulation
+        return FormationParams(
+            uavs=tuple(u.vehicle for u in self.uavs),
+            cable_lengths=tuple(u.cable_length for u in self.uavs),
+            payload_mass=self.payload.mass,
+            payload_drag_coefficient=self.payload.drag_coefficient,
+            gusts=self.gusts,
+            gravity=sim.gravity, wind=self.wind,
+            baumgarte_alpha=sim.baumgarte_alpha if baumgarte_alpha is None else baumgarte_alpha,
+            baumgarte_beta=sim.baumgarte_beta if baumgarte_beta is None else baumgarte_beta,
+        )
+
+    def with_duration(self, duration: float) -> 'Scenario':
+        """The same scenario flown for `duration` [s] (a `--duration` override); ScenarioError
+        unless it is at least one control period."""
+        if not flies_a_period(duration, self.simulation.control_rate):
+            raise ScenarioError(f'duration: {duration!r} '
+                                f'{one_period_rule(self.simulation.control_rate)}')
+        return dataclasses.replace(
+            self, simulation=dataclasses.replace(self.simulation, duration=float(duration)))
+
+    def total_weight(self) -> float:
+        """Weight of every UAV and the payload [N]."""
+        mass = sum(u.vehicle.mass for u in self.uavs) + self.payload.mass
+        return mass * self.simulation.gravity
+
+
+def flies_a_period(duration: float, control_rate: float) -> bool:
+    """A run integrates whole control periods and asks for commands before t_max only: it
+    needs at least one period, or there is nothing to integrate."""
+    return math.isfinite(duration) and round(duration * control_rate) >= 1
+
+
+def one_period_rule(control_rate: float) -> str:
+    return f'must be at least one control period (1/control_rate = {1.0 / control_rate:g} s)'

@@ -1,0 +1,51 @@
+"""Where scenarios are and how they load: a name in `scenarios/` ($MULTILIFT_SCENARIOS, else
+the repository's) or a YAML path, read and validated (`parse.scenario_of`)."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import yaml
+
+from multilift_sim.scenario.config import Scenario, ScenarioError
+from multilift_sim.scenario.parse import scenario_of
+
+
+def scenario_dir() -> Path:
+    """The `scenarios/` folder: $MULTILIFT_SCENARIOS, else the repository's."""
+    env = os.environ.get('MULTILIFT_SCENARIOS')
+    if env:
+        return Path(env)
+    root = os.environ.get('ML_ROOT')
+    if root:
+        return Path(root) / 'scenarios'
+    return Path.cwd() / 'scenarios'
+
+
+def resolve(name_or_path: str) -> Path:
+    """A scenario name (a file in scenarios/) or a YAML path -> the file."""
+    candidate = Path(name_or_path)
+    if candidate.suffix in ('.yaml', '.yml') or os.sep in name_or_path:
+        if not candidate.is_file():
+            raise ScenarioError(f'{name_or_path}: no such scenario file')
+        return candidate
+    path = scenario_dir() / f'{name_or_path}.yaml'
+    if not path.is_file():
+        known = sorted(p.stem for p in scenario_dir().glob('*.yaml'))
+        raise ScenarioError(f'{name_or_path}: unknown scenario (known: {", ".join(known)})')
+    return path
+
+
+def load(name_or_path: str) -> Scenario:
+    """Load and validate a scenario by name or path. Raises ScenarioError."""
+    path = resolve(name_or_path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ScenarioError(f'{path}: not valid YAML: {exc}'.replace('\n', ' ')) from None
+    return scenario_of(data, str(path))
+
+
+def loads(text: str, where: str = '<string>') -> Scenario:
+    """Validate a scenario given as YAML text (tests, tools)."""
+    return scenario_of(yaml.safe_load(text), where)

@@ -1,0 +1,316 @@
+"""A scenario file's mapping -> `Scenario`, validated once: every section read with checks
+(`reading.Section`), the vehicles (`vehicle`), the formation, gusts, wind, sensors, events,
+control and mission, then what only the Baumgarte DAE models refused under another formulation
+and what the rotors cannot lift at all."""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+from multilift_sim.disturbances import Gust
+from multilift_sim.formation_geometry import hanging_payload, nominal_positions
+from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
+from multilift_sim.physics.layout import EVENT_KINDS, SENSED_QUANTITIES
+from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
+                                           ControlConfig, EventConfig, FormationConfig,
+                                           MissionConfig, MissionSegment, PayloadConfig,
+                                           Scenario, ScenarioError, SensorConfig,
+                                           SimulationConfig, TurbulenceConfig, UavConfig,
+                                           flies_a_period, one_period_rule)
+from multilift_sim.scenario.reading import Section
+from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
+                                            vehicle_params)
+
+
+def scenario_of(data: Any, where: str) -> Scenario:
+    top = Section(data, '', where)
+    name = top.text('name')
+    description = top.text('description', '')
+    top.text('frame', 'world', choices=('world',))
+    cable_model = top.text('cable_model', 'rigid', choices=CABLE_MODELS)
+    # a slack cable may start with the payload above its UAV (it falls and snaps taut)
+    release_limit = 180.0 if cable_model == 'slack' else 90.0
+    release_rule = f'must be within (-{release_limit:g}, {release_limit:g}) degrees' + (
+        '' if cable_model == 'slack' else ' (beyond 90 needs cable_model: slack)')
+
+    s = top.section('simulation')
+    duration = s.positive('duration')
+    physics_rate = s.positive('physics_rate')
+    control_rate = s.number('control_rate', ..., lambda v: 0 < v <= physics_rate,
+                            f'must be > 0 and <= physics_rate ({physics_rate})')
+    if not flies_a_period(duration, control_rate):
+        raise s.fail('duration', duration, one_period_rule(control_rate))
+    ratio = physics_rate / control_rate
+    if abs(ratio - round(ratio)) > 1e-9:
+        raise s.fail('control_rate', control_rate,
+                     f'must divide physics_rate ({physics_rate}) into a whole number of steps')
+    sim = SimulationConfig(
+        duration=duration, physics_rate=physics_rate, control_rate=control_rate,
+        gravity=s.positive('gravity', 9.81),
+        baumgarte_alpha=s.non_negative('baumgarte_alpha'),
+        baumgarte_beta=s.non_negative('baumgarte_beta'),
+        constraint_tolerance=s.positive('constraint_tolerance'),
+        constraint_rate_tolerance=s.positive('constraint_rate_tolerance'),
+        command_timeout=s.positive('command_timeout', 5.0),
+        integrator=s.text('integrator', 'baumgarte', choices=tuple(FORMULATIONS)))
+    s.done()
+
+    v = top.section('vehicle')
+    base_vehicle = dataclasses.asdict(vehicle_params(v, None))
+    base_source = inertia_source(v, tuple(base_vehicle['inertia']))
+    v.done()
+    warnings = inertia_warning(where, 'vehicle.inertia', tuple(base_vehicle['inertia']),
+                               base_source)
+
+    # n comes from formation.n, or from the length of `uavs` (per-UAV overrides), or is 1
+    n_formation = None
+    if top.has('formation') and isinstance(top.data['formation'], dict) \
+            and 'n' in top.data['formation']:
+        n_formation = top.data['formation']['n']
+        if isinstance(n_formation, bool) or not isinstance(n_formation, int) or n_formation < 1:
+            raise ScenarioError(f'{where}: formation.n: {n_formation!r} must be an integer >= 1')
+    uav_list = top.raw('uavs', None)
+    if uav_list is None:
+        uav_list = [{}] * (n_formation or 1)
+    if not isinstance(uav_list, list) or not uav_list:
+        raise ScenarioError(f'{where}: uavs: {uav_list!r} must be a non-empty list')
+    if n_formation is not None and len(uav_list) != n_formation:
+        raise ScenarioError(f'{where}: uavs: {len(uav_list)} entries but formation.n is '
+                            f'{n_formation}')
+    default_cable = top.positive('cable_length') if top.has('cable_length') else ...
+    uavs = []
+    for i, entry in enumerate(uav_list):
+        u = Section(entry, f'uavs[{i}]', where)
+        vehicle = vehicle_params(u, base_vehicle)
+        source = inertia_source(u, vehicle.inertia,
+                                base_source if vehicle.inertia == SEED_INERTIA else 'given')
+        if vehicle.inertia != tuple(base_vehicle['inertia']) or source != base_source:
+            warnings += inertia_warning(where, u.key('inertia'), vehicle.inertia, source)
+        if i > 0 and u.has('position'):
+            raise u.fail('position', u.data['position'],
+                         'is not allowed: follower positions come from the formation geometry')
+        uavs.append(UavConfig(vehicle=vehicle, cable_length=u.positive('cable_length',
+                                                                       default_cable),
+                              position=u.vector('position', [0.0, 0.0, 0.0]),
+                              yaw=u.number('yaw', 0.0)))
+        u.done()
+
+    p = top.section('payload')
+    payload = PayloadConfig(mass=p.positive('mass'),
+                            drag_coefficient=p.non_negative('drag_coefficient', 0.0),
+                            alpha=math.radians(p.number('alpha_deg', 0.0,
+                                                        lambda a: abs(a) < release_limit,
+                                                        release_rule)),
+                            beta=math.radians(p.number('beta_deg', 0.0, lambda a: abs(a) < 90,
+                                                       'must be within (-90, 90) degrees')),
+                            swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
+                                                        'must be within (-90, 90) degrees')))
+    swing = math.degrees(payload.swing)
+    p.done()
+    if len(uavs) > 1 and (payload.alpha or payload.beta):
+        raise p.fail('alpha_deg', math.degrees(payload.alpha),
+                     'release angles alpha/beta are for n = 1 (use swing_deg for n = 2)')
+    if len(uavs) != 2 and payload.swing:
+        raise p.fail('swing_deg', swing, 'a swing out of the UAVs-payload plane needs n = 2')
+
+    formation = None
+    if top.has('formation') or len(uavs) > 1:
+        formation = _formation(top.section('formation'), len(uavs))
+
+    gusts = []
+    for i, entry in enumerate(top.sequence('gusts', [])):
+        g = Section(entry, f'gusts[{i}]', where)
+        direction = g.vector('direction')
+        norm = math.sqrt(sum(c * c for c in direction))
+        if norm == 0:
+            raise g.fail('direction', list(direction), 'must not be zero')
+        gusts.append(Gust(center=g.vector('center', length=2),
+                          direction=tuple(c / norm for c in direction),
+                          gradient_distance=g.positive('gradient_distance'),
+                          reference_speed=g.non_negative('reference_speed')))
+        g.done()
+
+    events = _events(top, uavs, duration)
+    w = top.section('wind', {})
+    wind = w.vector('velocity', [0.0, 0.0, 0.0])  # steady, everywhere (issue 21)
+    turbulence = None
+    if w.has('turbulence'):
+        d = w.section('turbulence')
+        turbulence = TurbulenceConfig(
+            intensity=d.vector('intensity', check=lambda v: v >= 0, rule='must be >= 0'),
+            length_scale=d.vector('length_scale', check=lambda v: v > 0, rule='must be > 0'),
+            airspeed=d.positive('airspeed'), seed=d.count('seed', 0))
+        d.done()
+    w.done()
+    sensors = _sensors(top.section('sensors'), sim) if top.has('sensors') else None
+
+    c = top.section('control')
+    mode = c.text('mode', choices=CONTROL_MODES)
+    constant = c.raw('constant_rotor_speed', None)
+    if constant is not None:
+        constant = c.positive('constant_rotor_speed')
+    gains_pos = c.section('position_gains')
+    gains_att = c.section('attitude_gains')
+    nonneg = dict(check=lambda x: x >= 0, rule='must be >= 0')
+    control = ControlConfig(
+        mode=mode, constant_rotor_speed=constant,
+        position_kp=gains_pos.vector('kp', **nonneg), position_kd=gains_pos.vector('kd', **nonneg),
+        position_ki=gains_pos.vector('ki', **nonneg),
+        attitude_kp=gains_att.vector('kp', **nonneg), attitude_kd=gains_att.vector('kd', **nonneg),
+        max_tilt=math.radians(c.number('max_tilt_deg', 30.0, lambda a: 0 < a < 90,
+                                       'must be within (0, 90) degrees')))
+    gains_pos.done()
+    gains_att.done()
+    c.done()
+
+    m = top.section('mission')
+    start = m.vector('start', list(uavs[0].position))
+    segments = []
+    t_prev = 0.0
+    for i, entry in enumerate(m.sequence('segments', [])):
+        seg = Section(entry, f'mission.segments[{i}]', where)
+        velocity = seg.vector('velocity')
+        if seg.has('duration') == seg.has('until'):
+            raise ScenarioError(f'{where}: {seg.path}: give exactly one of duration, until')
+        if seg.has('duration'):
+            end = t_prev + seg.positive('duration')
+        else:
+            end = seg.number('until', ..., lambda t: t > t_prev, f'must be > {t_prev}')
+        seg.done()
+        segments.append(MissionSegment(velocity=velocity, end_time=end))
+        t_prev = end
+    reference_filter_time = m.non_negative('reference_filter_time', 0.0)
+    m.done()
+    top.done()
+
+    scenario = Scenario(name=name, description=description, source=where, simulation=sim,
+                        uavs=tuple(uavs), payload=payload, gusts=tuple(gusts), control=control,
+                        mission=MissionConfig(start=start, segments=tuple(segments),
+                                              reference_filter_time=reference_filter_time),
+                        formation=formation, warnings=tuple(warnings),
+                        cable_model=cable_model, events=events, wind=tuple(wind),
+                        turbulence=turbulence, sensors=sensors)
+    _check_feasible(scenario)
+    # what only the engine's DAE (physics/) models: refused with another formulation
+    lagging = [i + 1 for i, u in enumerate(scenario.uavs)
+               if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
+    windy = any(wind) or turbulence is not None or any(u.vehicle.drag_coefficient
+                                                       for u in scenario.uavs)
+    for used, what in ((windy, 'wind and vehicle.drag_coefficient'), (events, 'events'),
+                       (lagging, f'vehicle.motor_time_constant / motor_rate_limit '
+                                 f'(uav{lagging[0] if lagging else 0})')):
+        if used and sim.integrator != 'baumgarte':
+            raise ScenarioError(f'{where}: {what} need simulation.integrator: baumgarte, got '
+                                f'{sim.integrator!r}')
+    if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
+        raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
+                            f'baumgarte, got {sim.integrator!r}')
+    return scenario
+
+
+def _sensors(d: Section, sim: SimulationConfig) -> SensorConfig:
+    """The `sensors:` section, validated: per quantity `{name}_noise` and `{name}_bias`
+    (default 0), the rate (default the control rate, which it must divide), the latency in
+    ticks, the dropout probability and the seed."""
+    noise = tuple(d.non_negative(f'{q}_noise', 0.0) for q in SENSED_QUANTITIES)
+    bias = tuple(d.non_negative(f'{q}_bias', 0.0) for q in SENSED_QUANTITIES)
+    control_rate = sim.control_rate
+    rate = d.number('rate', control_rate, lambda v: 0 < v <= control_rate,
+                    f'must be > 0 and <= simulation.control_rate ({control_rate:g})')
+    ratio = control_rate / rate
+    if abs(ratio - round(ratio)) > 1e-9:
+        raise d.fail('rate', rate, f'must divide simulation.control_rate ({control_rate:g}) '
+                     'into a whole number of ticks')
+    config = SensorConfig(noise=noise, bias=bias, rate=rate,
+                          latency_ticks=d.count('latency_ticks', 0),
+                          dropout=d.number('dropout', 0.0, lambda v: 0 <= v < 1,
+                                           'must be within [0, 1)'),
+                          seed=d.count('seed', 0))
+    d.done()
+    return config
+
+
+def _events(top: Section, uavs: list[UavConfig], duration: float) -> tuple[EventConfig, ...]:
+    """The `events:` list, validated (each key of its type, nothing else) and in time order."""
+    events = []
+    released: set[int] = set()
+    for k, entry in enumerate(top.sequence('events', [])):
+        e = Section(entry, f'events[{k}]', top.where)
+        time = e.number('time', ..., lambda v: 0 <= v < duration,
+                        f'must be >= 0 and before the run\'s end ({duration:g} s)')
+        kind = e.text('type', choices=EVENT_KINDS)
+        if kind == 'gust':  # the whole formation's air: no UAV
+            velocity = e.vector('velocity')
+            if not any(velocity):
+                raise e.fail('velocity', list(velocity), 'must not be zero')
+            events.append(EventConfig(time=time, type=kind, uav=0, velocity=velocity,
+                                      duration=e.positive('duration')))
+            e.done()
+            continue
+        uav = e.raw('uav')
+        if isinstance(uav, bool) or not isinstance(uav, int) or not 1 <= uav <= len(uavs):
+            raise e.fail('uav', uav, f'must be a UAV from 1 to {len(uavs)}')
+        event = EventConfig(time=time, type=kind, uav=uav)
+        if kind == 'rotor_effectiveness':
+            rotors = uavs[uav - 1].vehicle.n_rotors
+            rotor = e.raw('rotor')
+            if isinstance(rotor, bool) or not isinstance(rotor, int) or not 1 <= rotor <= rotors:
+                raise e.fail('rotor', rotor, f'must be a rotor of uav{uav}, from 1 to {rotors}')
+            event = dataclasses.replace(event, rotor=rotor, effectiveness=e.number(
+                'effectiveness', ..., lambda v: 0 <= v <= 1, 'must be within [0, 1]'))
+        elif kind == 'controller_silence':
+            event = dataclasses.replace(event, duration=e.positive('duration'))
+        elif kind == 'cable_release':
+            if uav in released:
+                raise e.fail('uav', uav, 'has let go of its cable already')
+            released.add(uav)
+            if len(released) == len(uavs):
+                raise e.fail('uav', uav, 'is the last cable holding the payload')
+        e.done()
+        events.append(event)
+    return tuple(sorted(events, key=lambda event: event.time))
+
+
+def _formation(f: Section, n: int) -> FormationConfig:
+    f.raw('n', n)  # checked with the UAV list
+    geometry = f.text('geometry', choices=FORMATION_GEOMETRIES)
+    offsets: list[tuple[float, ...]] = []
+    if geometry == 'linear':
+        raw = f.raw('offsets')
+        if not isinstance(raw, list) or len(raw) != n - 1:
+            raise f.fail('offsets', raw, f'must list one [dx, dy, dz] per follower ({n - 1})')
+        holder = Section({str(k): v for k, v in enumerate(raw)}, f.key('offsets'), f.where)
+        offsets = [holder.vector(str(k)) for k in range(n - 1)]
+        holder.done()
+    needs_distance = geometry in ('distance', 'v', 'circle')
+    distance = f.positive('distance') if needs_distance else 0.0
+    half_angle = 0.0
+    if geometry == 'v':
+        half_angle = math.radians(f.number('half_angle_deg', ..., lambda a: 0 < a < 90,
+                                           'must be within (0, 90) degrees'))
+    if geometry == 'circle' and n < 3:
+        raise f.fail('geometry', geometry, 'needs n >= 3')
+    config = FormationConfig(geometry=geometry, offsets=tuple(offsets), distance=distance,
+                             half_angle=half_angle, alpha_vc=f.non_negative('alpha_vc'),
+                             beta_vc=f.non_negative('beta_vc'))
+    f.done()
+    return config
+
+
+def _check_feasible(scenario: Scenario) -> None:
+    """Reject what the rotors cannot lift at all."""
+    lift = sum(u.vehicle.max_thrust for u in scenario.uavs)
+    weight = scenario.total_weight()
+    if weight >= lift:
+        raise ScenarioError(
+            f'{scenario.source}: payload.mass: {scenario.payload.mass} kg is too heavy: the '
+            f'formation weighs {weight:.2f} N but its rotors lift at most {lift:.2f} N')
+    f = scenario.formation
+    if f is not None and scenario.n_uavs > 1:
+        uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position,
+                                 f.offsets, f.distance, f.half_angle)
+        try:
+            hanging_payload(uavs, [u.cable_length for u in scenario.uavs])
+        except ValueError as exc:
+            raise ScenarioError(f'{scenario.source}: formation: {exc}') from None

@@ -25,7 +25,7 @@ def foxglove_main(argv: list[str]) -> int:
     """`foxglove [--port P] [--host H]` or `foxglove --layout FILE SCENARIO` (argv without the
     word `foxglove`); the exit code."""
     parser = argparse.ArgumentParser(prog='multilift foxglove', description=__doc__.split('\n')[0],
-                                     epilog='See the foxglove_bridge module docstring.')
+                                     epilog='See the multilift_tools.foxglove package docstring.')
     parser.add_argument('--port', type=int, default=DEFAULT_PORT,
                         help=f'TCP port (default {DEFAULT_PORT}; 0: any free port)')
     parser.add_argument('--host', default=DEFAULT_HOST,

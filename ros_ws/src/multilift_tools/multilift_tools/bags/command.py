@@ -81,7 +81,7 @@ def _play(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The `multilift bag` argument parser."""
     parser = argparse.ArgumentParser(prog='multilift bag', description=__doc__.split('\n')[0],
-                                     epilog='See the multilift_tools.bags package docstring for details.')
+                                     epilog='See the multilift_tools.bags package docstring.')
     verbs = parser.add_subparsers(dest='verb', required=True)
     info = verbs.add_parser('info', help='print a summary of a bag, as ros2 bag info')
     info.add_argument('bag', help='bag directory (or its .mcap file)')

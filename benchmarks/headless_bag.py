@@ -2,7 +2,7 @@
 of several repeats, so other processes on the machine disturb it little):
 
 - per message: rclpy (build the message with multilift_sim.ros.messages / markers, then
-  rclpy.serialization.serialize_message) against multilift_sim.cdr (pack from the same values);
+  rclpy.serialization.serialize_message) against multilift_sim.wire.cdr (pack from the same values);
 - per RK4 step (twin_lift, n = 2): the pure-Python float kernel against the compiled one;
 - a new process importing the compiled kernel from numba's cache and making its first call;
 - a headless twin_lift run with and without the bag, per tick.
@@ -37,11 +37,11 @@ def best_us(fn, number: int, repeat: int = 5) -> float:
 def messages_table() -> None:
     from rclpy.serialization import serialize_message
 
-    from multilift_sim import cdr, msgvalues
+    from multilift_sim.wire import cdr, msgvalues
     from multilift_sim import scenario as scenario_io
     from multilift_sim.ros import messages
     from multilift_sim.ros.markers import formation_markers
-    from multilift_sim.scene import FormationScene
+    from multilift_sim.wire.scene import FormationScene
     from multilift_sim.simulation import FormationSimulator
 
     scenario = scenario_io.load('twin_lift')

@@ -32,7 +32,7 @@ from multilift_sim.bag import BagWriter
 from multilift_tools.bags.play import (CLOCK_TOPIC, PlayEvent, play_events, playback_qos_policies,
                                       wall_offset)
 from multilift_tools.bags.summary import format_file_size, read_summary
-from multilift_sim.bagyaml import OfferedQos, qos_yaml
+from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
 from multilift_tools.topic_tools import RateWindow, format_hz
 from multilift_sim.topics import run_topics
 

@@ -28,7 +28,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from websockets.sync.client import connect
 
-from multilift_sim import msgdefs
+from multilift_sim.wire import msgdefs
 from multilift_tools.foxglove.bridge import is_bridged
 from multilift_tools.foxglove.server import SUBPROTOCOL
 from multilift_tools.foxglove.stamps import stamp_ns

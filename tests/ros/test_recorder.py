@@ -29,8 +29,8 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Int64, String
 
 from multilift_sim.bag import recover
-from multilift_sim import recording
-from multilift_sim.recording import LogTime, is_recordable, parse_topic_spec
+from multilift_sim.bag import recording
+from multilift_sim.bag.recording import LogTime, is_recordable, parse_topic_spec
 
 from conftest import ROOT, next_domain
 DOMAIN = next_domain()

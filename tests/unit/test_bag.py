@@ -15,7 +15,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.interfaces import QosDurability, QosHistory, QosReliability
 from std_msgs.msg import String
 
-from multilift_sim import bagyaml
+from multilift_sim.bag import metadata_yaml
 from multilift_sim.bag import BagError, BagWriter, recover
 
 # A profile exactly as `ros2 bag record` (Jazzy) stores it in an MCAP channel.
@@ -58,9 +58,9 @@ def _mcap(bag_dir: Path) -> Path:
 
 
 def test_qos_yaml_is_rosbag2_text():
-    assert bagyaml.qos_yaml([bagyaml.OfferedQos()]) == ROSBAG2_QOS
-    assert bagyaml.dump([]) == '[]'
-    assert bagyaml.parse_qos_yaml(ROSBAG2_QOS)[0]['durability'] == 'transient_local'
+    assert metadata_yaml.qos_yaml([metadata_yaml.OfferedQos()]) == ROSBAG2_QOS
+    assert metadata_yaml.dump([]) == '[]'
+    assert metadata_yaml.parse_qos_yaml(ROSBAG2_QOS)[0]['durability'] == 'transient_local'
 
 
 @pytest.mark.parametrize('compression', ['zstd', 'lz4', 'none'])

@@ -1,6 +1,6 @@
-"""multilift_sim.cdr against rclpy: every packer's bytes decode (with rosbags from the installed
-.msg definitions, and with rclpy) to the message the rclpy builders of multilift_sim.ros make
-from the same inputs, and equal rclpy's `serialize_message` except in the padding, which the
+"""multilift_sim.wire.cdr against rclpy: every packer's bytes decode (with rosbags from the
+installed .msg definitions, and with rclpy) to the message the rclpy builders of multilift_sim.ros
+make from the same inputs, and equal rclpy's `serialize_message` except in the padding, which the
 packers zero."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from multilift_sim import cdr, msgdefs, msgvalues
+from multilift_sim.wire import cdr, msgdefs, msgvalues
 from multilift_sim.ros import messages
 from multilift_sim.ros.markers import FormationMarkers
 

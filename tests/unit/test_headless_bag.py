@@ -11,7 +11,7 @@ import pytest
 
 from multilift_sim import scenario as scenario_io
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
-from multilift_sim.tick_messages import state_rows
+from multilift_sim.wire.tick_messages import state_rows
 from multilift_tools import headless_bag
 from multilift_tools.headless_bag import _record_per_object, record_headless
 

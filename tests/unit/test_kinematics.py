@@ -67,7 +67,7 @@ def test_euler_from_quaternion_inverts_quaternion_from_euler():
 
 def test_message_quaternion_is_quaternion_from_euler():
     """msgvalues.quaternion (plain floats, one attitude per message) against the array form."""
-    from multilift_sim.msgvalues import quaternion
+    from multilift_sim.wire.msgvalues import quaternion
     rng = np.random.default_rng(11)
     for eta in rng.uniform(-np.pi, np.pi, (200, 3)):
         np.testing.assert_allclose(quaternion(eta), quaternion_from_euler(eta), rtol=0,

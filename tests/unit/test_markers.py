@@ -16,7 +16,7 @@ from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.markers import (BODY_DIAMETER_ARMS, FormationMarkers, formation_markers,
                                    mission_corners, tension_color)
 from multilift_sim.simulation import FormationSimulator
-from multilift_sim.scene import CABLE_SEGMENTS
+from multilift_sim.wire.scene import CABLE_SEGMENTS
 
 
 def by_key(array: MarkerArray) -> dict[tuple[str, int], Marker]:

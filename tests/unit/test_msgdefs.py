@@ -15,7 +15,7 @@ from mcap_ros2.reader import read_ros2_messages
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from multilift_sim import msgdefs
+from multilift_sim.wire import msgdefs
 from multilift_sim.bag import BagWriter
 
 SEP = '=' * 80

@@ -10,7 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from multilift_sim import kernels, msgvalues
+from multilift_sim import kernels
+from multilift_sim.wire import msgvalues
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.kinematics import euler_rate_matrix, quaternion_from_euler, rotation_matrix

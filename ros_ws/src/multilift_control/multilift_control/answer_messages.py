@@ -1,15 +1,15 @@
 """A controller's answer as CDR bytes by topic (no rclpy): what the controller nodes publish
 as they are and what the headless bag writes, so both carry the same messages (see
-multilift_sim.tick_messages for the simulator's side)."""
+multilift_sim.wire.tick_messages for the simulator's side)."""
 from __future__ import annotations
 
 from typing import Sequence
 
 from multilift_control.runtime import ControllerAnswer
-from multilift_sim import cdr
-from multilift_sim.msgvalues import uav_frame
+from multilift_sim.wire import cdr
+from multilift_sim.wire.msgvalues import uav_frame
 from multilift_sim.scenario import Scenario
-from multilift_sim.tick_messages import Message
+from multilift_sim.wire.tick_messages import Message
 from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_ERROR, REFERENCE, ROTOR_CMD,
                                   uav_topic)
 

@@ -27,7 +27,7 @@ from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_DURATION, EVENT_E
 from multilift_sim.physics.measurement import odometry_states
 from multilift_sim.physics.sensors import sensed_states
 from multilift_sim import kernels
-from multilift_sim.msgvalues import formation_event
+from multilift_sim.wire.msgvalues import formation_event
 from multilift_sim.scenario import Scenario
 from multilift_sim.sensors import sensor_errors
 from multilift_sim.statistics import RunStatistics

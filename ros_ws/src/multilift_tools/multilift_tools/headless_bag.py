@@ -1,6 +1,6 @@
 """A headless run recorded to the same bag a ROS run gives: the same topics, the same messages,
 stamped with simulated time. No ROS graph and no rclpy: the bytes are the ones the nodes
-publish (multilift_sim.tick_messages for the simulator's, multilift_control.answer_messages
+publish (multilift_sim.wire.tick_messages for the simulator's, multilift_control.answer_messages
 for the controllers'), CDR packed straight from the tick's numbers with the padding zeroed, so
 two runs of a scenario write byte-identical bags.
 
@@ -27,13 +27,13 @@ from multilift_control.engine.arrays import MODE_CASCADE, TickRecord, engine_fli
 from multilift_control.headless import FlownRun, HeadlessRun, progress_ticker, run_headless
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
-from multilift_sim.bagyaml import OfferedQos, qos_yaml
+from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
 from multilift_sim.formulations import make_formulation
 from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables)
-from multilift_sim.tick_messages import SimulatorMessages, measured_odometry, state_rows
+from multilift_sim.wire.tick_messages import SimulatorMessages, measured_odometry, state_rows
 from multilift_sim.topics import MARKER_DECIMATION, scenario_topics
 
 # ticks per compiled call (and between two progress reports): 2.5 s of a 100 Hz mission

@@ -21,7 +21,7 @@ import threading
 import time
 from pathlib import Path
 
-from multilift_sim.msgdefs import ament_prefixes
+from multilift_sim.wire.msgdefs import ament_prefixes
 
 DISCOVERY_WAIT = 3.0  # [s] longest wait for the graph (Fast DDS may take 2.5 s to discover)
 SETTLE = 0.5  # [s] without graph change, once another node is seen, that ends the wait

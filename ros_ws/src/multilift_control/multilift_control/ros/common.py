@@ -7,7 +7,7 @@ import numpy as np
 from rclpy.node import Node
 
 from multilift_control.cascade import FormationStates, UavState
-from multilift_sim import cdr
+from multilift_sim.wire import cdr
 from multilift_sim.ros.common import Fatal, serve_controllers
 from multilift_sim.scenario import Scenario
 from multilift_sim.topics import FORMATION_SNAPSHOT as SNAPSHOT_TOPIC  # noqa: F401 (nodes)

@@ -25,7 +25,7 @@ from rclpy.node import Node
 from multilift_control.answer_messages import AnswerMessages
 from multilift_learning.batch import FormationBatch
 from multilift_learning.tasks import scenario_of
-from multilift_sim import cdr
+from multilift_sim.wire import cdr
 from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
                                       RawPublishers, controller_peers_missing, run_node,
                                       serve_controllers)

@@ -28,9 +28,9 @@ from rclpy.signals import SignalHandlerOptions
 from multilift_sim.kinematics import (euler_from_quaternion, quaternion_from_euler,  # noqa: F401
                                       rotation_matrix)
 
-from multilift_sim import msgvalues
+from multilift_sim.wire import msgvalues
 from multilift_sim.ros.fastdds import use_fastdds_profile
-from multilift_sim.msgvalues import WORLD_FRAME, uav_frame  # noqa: F401
+from multilift_sim.wire.msgvalues import WORLD_FRAME, uav_frame  # noqa: F401
 
 # Publishers keep their last messages for late joiners and our subscribers ask for them: a
 # controller or recorder whose subscription matched a moment after t = 0 was published still
@@ -218,7 +218,7 @@ FIRST_ACK_TIMEOUT = 2.0  # [s]
 
 class RawPublishers:
     """A node's publishers by topic, for messages that are already CDR bytes
-    (`multilift_sim.tick_messages.Message`: (topic, bytes)): sent as they are.
+    (`multilift_sim.wire.tick_messages.Message`: (topic, bytes)): sent as they are.
 
     `confirm_first` [s]: after the first `send`, wait up to this long until every subscriber of
     every topic acknowledged it (FIRST_ACK_TIMEOUT when recording; 0: no wait)."""

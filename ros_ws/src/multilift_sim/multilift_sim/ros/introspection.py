@@ -15,8 +15,8 @@ import yaml
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSProfile,
                        ReliabilityPolicy)
 
-from multilift_sim.bagyaml import OfferedQos
-from multilift_sim.msgdefs import MessageDefinitionError, split_type_name
+from multilift_sim.bag.metadata_yaml import OfferedQos
+from multilift_sim.wire.msgdefs import MessageDefinitionError, split_type_name
 
 # What the recorder asks for: our publishers are reliable + transient_local, so a recorder that
 # starts late still gets their startup messages.

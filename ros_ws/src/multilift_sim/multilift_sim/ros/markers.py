@@ -3,7 +3,8 @@
 Pure message building (no node, no publisher): `formation_markers(snapshot, tensions, scenario,
 stamp)` turns one simulator `Snapshot` into markers in the `world` frame that RViz and
 Foxglove's 3-D panel draw. What each marker is, where and in which colour is computed by
-multilift_sim.scene (`FormationScene`, see its docstring), which the headless bag packs too;
+multilift_sim.wire.scene (`FormationScene`, see its docstring), which the headless bag packs
+too;
 this module copies those values into rclpy messages.
 
 Cost: making a Marker message in rclpy is what costs (about 60 us each), so a
@@ -24,9 +25,10 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from multilift_sim.ros.common import WORLD_FRAME, stamp_from_ns
 from multilift_sim.scenario import Scenario
-from multilift_sim.scene import (BODY_DIAMETER_ARMS, BODY_HEIGHT, CABLE_WIDTH,  # noqa: F401
-                                 GUST_ALPHA, GUST_MARGIN, PATH_WIDTH, PAYLOAD_DIAMETER,
-                                 FormationScene, MarkerSpec, mission_corners, tension_color)
+from multilift_sim.wire.scene import (BODY_DIAMETER_ARMS, BODY_HEIGHT,  # noqa: F401
+                                      CABLE_WIDTH, GUST_ALPHA, GUST_MARGIN, PATH_WIDTH,
+                                      PAYLOAD_DIAMETER, FormationScene, MarkerSpec,
+                                      mission_corners, tension_color)
 from multilift_sim.simulation import Snapshot
 
 

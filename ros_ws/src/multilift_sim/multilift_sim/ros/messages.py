@@ -1,5 +1,5 @@
 """The multilift messages as rclpy objects, built from the same model values
-(multilift_sim.msgvalues) as the CDR bytes the nodes publish (multilift_sim.tick_messages,
+(multilift_sim.wire.msgvalues) as the CDR bytes the nodes publish (multilift_sim.wire.tick_messages,
 multilift_control.answer_messages): the independent reference tests/unit/test_cdr.py holds
 those bytes to. World frame, SI units.
 """
@@ -16,7 +16,7 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
-from multilift_sim import msgvalues
+from multilift_sim.wire import msgvalues
 from multilift_sim.kinematics import quaternion_from_euler
 from multilift_sim.ros.common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
 

@@ -60,11 +60,11 @@ from rclpy.signals import SignalHandlerOptions
 from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock
 
-from multilift_sim import recording
+from multilift_sim.bag import recording
 from multilift_sim.ros import introspection
 from multilift_sim.ros.fastdds import use_fastdds_profile
 from multilift_sim.bag import BagError, BagWriter
-from multilift_sim.bagyaml import qos_yaml
+from multilift_sim.bag.metadata_yaml import qos_yaml
 
 POLL_PERIOD = 0.5  # [s] graph poll for new topics
 DRAIN_QUIET = 0.3  # [s] without messages that ends the drain

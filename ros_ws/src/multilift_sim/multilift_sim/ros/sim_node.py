@@ -39,12 +39,12 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE,
-                                   MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
-                                   PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, parse_external,
-                                   state_topics, uav_topic)
+                                  MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
+                                  PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, parse_external,
+                                  state_topics, uav_topic)
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
                                       TickCables, run_seeds)
-from multilift_sim.tick_messages import SimulatorMessages
+from multilift_sim.wire.tick_messages import SimulatorMessages
 
 
 # [s] the graph stays complete this long before t = 0 when a user's node answers (see

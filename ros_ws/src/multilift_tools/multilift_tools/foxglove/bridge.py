@@ -164,7 +164,7 @@ class FoxgloveBridge:
         self._report_drops()
 
     def _add(self, topic: str, type_name: str) -> None:
-        from multilift_sim import msgdefs
+        from multilift_sim.wire import msgdefs
         from multilift_sim.ros import introspection
         try:
             msg_type = introspection.import_message_type(type_name)

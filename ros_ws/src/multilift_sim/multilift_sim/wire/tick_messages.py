@@ -3,8 +3,8 @@
 The simulator node publishes these bytes as they are (`Publisher.publish` of serialized
 bytes: about a fifth of the cost of building and serializing an rclpy message), and the
 headless bag writes the very same bytes, so a ROS run and a headless run carry the same
-messages by construction. The values come from multilift_sim.msgvalues and .scene, the
-packing from multilift_sim.cdr (tests/unit/test_cdr.py holds it to rclpy's serialization).
+messages by construction. The values come from multilift_sim.wire.msgvalues and .scene, the
+packing from multilift_sim.wire.cdr (tests/unit/test_cdr.py holds it to rclpy's serialization).
 World frame, SI units.
 """
 from __future__ import annotations
@@ -13,16 +13,16 @@ from typing import Sequence
 
 import numpy as np
 
-from multilift_sim import cdr
 from multilift_sim import kernels
-from multilift_sim.msgvalues import (IDENTITY, PAYLOAD_FRAME, SNAPSHOT_BLOCKS, formation_event,
-                                     formation_snapshot, uav_frame, vec3)
+from multilift_sim.wire import cdr
+from multilift_sim.wire.msgvalues import (IDENTITY, PAYLOAD_FRAME, SNAPSHOT_BLOCKS, formation_event,
+                                          formation_snapshot, uav_frame, vec3)
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS,
                                           MEASURED_POSITION, ODOMETRY_BODY_VELOCITY,
                                           ODOMETRY_COLUMNS, ODOMETRY_QUATERNION)
 from multilift_sim.physics.measurement import odometry_rows, odometry_states
 from multilift_sim.scenario import Scenario
-from multilift_sim.scene import FormationScene
+from multilift_sim.wire.scene import FormationScene
 from multilift_sim.simulation import Snapshot
 from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE, MARKERS,
                                   MEASURED_ODOM, PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, WIND,

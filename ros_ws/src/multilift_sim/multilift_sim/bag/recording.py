@@ -23,7 +23,7 @@ import bisect
 import time
 from typing import Callable
 
-from multilift_sim.msgdefs import MessageDefinitionError, split_type_name
+from multilift_sim.wire.msgdefs import MessageDefinitionError, split_type_name
 from multilift_sim.topics import CLOCK
 
 EXCLUDED_TOPICS = frozenset({'/rosout', '/parameter_events'})

@@ -2,7 +2,7 @@
 
 `FormationScene(scenario)` holds one `MarkerSpec` per marker of the scenario's MarkerArray, in
 the array's order; `update(...)` writes one tick's poses, cable points and colours into them.
-multilift_sim.ros.markers fills rclpy Marker messages from these specs and multilift_sim.cdr
+multilift_sim.ros.markers fills rclpy Marker messages from these specs and multilift_sim.wire.cdr
 packs CDR from them, so the node's array and the headless bag's hold the same values. The
 markers (world frame, z up, metres):
 
@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Sequence
 
-from multilift_sim.msgvalues import quaternion
+from multilift_sim.wire.msgvalues import quaternion
 from multilift_sim.scenario import Scenario
 
 PAYLOAD_DIAMETER = 0.3  # [m] drawn size of the payload (the model's payload is a point mass)

@@ -2,8 +2,8 @@
 
 Each packer compiles one `struct.Struct` for its message layout once (the frame names and the
 sequence lengths of a run are fixed), then packs a message in one call from plain numbers: the
-values come from multilift_sim.msgvalues and multilift_sim.scene, the same functions the rclpy
-builders of multilift_sim.ros.messages use. The bytes are rclpy's `serialize_message` output
+values come from `wire.msgvalues` and `wire.scene`, the same functions the rclpy builders of
+multilift_sim.ros.messages use. The bytes are rclpy's `serialize_message` output
 with the padding zeroed (rclpy leaves it uninitialised):
 
 - a 4-byte encapsulation header `00 01 00 00` (CDR, little endian), then the message;
@@ -19,8 +19,8 @@ from typing import Sequence
 
 import numpy as np
 
-from multilift_sim.msgvalues import WORLD_FRAME, stamp
-from multilift_sim.scene import MarkerSpec
+from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp
+from multilift_sim.wire.scene import MarkerSpec
 
 ENCAPSULATION = b'\x00\x01\x00\x00'
 _ZERO_VECTOR = (0.0, 0.0, 0.0)

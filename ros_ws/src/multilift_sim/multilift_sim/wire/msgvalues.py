@@ -1,6 +1,6 @@
 """The numbers our messages carry, computed once from model values (no rclpy, no message types).
 
-multilift_sim.cdr packs CDR straight from these functions (the bytes the nodes publish and the
+multilift_sim.wire.cdr packs CDR straight from these functions (the bytes the nodes publish and the
 headless bag writes), and multilift_sim.ros.messages fills rclpy messages from them, the
 reference the packed bytes are tested against. World frame, SI units.
 """

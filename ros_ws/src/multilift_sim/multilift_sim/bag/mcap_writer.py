@@ -33,7 +33,8 @@ from mcap.records import Channel, Message, MessageIndex, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
-from multilift_sim import bagyaml, msgdefs
+from multilift_sim.bag import metadata_yaml
+from multilift_sim.wire import msgdefs
 
 try:
     from zstandard import ZstdError
@@ -223,7 +224,7 @@ class BagWriter:
                   message_definition: str | None = None) -> None:
         """Declare topic `name` of type `pkg/msg/Type` before its first `write`.
 
-        `qos_yaml` is the publishers' offered QoS as rosbag2 stores it (`bagyaml.qos_yaml`;
+        `qos_yaml` is the publishers' offered QoS as rosbag2 stores it (`metadata_yaml.qos_yaml`;
         '' = unknown). The schema text and type hash are looked up on AMENT_PREFIX_PATH unless
         given. Declaring a topic again with the same type is a no-op.
         """
@@ -235,7 +236,7 @@ class BagWriter:
             return
         try:
             msgdefs.split_type_name(type_name)
-            profiles = bagyaml.parse_qos_yaml(qos_yaml)
+            profiles = metadata_yaml.parse_qos_yaml(qos_yaml)
             if type_name not in self._schema_ids:
                 text = (message_definition if message_definition is not None
                         else msgdefs.message_definition(type_name))
@@ -247,7 +248,7 @@ class BagWriter:
             raise BagError(f'cannot add topic {name} to bag {self.directory}: {error}') from None
         channel_id = self._writer.register_channel(
             name, MESSAGE_ENCODING, self._schema_ids[type_name],
-            {'offered_qos_profiles': bagyaml.dump(profiles),
+            {'offered_qos_profiles': metadata_yaml.dump(profiles),
              'topic_type_hash': type_description_hash})
         self._topics[name] = _Topic(name, type_name, profiles, type_description_hash, channel_id)
 
@@ -302,11 +303,11 @@ class BagWriter:
         self._closed = True
         try:
             info = self.metadata()
-            self._writer.add_metadata('rosbag2', {'serialized_metadata': bagyaml.dump(info)})
+            self._writer.add_metadata('rosbag2', {'serialized_metadata': metadata_yaml.dump(info)})
             self._writer.finish()
         finally:
             self._file.close()
-        text = bagyaml.dump({'rosbag2_bagfile_information': info}) + '\n'
+        text = metadata_yaml.dump({'rosbag2_bagfile_information': info}) + '\n'
         tmp = self.directory / 'metadata.yaml.tmp'
         tmp.write_text(text, encoding='utf-8')
         tmp.replace(self.directory / 'metadata.yaml')

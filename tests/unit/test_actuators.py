@@ -21,7 +21,8 @@ from multilift_control.engine import Engine
 from multilift_control.headless import run_headless
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
-from multilift_sim.dynamics import FormationModel, actuator_array
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import actuator_array
 from multilift_sim.physics.actuators import actuated_period, rotor_speed_at
 from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.formation_dae import integrate_period

@@ -15,7 +15,8 @@ import pytest
 
 from multilift_control import laws
 from multilift_control.controllers import MissionLeader
-from multilift_control.formation import FormationFollower, FormationGeometry, VirtualConstraints
+from multilift_control.formation import FormationFollower
+from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_control.headless import run_headless
 from multilift_control.laws import cascade, constraints, follower, linalg, mixer, reference
 from multilift_control.laws.layout import (CASCADE_GRAVITY, CASCADE_MAX_TILT,

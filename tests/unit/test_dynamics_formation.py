@@ -10,7 +10,8 @@ import pytest
 from multilift_sim.constraints import (cable_residual_rates, cable_residuals,
                                        constraint_jacobian, constraint_jacobian_rate_term)
 from multilift_sim.disturbances import Gust, gust_velocity, payload_drag
-from multilift_sim.dynamics import FormationModel, FormationParams, StateLayout
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.kinematics import euler_rate_matrix, rotation_matrix
 from multilift_sim.multirotor import MultirotorParams, euler_mass_matrix, euler_velocity_term
 from multilift_sim.slack import SlackCableModel

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from multilift_sim.dynamics import FormationModel, FormationParams, initial_state_single_lift
+from multilift_sim.dynamics import FormationModel, initial_state_single_lift
+from multilift_sim.formation_params import FormationParams
 from multilift_sim.frames import world_to_seed_vector
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state

@@ -14,7 +14,7 @@ import pytest
 from multilift_control.cascade import RotorMixer
 from multilift_control.engine import Engine
 from multilift_control.faults import RELEASE_TRANSITION, release_targets, target_schedule
-from multilift_control.formation import FormationGeometry, VirtualConstraints
+from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_control.engine.arrays import FINISHED, NOT_FINITE
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io

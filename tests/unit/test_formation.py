@@ -8,8 +8,9 @@ import pytest
 from scipy.linalg import expm
 
 from multilift_control.cascade import UavState
-from multilift_control.formation import (FormationFollower, FormationGeometry,
-                                         VirtualConstraints, virtual_forces)
+from multilift_control.formation import FormationFollower
+from multilift_control.virtual_constraints import (FormationGeometry, VirtualConstraints,
+                                                 virtual_forces)
 from multilift_sim.frames import seed_to_world_vector
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.multirotor import MultirotorParams

@@ -168,7 +168,7 @@ def test_layout_slots_tile_their_rows(prefix, columns, widths):
 
 
 def test_the_state_layout_is_the_slots():
-    from multilift_sim.dynamics import StateLayout
+    from multilift_sim.formation_params import StateLayout
     state = StateLayout(3)
     x = np.arange(state.size, dtype=float)
     assert state.n_coordinates == layout.n_coordinates(3) == 21

@@ -14,7 +14,8 @@ import pytest
 from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
 from multilift_sim.constraints import constraint_jacobian
-from multilift_sim.dynamics import FormationModel, StateLayout
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.modal import (coordinate_names, default_dependent_coordinates,
                                  elimination_basis, modal_analysis, mode_state,

@@ -22,14 +22,14 @@ from __future__ import annotations
 import numpy as np
 
 from multilift_control.cascade import RotorMixer
-from multilift_control.formation import FormationGeometry, VirtualConstraints
+from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_control.laws.layout import MIXER_SIZE
 from multilift_sim.formation_geometry import hanging_payload
 from multilift_sim.physics.layout import (EVENT_KIND, EVENT_ROTOR, EVENT_TICK, EVENT_UAV,
                                           EVENT_VALUE, KIND_CABLE_RELEASE,
                                           KIND_ROTOR_EFFECTIVENESS)
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import event_array
+from multilift_sim.schedules import event_array
 
 CLEAR_DISTANCE = 4.0  # [m] farther from the leader, horizontally, a released UAV flies
 RELEASE_TRANSITION = 5.0  # [s] the formation takes to move to its new offsets

@@ -24,7 +24,8 @@ from multilift_control.engine.arrays import engine_flies
 from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answer_tick,
                                        formation_runtimes, uav_states)
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, run_seeds
+from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot
+from multilift_sim.schedules import run_seeds
 
 # on_tick(simulator, snapshot at t, every controller's answer to it: none at the last tick)
 TickObserver = Callable[[FormationSimulator, Snapshot, list[ControllerAnswer]], None]

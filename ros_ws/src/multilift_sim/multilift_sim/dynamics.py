@@ -27,8 +27,10 @@ multilift_sim.physics.formation_dae):
 Forces: UAV i gets thrust ``u_T R(eta_i) e_z`` and gravity ``-m_i g e_z``, and body torque tau
 enters as ``W^T tau``; the payload gets gravity and the air-relative quadratic drag of
 disturbances.py (gusts included). Rotor speeds are held constant over each RK4 step; with
-lagging rotors (`vehicle.motor_time_constant`, `motor_rate_limit`) each step holds their speeds
-at its midpoint (multilift_sim.physics.actuators).
+lagging rotors (`vehicle.motor_time_constant`, `motor_rate_limit`) each step holds the speed
+whose square is the step's mean of omega^2 (multilift_sim.physics.actuators).
+
+The parameters and the state layout are multilift_sim.formation_params'.
 """
 from __future__ import annotations
 
@@ -40,150 +42,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from multilift_sim import kernels
-from multilift_sim.disturbances import Gust
 from multilift_sim.frames import seed_to_world_vector
-from multilift_sim.multirotor import MultirotorParams, rotational_kinetic_energy
-from multilift_sim.physics import layout as slots
-from multilift_sim.physics.layout import (
-    ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, CABLE_COLUMNS,
-    FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_WIND, UAV_DRAG,
-    FORMATION_INV_PAYLOAD_MASS, FORMATION_PAYLOAD_MASS, FORMATION_SCALARS, FORMATION_TWO_ALPHA,
-    GUST_CENTER, GUST_COLUMNS, GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED,
-    UAV_COLUMNS, UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS, WORK_ROWS, WRENCH_COLUMNS)
-
-
-@dataclass(frozen=True, kw_only=True)
-class FormationParams:
-    """Physical and numerical parameters of the formation DAE (world frame, SI units)."""
-
-    uavs: tuple[MultirotorParams, ...]       # UAV i = index i-1; UAV 1 is the leader
-    cable_lengths: tuple[float, ...]         # l_i [m], one per UAV
-    payload_mass: float                      # m_p [kg]
-    payload_drag_coefficient: float          # c_pd of seed Eq. 2.53 [N s^2/m^2]
-    baumgarte_alpha: float                   # alpha_f of seed Eq. 2.59 [1/s]
-    baumgarte_beta: float                    # beta_f of seed Eq. 2.59 [1/s]
-    gusts: tuple[Gust, ...] = ()             # 1-cosine gusts acting on the payload
-    gravity: float = 9.81                    # g [m/s^2], along -z of the world frame
-    wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world, everywhere
-
-    def __post_init__(self) -> None:
-        uavs = tuple(self.uavs)
-        if not uavs:
-            raise ValueError('FormationParams.uavs must hold at least one MultirotorParams')
-        for i, uav in enumerate(uavs):
-            if not isinstance(uav, MultirotorParams):
-                raise ValueError(f'FormationParams.uavs[{i}] must be a MultirotorParams, got '
-                                 f'{type(uav).__name__}')
-        lengths = tuple(float(v) for v in self.cable_lengths)
-        if len(lengths) != len(uavs):
-            raise ValueError(f'FormationParams.cable_lengths has {len(lengths)} entries for '
-                             f'{len(uavs)} UAVs')
-        for i, length in enumerate(lengths):
-            if not (math.isfinite(length) and length > 0):
-                raise ValueError(f'FormationParams.cable_lengths[{i}] (cable {i + 1}) must be '
-                                 f'finite and > 0 [m], got {length!r}')
-        gusts = tuple(self.gusts)
-        for i, gust in enumerate(gusts):
-            if not isinstance(gust, Gust):
-                raise ValueError(f'FormationParams.gusts[{i}] must be a Gust, got '
-                                 f'{type(gust).__name__}')
-        checks = (('payload_mass', lambda v: v > 0, '> 0'),
-                  ('payload_drag_coefficient', lambda v: v >= 0, '>= 0'),
-                  ('baumgarte_alpha', lambda v: v >= 0, '>= 0'),
-                  ('baumgarte_beta', lambda v: v >= 0, '>= 0'),
-                  ('gravity', lambda v: v >= 0, '>= 0'))
-        for name, rule, text in checks:
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and rule(value)):
-                raise ValueError(f'FormationParams.{name} must be finite and {text}, got '
-                                 f'{value!r}')
-        object.__setattr__(self, 'uavs', uavs)
-        object.__setattr__(self, 'cable_lengths', lengths)
-        object.__setattr__(self, 'gusts', gusts)
-        wind = tuple(float(v) for v in self.wind)
-        if len(wind) != 3 or not all(math.isfinite(v) for v in wind):
-            raise ValueError(f'FormationParams.wind must be a finite 3-vector [m/s], got '
-                             f'{self.wind!r}')
-        object.__setattr__(self, 'wind', wind)
-
-    @property
-    def n_uavs(self) -> int:
-        return len(self.uavs)
-
-
-@dataclass(frozen=True)
-class StateLayout:
-    """Named views into the packed formation state ``x = (q_f, q_f_dot)`` of length 2(6n+3).
-
-    Each accessor returns a view (writable when x is a contiguous float array), not a copy.
-    """
-
-    n_uavs: int
-
-    def __post_init__(self) -> None:
-        if self.n_uavs < 1:
-            raise ValueError(f'StateLayout.n_uavs must be >= 1, got {self.n_uavs}')
-
-    @property
-    def n_coordinates(self) -> int:
-        """Length of q_f: 6n + 3."""
-        return slots.n_coordinates(self.n_uavs)
-
-    @property
-    def size(self) -> int:
-        """Length of the state x: 2 (6n + 3)."""
-        return 2 * self.n_coordinates
-
-    def coordinates(self, x: np.ndarray) -> np.ndarray:
-        """q_f, shape (6n + 3,)."""
-        return x[:self.n_coordinates]
-
-    def rates(self, x: np.ndarray) -> np.ndarray:
-        """q_f_dot, shape (6n + 3,)."""
-        return x[self.n_coordinates:]
-
-    def _uav_block(self, q: np.ndarray) -> np.ndarray:
-        return q[:slots.payload_slot(self.n_uavs)].reshape(self.n_uavs, slots.UAV_COORDINATES)
-
-    def uav_positions(self, x: np.ndarray) -> np.ndarray:
-        """UAV centres of mass r_i [m], world, shape (n, 3)."""
-        return self._uav_block(self.coordinates(x))[:, slots.POSITION:slots.POSITION + 3]
-
-    def uav_euler(self, x: np.ndarray) -> np.ndarray:
-        """UAV ZYX Euler angles eta_i (roll, pitch, yaw) [rad], shape (n, 3)."""
-        return self._uav_block(self.coordinates(x))[:, slots.EULER:slots.EULER + 3]
-
-    def payload_position(self, x: np.ndarray) -> np.ndarray:
-        """Payload position r_p [m], world, shape (3,)."""
-        return self.coordinates(x)[slots.payload_slot(self.n_uavs):]
-
-    def uav_velocities(self, x: np.ndarray) -> np.ndarray:
-        """UAV velocities [m/s], world, shape (n, 3)."""
-        return self._uav_block(self.rates(x))[:, slots.POSITION:slots.POSITION + 3]
-
-    def uav_euler_rates(self, x: np.ndarray) -> np.ndarray:
-        """UAV Euler angle rates eta_dot_i [rad/s], shape (n, 3)."""
-        return self._uav_block(self.rates(x))[:, slots.EULER:slots.EULER + 3]
-
-    def payload_velocity(self, x: np.ndarray) -> np.ndarray:
-        """Payload velocity [m/s], world, shape (3,)."""
-        return self.rates(x)[slots.payload_slot(self.n_uavs):]
-
-    def pack(self, uav_positions: ArrayLike, uav_euler: ArrayLike, payload_position: ArrayLike,
-             uav_velocities: ArrayLike | None = None, uav_euler_rates: ArrayLike | None = None,
-             payload_velocity: ArrayLike | None = None) -> np.ndarray:
-        """Packed state from its parts (world frame, SI); omitted rates are zero."""
-        x = np.zeros(self.size)
-        self.uav_positions(x)[:] = np.reshape(uav_positions, (self.n_uavs, 3))
-        self.uav_euler(x)[:] = np.reshape(uav_euler, (self.n_uavs, 3))
-        self.payload_position(x)[:] = payload_position
-        if uav_velocities is not None:
-            self.uav_velocities(x)[:] = np.reshape(uav_velocities, (self.n_uavs, 3))
-        if uav_euler_rates is not None:
-            self.uav_euler_rates(x)[:] = np.reshape(uav_euler_rates, (self.n_uavs, 3))
-        if payload_velocity is not None:
-            self.payload_velocity(x)[:] = payload_velocity
-        return x
+from multilift_sim.multirotor import rotational_kinetic_energy
+from multilift_sim.formation_params import (FormationParams, StateLayout, actuator_array,
+                                             constant_arrays)
+from multilift_sim.physics.layout import CABLE_COLUMNS, FORMATION_WIND, WORK_ROWS, WRENCH_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -193,47 +56,6 @@ class Integration:
     cable_tension: np.ndarray      # T_i = 2 l_i lambda_i at the start [N], (n,)
     constraint: np.ndarray         # g_i at the end [m^2], (n,)
     constraint_rate: np.ndarray    # g_i_dot at the end [m^2/s], (n,)
-
-
-def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The constants the physics functions read (slots: multilift_sim.physics.layout):
-    (per-UAV rows (n, UAV_COLUMNS), gust rows (k, GUST_COLUMNS), the formation's scalars
-    (FORMATION_SCALARS,))."""
-    n = params.n_uavs
-    uavs = np.empty((n, UAV_COLUMNS))
-    moments = np.array([uav.inertia for uav in params.uavs], dtype=float).T      # (3, n)
-    uavs[:, UAV_MASS] = [uav.mass for uav in params.uavs]
-    uavs[:, UAV_LENGTH_SQ] = np.array(params.cable_lengths) ** 2
-    uavs[:, UAV_INV_INERTIA:UAV_INV_INERTIA + 3] = (1.0 / moments).T
-    # Euler's equation J omega_dot = tau - omega x J omega, per axis:
-    # omega_dot_x = tau_x / I_xx - (I_zz - I_yy) / I_xx omega_y omega_z, and cyclically.
-    uavs[:, UAV_DRAG] = [uav.drag_coefficient for uav in params.uavs]
-    uavs[:, UAV_GYRO:UAV_GYRO + 3] = np.array([(moments[2] - moments[1]) / moments[0],
-                                               (moments[0] - moments[2]) / moments[1],
-                                               (moments[1] - moments[0]) / moments[2]]).T
-    gusts = np.empty((len(params.gusts), GUST_COLUMNS))
-    for k, gust in enumerate(params.gusts):
-        gusts[k, GUST_CENTER:GUST_CENTER + 2] = gust.center
-        gusts[k, GUST_DIRECTION:GUST_DIRECTION + 3] = gust.direction
-        gusts[k, GUST_GRADIENT_DISTANCE] = gust.gradient_distance
-        gusts[k, GUST_REFERENCE_SPEED] = gust.reference_speed
-    formation = np.empty(FORMATION_SCALARS)
-    formation[FORMATION_PAYLOAD_MASS] = params.payload_mass
-    formation[FORMATION_INV_PAYLOAD_MASS] = 1.0 / float(params.payload_mass)
-    formation[FORMATION_GRAVITY] = params.gravity
-    formation[FORMATION_TWO_ALPHA] = 2.0 * params.baumgarte_alpha
-    formation[FORMATION_BETA_SQ] = params.baumgarte_beta ** 2
-    formation[FORMATION_DRAG] = params.payload_drag_coefficient
-    formation[FORMATION_WIND:FORMATION_WIND + 3] = params.wind
-    return uavs, gusts, formation
-
-
-def actuator_array(params: FormationParams) -> np.ndarray:
-    """Each UAV's rotor actuators (n, ACTUATOR_COLUMNS) (physics.layout ACTUATOR_*)."""
-    actuators = np.empty((params.n_uavs, ACTUATOR_COLUMNS))
-    actuators[:, ACTUATOR_TIME_CONSTANT] = [uav.motor_time_constant for uav in params.uavs]
-    actuators[:, ACTUATOR_RATE_LIMIT] = [uav.motor_rate_limit for uav in params.uavs]
-    return actuators
 
 
 class FormationModel:

@@ -13,7 +13,8 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike
 
-from multilift_sim.dynamics import FormationModel, FormationParams, Integration, StateLayout
+from multilift_sim.dynamics import FormationModel, Integration
+from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.nullspace import NullSpaceModel
 from multilift_sim.slack import SlackCableModel
 

@@ -51,7 +51,8 @@ import scipy.linalg
 from numpy.typing import ArrayLike
 
 from multilift_sim.constraints import cable_residuals, cable_tension, constraint_jacobian
-from multilift_sim.dynamics import FormationModel, FormationParams, StateLayout
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.multirotor import euler_mass_matrix
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import formation_start

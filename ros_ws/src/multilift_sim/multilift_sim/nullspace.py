@@ -31,7 +31,8 @@ from numpy.typing import ArrayLike
 from multilift_sim.constraints import (cable_residuals, cable_tension, constraint_jacobian,
                                        constraint_jacobian_rate_term)
 from multilift_sim.disturbances import gust_velocity, payload_drag
-from multilift_sim.dynamics import FormationModel, FormationParams, Integration
+from multilift_sim.dynamics import FormationModel, Integration
+from multilift_sim.formation_params import FormationParams
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.multirotor import euler_acceleration
 

@@ -11,27 +11,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_sim.dynamics import Integration, StateLayout, initial_state_single_lift
+from multilift_sim import kernels
+from multilift_sim.dynamics import Integration, initial_state_single_lift
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.formulations import make_formulation
 from multilift_sim.physics.events import apply_events, held_commands
-from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_DURATION, EVENT_END_TICK,
-                                          EVENT_KIND, EVENT_VELOCITY,
-                                          EVENT_KINDS, EVENT_ROTOR, EVENT_TICK, EVENT_TIME,
-                                          EVENT_UAV, EVENT_VALUE,
-                                          MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
+from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
                                           ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
 from multilift_sim.physics.measurement import odometry_states
 from multilift_sim.physics.sensors import sensed_states
-from multilift_sim import kernels
-from multilift_sim.wire.msgvalues import formation_event
 from multilift_sim.scenario import Scenario
-from multilift_sim.sensors import sensor_errors
+from multilift_sim.schedules import event_array, event_records, sensor_arrays, wind_series
 from multilift_sim.statistics import RunStatistics
-from multilift_sim.turbulence import dryden_series
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
 
 
@@ -89,117 +84,6 @@ def swing_sampling(n_uavs: int) -> int:
     closed form); from three on, where rigid cables hold the payload at its equilibrium place,
     every 10th (10 Hz of a 100 Hz loop)."""
     return 1 if n_uavs <= 2 else 10
-
-
-def event_array(scenario: Scenario) -> np.ndarray:
-    """The scenario's events as rows (k, EVENT_COLUMNS) (physics.layout EVENT_*), in time
-    order, each at the first control tick at or after its time."""
-    rows = np.zeros((len(scenario.events), EVENT_COLUMNS))
-    rate = scenario.simulation.control_rate
-    for k, event in enumerate(scenario.events):
-        rows[k, EVENT_TICK] = math.ceil(event.time * rate - 1e-9)
-        rows[k, EVENT_TIME] = event.time
-        rows[k, EVENT_KIND] = EVENT_KINDS.index(event.type)
-        rows[k, EVENT_UAV] = event.uav - 1
-        rows[k, EVENT_ROTOR] = max(event.rotor - 1, 0)
-        if event.type == 'controller_silence':
-            rows[k, EVENT_VALUE] = event.duration
-            rows[k, EVENT_END_TICK] = math.ceil((event.time + event.duration) * rate - 1e-9)
-        elif event.type == 'gust':
-            rows[k, EVENT_VALUE] = math.sqrt(sum(v * v for v in event.velocity))
-            rows[k, EVENT_DURATION] = event.duration
-            rows[k, EVENT_VELOCITY:EVENT_VELOCITY + 3] = event.velocity
-        else:
-            rows[k, EVENT_VALUE] = event.effectiveness
-    return rows
-
-
-def wind_series(scenario: Scenario) -> np.ndarray:
-    """The unsteady wind [m/s], world, of every control period of the run, (ticks + 1, 3), or
-    (0, 3) where the wind is steady: tick k's is held over the period from it, added to the
-    steady wind. The Dryden turbulence sampled at the tick (`turbulence.dryden_series`,
-    `wind.turbulence`) plus the gust events' 1-cosine profiles averaged over the period
-    (`gust_profile_mean`, docs/wind.md)."""
-    sim = scenario.simulation
-    gusts = [e for e in scenario.events if e.type == 'gust']
-    if scenario.turbulence is None and not gusts:
-        return np.zeros((0, 3))
-    series = np.zeros((sim.tick_count + 1, 3))
-    config = scenario.turbulence
-    if config is not None:
-        series += dryden_series(sim.tick_count + 1, 1.0 / sim.control_rate, config.intensity,
-                                config.length_scale, config.airspeed, scenario.wind,
-                                config.seed)
-    starts = np.arange(sim.tick_count + 1) / sim.control_rate
-    for gust in gusts:
-        series += np.outer(gust_profile_mean(starts, 1.0 / sim.control_rate, gust.time,
-                                             gust.duration), gust.velocity)
-    return series
-
-
-def gust_profile_mean(starts: np.ndarray, period: float, onset: float,
-                      duration: float) -> np.ndarray:
-    """The mean over each period [s, s + period] (starts (K,) [s]) of a 1-cosine gust's
-    profile p(t) = (1 - cos(2 pi (t - onset) / D)) / 2 for onset <= t <= onset + D, 0 outside
-    (the time form of seed Eq. 2.55's 1-cosine shape): its integral over the period's overlap
-    with the gust, in closed form, divided by the period."""
-    a = np.clip(starts, onset, onset + duration)
-    b = np.clip(starts + period, onset, onset + duration)
-    w = 2.0 * math.pi / duration
-    integral = 0.5 * (b - a) - (np.sin(w * (b - onset)) - np.sin(w * (a - onset))) / (2.0 * w)
-    return integral / period
-
-
-@dataclass(frozen=True)
-class SensorArrays:
-    """A run's sensors as `physics.sensors.sensed_states` reads them (`sensors:`): every
-    sample's errors and arrivals (`sensors.sensor_errors`), ticks between samples and from a
-    sample to its arrival. Without sensors, no samples."""
-    errors: np.ndarray       # (S, n, MEASURED_COLUMNS) [the slots' units]
-    delivered: np.ndarray    # (S, n) bool
-    every: int               # control ticks between two samples
-    latency: int             # control ticks from a sample to its arrival
-
-    @property
-    def on(self) -> bool:
-        return len(self.errors) > 0
-
-    def memory(self) -> tuple[np.ndarray, np.ndarray]:
-        """Fresh (history (latency + 1, n, MEASURED_COLUMNS), seen (n, MEASURED_COLUMNS):
-        NaN, nothing received yet) for a run's start."""
-        n = self.errors.shape[1]
-        return (np.zeros((self.latency + 1, n, MEASURED_COLUMNS)),
-                np.full((n, MEASURED_COLUMNS), math.nan))
-
-
-def sensor_arrays(scenario: Scenario) -> SensorArrays:
-    """The scenario's `sensors:` as arrays (none without them)."""
-    config, sim, n = scenario.sensors, scenario.simulation, scenario.n_uavs
-    if config is None:
-        return SensorArrays(np.zeros((0, n, MEASURED_COLUMNS)), np.zeros((0, n), dtype=bool),
-                            1, 0)
-    errors, delivered = sensor_errors(config, n, sim.tick_count, sim.control_rate)
-    return SensorArrays(errors, delivered, config.every(sim.control_rate),
-                        config.latency_ticks)
-
-
-def run_seeds(scenario: Scenario) -> dict[str, int]:
-    """The seeds a run's random draws come from, by what they draw (`sensors`, `turbulence`),
-    as its summary records them: none where it draws nothing."""
-    seeds = {}
-    if scenario.sensors is not None:
-        seeds['sensors'] = scenario.sensors.seed
-    if scenario.turbulence is not None:
-        seeds['turbulence'] = scenario.turbulence.seed
-    return seeds
-
-
-def event_records(rows: np.ndarray) -> list[dict]:
-    """Event rows (physics.layout EVENT_*) as a run's summary lists them: each with its
-    scheduled time [s], type, uav (from 1), rotor (from 1; 0: none), value and description
-    (msgvalues.formation_event, what /formation/events carries)."""
-    keys = ('type', 'uav', 'rotor', 'value', 'time', 'description')
-    return [dict(zip(keys, formation_event(row))) for row in rows]
 
 
 def initial_state(scenario: Scenario) -> np.ndarray:

@@ -31,7 +31,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from multilift_sim.dynamics import FormationModel, FormationParams
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import FormationParams
 from multilift_sim.physics.layout import CABLE_COLUMNS
 
 

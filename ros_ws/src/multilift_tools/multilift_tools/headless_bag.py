@@ -31,8 +31,7 @@ from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
 from multilift_sim.formulations import make_formulation
 from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
-                                      TickCables)
+from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, TickCables
 from multilift_sim.wire.tick_messages import SimulatorMessages, measured_odometry, state_rows
 from multilift_sim.topics import MARKER_DECIMATION, scenario_topics
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from multilift_sim.dynamics import StateLayout
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.modal import MODE_KINDS, ModalAnalysis, coordinate_names, scenario_modal_analysis
 from multilift_sim.scenario import ScenarioError, load
 

@@ -21,11 +21,12 @@ from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_MEMORY_SIZ
                                            FOLLOWER_SIZE, FOLLOWER_TWO_ALPHA, REFERENCE_SIZE,
                                            ROW_SIZE, UAV_STATE_SIZE)
 from multilift_control.runtime import ThrustBook
-from multilift_sim.dynamics import FormationModel, actuator_array, constant_arrays
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import actuator_array, constant_arrays
 from multilift_sim.physics.layout import UAV_MASS
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import (cable_reach, event_array, initial_state, sensor_arrays,
-                                      swing_sampling, wind_series)
+from multilift_sim.simulation import cable_reach, initial_state, swing_sampling
+from multilift_sim.schedules import event_array, sensor_arrays, wind_series
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
 

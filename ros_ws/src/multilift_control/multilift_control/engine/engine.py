@@ -11,9 +11,10 @@ from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAIN
                                              RUNNING, FormationArrays, FormationMemory,
                                              TickRecord, batch_arrays, empty_record)
 from multilift_control.laws.layout import REFERENCE_SIZE, UAV_STATE_SIZE
-from multilift_sim.dynamics import StateLayout
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import event_records, run_seeds, stop_message
+from multilift_sim.simulation import stop_message
+from multilift_sim.schedules import event_records, run_seeds
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
 from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE

@@ -42,8 +42,8 @@ from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_S
                                   MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
                                   PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, parse_external,
                                   state_topics, uav_topic)
-from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot,
-                                      TickCables, run_seeds)
+from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, TickCables
+from multilift_sim.schedules import run_seeds
 from multilift_sim.wire.tick_messages import SimulatorMessages
 
 

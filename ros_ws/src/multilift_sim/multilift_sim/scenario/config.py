@@ -8,7 +8,7 @@ import math
 from dataclasses import dataclass, field
 
 from multilift_sim.disturbances import Gust
-from multilift_sim.dynamics import FormationParams
+from multilift_sim.formation_params import FormationParams
 from multilift_sim.formation_geometry import FORMATION_GEOMETRIES  # noqa: F401 (the registry)
 from multilift_sim.multirotor import MultirotorParams
 

@@ -79,7 +79,7 @@ def _still_air(name: str, progress: _ProgressFile) -> dict:
 
 def _modal_case(figures: Path, progress: _ProgressFile) -> dict:
     """Modal analyses of the twin-lift (Fig. 2.12) and the V at their Eq. 2.73 equilibria."""
-    from multilift_sim.dynamics import StateLayout
+    from multilift_sim.formation_params import StateLayout
     from multilift_sim.modal import coordinate_names, scenario_modal_analysis
     from multilift_tools.modal_cli import plot_eigenvalues
 

@@ -149,7 +149,7 @@ def single_lift_table(study_dir: str | Path | None = None) -> list[dict]:
     against m_p g. `study_dir`: where the Baumgarte study writes its table and figures (Fig.
     4.2, 4.3); default a temporary directory, removed.
     """
-    from multilift_sim.dynamics import StateLayout
+    from multilift_sim.formation_params import StateLayout
     from multilift_sim.frames import world_to_seed_vector
     from multilift_sim.modal import scenario_modal_analysis
     from multilift_sim.simulation import initial_state

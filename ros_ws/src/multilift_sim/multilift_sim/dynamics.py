@@ -69,8 +69,8 @@ class FormationModel:
 
     The arithmetic is `multilift_sim.physics.formation_dae` (numba functions over the arrays
     this model builds once: `constant_arrays`), compiled just in time, or under
-    MULTILIFT_KERNEL=python (or aot: the physics is not built ahead of time) its uncompiled
-    run, the same source run by Python (`kernels.runnable`).
+    MULTILIFT_KERNEL=python its uncompiled run, the same source run by Python
+    (`kernels.runnable`, resolved once when the model is made).
     """
 
     slack_cables = False  # whether its cables go slack (SlackCableModel)
@@ -101,8 +101,9 @@ class FormationModel:
         # for a released one (physics.events); the released ones never constrain again
         self._taut = np.ones(n, dtype=bool)
         self.released = np.zeros(n, dtype=bool)
-        # (MULTILIFT_KERNEL, {name: physics function}), made on first use
-        self._loaded: tuple[str, dict[str, Callable]] | None = None
+        # {name: physics function} as MULTILIFT_KERNEL said when the model was made (read once)
+        self._mode = kernels.mode()
+        self._loaded: dict[str, Callable] | None = None
 
     @property
     def taut(self) -> np.ndarray:
@@ -126,12 +127,12 @@ class FormationModel:
                 'air_velocity': air_velocity, 'actuated_period': actuated_period}
 
     def _physics(self) -> dict[str, Callable]:
-        """_physics_functions as MULTILIFT_KERNEL says, loaded once per mode."""
-        mode = kernels.mode()
-        if self._loaded is None or self._loaded[0] != mode:
-            self._loaded = (mode, {name: kernels.runnable(function) for name, function
-                                   in self._physics_functions().items()})
-        return self._loaded[1]
+        """_physics_functions as MULTILIFT_KERNEL said when the model was made, loaded on first
+        use."""
+        if self._loaded is None:
+            self._loaded = {name: kernels.runnable(function, self._mode) for name, function
+                            in self._physics_functions().items()}
+        return self._loaded
 
     def _wrench_array(self, wrenches: ArrayLike) -> np.ndarray:
         wrenches = np.ascontiguousarray(wrenches, dtype=np.float64)

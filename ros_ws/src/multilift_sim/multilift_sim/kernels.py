@@ -101,18 +101,19 @@ def enabled() -> bool:
     return compiled_module(PHYSICS) is not None
 
 
-def runnable(function: Callable) -> Callable:
+def runnable(function: Callable, kernel: str | None = None) -> Callable:
     """A compiled function (a numba dispatcher, or a plain function where numba does not
-    import) as MULTILIFT_KERNEL says: compiled, else its uncompiled run (`uncompiled`)."""
-    module = compiled_module(function.__module__)
+    import) as `kernel` (one of MODES; default: MULTILIFT_KERNEL now) says: compiled, else its
+    uncompiled run (`uncompiled`). Resolve it once and keep it: the environment is read here."""
+    module = compiled_module(function.__module__, kernel)
     return uncompiled(function) if module is None else getattr(module, function.__name__)
 
 
-def compiled_module(name: str) -> Any:
+def compiled_module(name: str, kernel: str | None = None) -> Any:
     """Module `name` of compiled functions (imported once per mode), or None when the
-    uncompiled reference is to be used (MULTILIFT_KERNEL=python, or numba missing under
-    auto)."""
-    key = (name, mode())
+    uncompiled reference is to be used (`kernel` (default MULTILIFT_KERNEL) python, or numba
+    missing under auto)."""
+    key = (name, mode() if kernel is None else kernel)
     if key not in _modules:
         compiled = None
         if key[1] != 'python':

@@ -165,6 +165,10 @@ class FormationSimulator:
         self._set_wind()
         # what the controllers receive (physics.sensors): its arrays and memory
         self.sensors = sensor_arrays(scenario)
+        # the functions of events and sensors, compiled or not as MULTILIFT_KERNEL says now
+        self._sensed_states = kernels.runnable(sensed_states)
+        self._held_commands = kernels.runnable(held_commands)
+        self._apply_events_function = kernels.runnable(apply_events)
         self._sensor_history, self._sensor_seen = self.sensors.memory()
         self._apply_events()
         rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
@@ -196,7 +200,7 @@ class FormationSimulator:
         measured = odometry[:, :MEASURED_COLUMNS].copy()
         sensors = self.sensors
         if sensors.on:
-            kernels.runnable(sensed_states)(
+            self._sensed_states(
                 measured, self.tick, sensors.errors, sensors.delivered, sensors.every,
                 sensors.latency, self._sensor_history, self._sensor_seen)
         uavs = tuple(UavSnapshot(
@@ -264,7 +268,7 @@ class FormationSimulator:
         for i, (own, own_flags) in enumerate(zip(speeds, saturated)):
             padded[i, :len(own)] = own
             flags[i, :len(own)] = own_flags
-        kernels.runnable(held_commands)(padded, flags, self.tick, self.silent_until, self.held,
+        self._held_commands(padded, flags, self.tick, self.silent_until, self.held,
                                         self.held_saturated)
         if self._uniform_rotors is not None:
             return self.held.copy(), self.held_saturated.copy()
@@ -300,7 +304,7 @@ class FormationSimulator:
         first = self.next_event
         if first < len(self.events):
             model = self.model
-            self.next_event = kernels.runnable(apply_events)(
+            self.next_event = self._apply_events_function(
                 self.events, first, self.tick, model.effectiveness, model.taut,
                 model.released, self.silent_until)
         self.happened = range(first, self.next_event)

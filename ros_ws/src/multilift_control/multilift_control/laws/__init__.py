@@ -1,8 +1,7 @@
 """The control laws, each written once: numba functions over float arrays (constants, memory,
 states), compiled just in time (`numba.njit(cache=True)`, the cache under NUMBA_CACHE_DIR) or
 run uncompiled (`multilift_sim.kernels.uncompiled`: their own source in Python), as
-MULTILIFT_KERNEL says (`runnable`, which is `kernels.runnable`: under aot, "built ahead of time
-or the uncompiled run", the laws run uncompiled, having no ahead-of-time build).
+MULTILIFT_KERNEL says (`runnable`, which is `kernels.runnable`).
 
 One concern per module: `layout` (the named slots of every array below), `reference` (the
 mission reference and its prefilter), `cascade` (position loop, attitude from force, attitude

@@ -208,7 +208,7 @@ class FormationFollower:
         of the O(n^3) solve of the general law (`laws.follower.linear_virtual_force`).
         Returns (P (3, m), Q (3, 3n)), read-only."""
         c = self.constraints
-        jac = c.jacobian(np.zeros((c.n, 3)))
+        jac = c.linear_jacobian
         a_plus = _law_inverse(jac, np.repeat(1.0 / self.masses, 3))
         p = -(jac[:, 3 * self.index:3 * self.index + 3].T @ a_plus)
         q = p @ jac

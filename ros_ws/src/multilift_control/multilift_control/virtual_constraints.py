@@ -6,6 +6,7 @@ arithmetic is the laws' (`laws.constraints` the rows, `laws.follower` the forces
 build their arrays once and call them. The follower that keeps them is `formation.py`'s."""
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -16,6 +17,7 @@ from multilift_control.laws import constraints as rows_laws
 from multilift_control.laws.follower import virtual_forces as virtual_forces_law
 from multilift_control.laws.layout import ROW_AXIS, ROW_DISTANCE, ROW_FIRST, ROW_SECOND, ROW_SIZE
 from multilift_sim import formation_geometry  # start places and the V offsets v_1i, world
+from multilift_sim import kernels
 
 GEOMETRIES = formation_geometry.FORMATION_GEOMETRIES  # seed Table 3.1: the one registry
 
@@ -151,7 +153,12 @@ class VirtualConstraints:
         self._rates = laws.runnable(rows_laws.rates)
         self._jacobian_rate_product = laws.runnable(rows_laws.jacobian_rate_product)
         self._free_follower_motions = laws.runnable(rows_laws.free_follower_motions)
-        self._rows_of = laws.runnable(rows_laws.rows_of)
+        # one-time queries of a formation's set-up (a follower's rows, the linear rows'
+        # constant Jacobian): the laws' own source run uncompiled, the same numbers without
+        # loading two more compiled functions from numba's cache (about 0.2 s of a process's
+        # start; the uncompiled Jacobian of a V of 100 takes 0.6 ms)
+        self._rows_of = kernels.uncompiled(rows_laws.rows_of)
+        self._setup_jacobian = kernels.uncompiled(rows_laws.jacobian)
 
     def offsets(self) -> np.ndarray:
         """(n-1, 3) desired r_1 - r_i per follower [m], world (linear and v only)."""
@@ -181,6 +188,16 @@ class VirtualConstraints:
     def jacobian(self, r: np.ndarray) -> np.ndarray:
         """J_vc = d g_vc / d r_f, shape (m, 3n); constant (Eq. 3.7) for linear rows."""
         return self._jacobian(self.rows, self._check(r))
+
+    @functools.cached_property
+    def linear_jacobian(self) -> np.ndarray:
+        """J_vc of linear (and V) rows, constant (Eq. 3.7), shape (m, 3n), read-only."""
+        if not self.linear:
+            raise ValueError(f'the {self.geometry.kind!r} rows are not linear: their J_vc '
+                             'depends on r (`jacobian`)')
+        jac = self._setup_jacobian(self.rows, np.zeros((self.n, 3)))
+        jac.flags.writeable = False
+        return jac
 
     def rate(self, r: np.ndarray, v: np.ndarray) -> np.ndarray:
         """g_vc_dot = J_vc r_f_dot (m,): [m/s] or [m^2/s]."""

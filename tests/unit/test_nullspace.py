@@ -193,3 +193,50 @@ def test_study_main_bad_input_is_one_line_and_exit_2(tmp_path, capsys, argv):
     assert study_main(argv + ['--out', str(tmp_path / 'x')]) == 2
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and err.startswith('error: ')
+
+
+@pytest.mark.parametrize('name', ['twin_lift', 'circle3'])
+def test_the_null_space_form_compiled_is_its_source_bit_for_bit(name):
+    """physics.nullspace (written once, compiled; issue 19): the solve and the projection in
+    numba and as the same source run by Python give the same bits, and the accelerations
+    equal the multiplier form's without Baumgarte (Eq. 2.57 is g_ddot = 0) to rounding."""
+    from multilift_sim import kernels
+    from multilift_sim.physics.nullspace import nullspace_solve, project, translational_masses
+
+    scenario = load(name)
+    model = NullSpaceModel(scenario.formation_params())
+    formation = model.formation
+    x = initial_state(scenario)
+    rng = np.random.default_rng(3)
+    layout = model.layout
+    layout.uav_velocities(x)[:] = rng.normal(0.0, 0.5, layout.uav_velocities(x).shape)
+    layout.payload_velocity(x)[:] = rng.normal(0.0, 0.5, 3)
+    wrenches = model.wrenches([np.full(u.vehicle.n_rotors, 1500.0) for u in scenario.uavs])
+    results = []
+    for function in (nullspace_solve, kernels.uncompiled(nullspace_solve)):
+        acc, multipliers = np.empty(layout.n_coordinates), np.empty(scenario.n_uavs)
+        function(x, wrenches, formation._uavs, formation._gusts, formation._formation, acc,
+                 multipliers)
+        results.append((acc, multipliers))
+    assert all(np.array_equal(a, b) for a, b in zip(*results))
+    multiplier_form = FormationModel(dataclasses.replace(scenario.formation_params(),
+                                                         baumgarte_alpha=0.0,
+                                                         baumgarte_beta=0.0))
+    expected_acc, expected_multipliers = multiplier_form.accelerations_from_wrenches(x, wrenches)
+    acc, multipliers = results[0]
+    assert np.abs(acc - expected_acc).max() < 1e-9 * np.abs(expected_acc).max()
+    assert np.abs(multipliers - expected_multipliers).max() < 1e-9 * np.abs(
+        expected_multipliers).max()
+    # the projection: from positions 1 mm off, onto |g| <= 1e-14 l^2, the same bits both ways
+    masses = translational_masses(formation._uavs, formation._formation)
+    off = x.copy()
+    layout.payload_position(off)[:] += 1e-3
+    projected = []
+    for function in (project, kernels.uncompiled(project)):
+        state = off.copy()
+        function(state, formation._uavs, masses, 1e-14, 4)
+        projected.append(state)
+    assert np.array_equal(*projected)
+    g, g_dot = model.constraint_residuals(projected[0])
+    assert np.abs(g).max() <= 1e-14 * model.cable_lengths.max() ** 2
+    assert np.abs(g_dot).max() < 1e-12

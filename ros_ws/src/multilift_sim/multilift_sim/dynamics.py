@@ -46,7 +46,8 @@ from multilift_sim.frames import seed_to_world_vector
 from multilift_sim.multirotor import rotational_kinetic_energy
 from multilift_sim.formation_params import (FormationParams, StateLayout, actuator_array,
                                              constant_arrays)
-from multilift_sim.physics.layout import CABLE_COLUMNS, FORMATION_WIND, WORK_ROWS, WRENCH_COLUMNS
+from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_NULL_SPACE, FORMATION_WIND,
+                                          WORK_ROWS, WRENCH_COLUMNS)
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,7 @@ class FormationModel:
 
     slack_cables = False  # whether its cables go slack (SlackCableModel)
 
-    def __init__(self, params: FormationParams):
+    def __init__(self, params: FormationParams, null_space: bool = False):
         self.params = params
         self.layout = StateLayout(params.n_uavs)
         n = params.n_uavs
@@ -94,6 +95,8 @@ class FormationModel:
         self.payload_mass = float(params.payload_mass)
         self.gravity = float(params.gravity)
         self._uavs, self._gusts, self._formation = constant_arrays(params)
+        # `null_space`: q_ddot by Eq. 2.71-2.72 (physics.nullspace; nullspace.NullSpaceModel)
+        self._formation[FORMATION_NULL_SPACE] = 1.0 if null_space else 0.0
         self._actuators = actuator_array(params)
         self.rotors = np.full(self.allocation.shape[::2], math.nan)
         self.effectiveness = np.ones(self.allocation.shape[::2])

@@ -15,7 +15,8 @@ from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (
     ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, FORMATION_BETA_SQ,
-    FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_PAYLOAD_MASS,
+    FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
+    FORMATION_PAYLOAD_MASS,
     FORMATION_SCALARS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_COLUMNS,
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, UAV_COLUMNS, UAV_DRAG,
     UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS)
@@ -185,6 +186,7 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     formation[FORMATION_BETA_SQ] = params.baumgarte_beta ** 2
     formation[FORMATION_DRAG] = params.payload_drag_coefficient
     formation[FORMATION_WIND:FORMATION_WIND + 3] = params.wind
+    formation[FORMATION_NULL_SPACE] = 0.0  # the multipliers' form (nullspace.NullSpaceModel: 1)
     return uavs, gusts, formation
 
 

@@ -15,61 +15,17 @@ The equations (dynamics.py's docstring): with f the unconstrained forces,
 the (6n+3)^2 matrices: each UAV's attitude on its own, and the n x n cable system by the
 Woodbury identity (`cable_multipliers`).
 """
-import math
-
 import numpy as np
 
 from multilift_sim.kernels import jit
+from multilift_sim.physics.free_motion import (air_velocity,  # noqa: F401 - its users' name
+                                              payload_force_per_mass, uav_free_motion)
+from multilift_sim.physics.nullspace import nullspace_solve
 from multilift_sim.physics.layout import (
-    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST, EULER,
-    FORMATION_BETA_SQ, FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
-    FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_DIRECTION,
-    GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, PAYLOAD_COORDINATES, POSITION, UAV_DRAG,
-    UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS, UAV_COORDINATES, WORK_ACC, WORK_K1, WORK_K2,
-    WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE, WRENCH_THRUST, WRENCH_TORQUE)
-
-
-@jit
-def air_velocity(px, py, gusts):
-    """The air velocity w [m/s], world, at a point (px, py) [m] of the horizontal plane (the
-    height does not matter): the sum of the 1-cosine gusts (Eq. 2.55), each of its speed along
-    its direction, r the horizontal distance from its centre (a square root, not math.hypot:
-    Python's and the C library's hypot round differently, and the uncompiled run must give
-    the compiled one's bits)."""
-    air_x = air_y = air_z = 0.0
-    for k in range(gusts.shape[0]):
-        east, north = px - gusts[k, GUST_CENTER], py - gusts[k, GUST_CENTER + 1]
-        radius = math.sqrt(east * east + north * north)
-        h = gusts[k, GUST_GRADIENT_DISTANCE]
-        if radius > h:
-            speed = 0.0
-        else:
-            speed = 0.5 * gusts[k, GUST_REFERENCE_SPEED] * (1.0 + math.cos(math.pi * radius / h))
-        if speed != 0.0:
-            air_x += speed * gusts[k, GUST_DIRECTION]
-            air_y += speed * gusts[k, GUST_DIRECTION + 1]
-            air_z += speed * gusts[k, GUST_DIRECTION + 2]
-    return air_x, air_y, air_z
-
-
-@jit
-def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
-    """Drag (gusts and the steady wind included) on the payload over m_p [m/s^2], world,
-    gravity excluded: at payload position (px, py, pz) [m] and velocity (pvx, pvy, pvz)
-    [m/s]. (The numpy form is disturbances.payload_drag and gust_velocity; tests hold them
-    equal.)"""
-    drag = formation[FORMATION_DRAG]
-    if drag <= 0.0:
-        return 0.0, 0.0, 0.0
-    air_x, air_y, air_z = air_velocity(px, py, gusts)
-    air_x += formation[FORMATION_WIND]
-    air_y += formation[FORMATION_WIND + 1]
-    air_z += formation[FORMATION_WIND + 2]
-    rel_x, rel_y, rel_z = pvx - air_x, pvy - air_y, pvz - air_z
-    # Eq. 2.53 on the air-relative velocity: -c_pd v_rel |v_rel| / m_p
-    scale = (-drag * formation[FORMATION_INV_PAYLOAD_MASS]
-             * math.sqrt(rel_x * rel_x + rel_y * rel_y + rel_z * rel_z))
-    return scale * rel_x, scale * rel_y, scale * rel_z
+    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ,
+    FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
+    FORMATION_TWO_ALPHA, PAYLOAD_COORDINATES, POSITION, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS,
+    WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
 
 
 @jit
@@ -128,6 +84,9 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     """q_ddot into acc (6n + 3,) [m/s^2, rad/s^2] and the cable multipliers Lambda into
     multipliers (n,) [N/m] at state x (seed Eq. 2.60, 2.70), only the `taut` cables
     constrained. Rotor speeds enter as the held body wrenches."""
+    if formation[FORMATION_NULL_SPACE] != 0.0:  # the `nullspace` formulation (every cable taut)
+        nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
+        return
     n = uavs.shape[0]
     p = UAV_COORDINATES * n
     nq = p + PAYLOAD_COORDINATES
@@ -139,59 +98,10 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     gravity = formation[FORMATION_GRAVITY]
     for i in range(n):
         mass, length_sq = uavs[i, UAV_MASS], uavs[i, UAV_LENGTH_SQ]
-        inv_ixx, inv_iyy = uavs[i, UAV_INV_INERTIA], uavs[i, UAV_INV_INERTIA + 1]
-        inv_izz = uavs[i, UAV_INV_INERTIA + 2]
-        gyro_x, gyro_y, gyro_z = uavs[i, UAV_GYRO], uavs[i, UAV_GYRO + 1], uavs[i, UAV_GYRO + 2]
         r = UAV_COORDINATES * i + POSITION
-        e = UAV_COORDINATES * i + EULER
         rx, ry, rz = x[r], x[r + 1], x[r + 2]
-        phi, theta, psi = x[e], x[e + 1], x[e + 2]
         vx, vy, vz = x[nq + r], x[nq + r + 1], x[nq + r + 2]
-        phi_dot, theta_dot, psi_dot = x[nq + e], x[nq + e + 1], x[nq + e + 2]
-        thrust = wrenches[i, WRENCH_THRUST]
-        torque_x, torque_y = wrenches[i, WRENCH_TORQUE], wrenches[i, WRENCH_TORQUE + 1]
-        torque_z = wrenches[i, WRENCH_TORQUE + 2]
-        s_phi, c_phi = math.sin(phi), math.cos(phi)
-        s_theta, c_theta = math.sin(theta), math.cos(theta)
-        s_psi, c_psi = math.sin(psi), math.cos(psi)
-
-        # Attitude: omega = W eta_dot (Eq. 2.7), Euler's equation J omega_dot = tau - omega x
-        # J omega per axis (omega_dot_x = tau_x / I_xx - (I_zz - I_yy) / I_xx omega_y omega_z,
-        # cyclically), then eta_ddot = W^-1 (omega_dot - W_dot eta_dot) (Eq. 2.8) -- the same
-        # as M_eta^-1 (W^T tau - C_eta eta_dot), see multirotor.py; W_dot from
-        # kinematics.euler_rate_matrix_dot.
-        c_theta_psi_dot = c_theta * psi_dot
-        omega_x = phi_dot - s_theta * psi_dot
-        omega_y = c_phi * theta_dot + s_phi * c_theta_psi_dot
-        omega_z = c_phi * c_theta_psi_dot - s_phi * theta_dot
-        s_theta_theta_psi_dot = s_theta * theta_dot * psi_dot
-        w_eta_ddot_x = (torque_x * inv_ixx - gyro_x * omega_y * omega_z
-                        + c_theta_psi_dot * theta_dot)
-        w_eta_ddot_y = (torque_y * inv_iyy - gyro_y * omega_z * omega_x
-                        - phi_dot * omega_z + s_phi * s_theta_theta_psi_dot)
-        w_eta_ddot_z = (torque_z * inv_izz - gyro_z * omega_x * omega_y
-                        + phi_dot * omega_y + c_phi * s_theta_theta_psi_dot)
-        yaw_part = s_phi * w_eta_ddot_y + c_phi * w_eta_ddot_z         # W^-1 of Eq. 2.8
-        acc[e] = w_eta_ddot_x + s_theta / c_theta * yaw_part
-        acc[e + 1] = c_phi * w_eta_ddot_y - s_phi * w_eta_ddot_z
-        acc[e + 2] = yaw_part / c_theta
-
-        # Unconstrained translational acceleration: thrust along R e_z (Eq. 2.6, 2.20).
-        # Gravity is common to every body, so it cancels in a_p - a_i; it is added at the end.
-        thrust_per_mass = thrust / mass
-        s_theta_c_phi = s_theta * c_phi
-        thrust_ax = (c_psi * s_theta_c_phi + s_psi * s_phi) * thrust_per_mass
-        thrust_ay = (s_psi * s_theta_c_phi - c_psi * s_phi) * thrust_per_mass
-        thrust_az = c_theta * c_phi * thrust_per_mass
-        drag = uavs[i, UAV_DRAG]
-        if drag > 0.0:  # the UAV's own drag in the steady wind: -c_d |v_rel| v_rel / m_i
-            rel_x = vx - formation[FORMATION_WIND]
-            rel_y = vy - formation[FORMATION_WIND + 1]
-            rel_z = vz - formation[FORMATION_WIND + 2]
-            scale = -drag / mass * math.sqrt(rel_x * rel_x + rel_y * rel_y + rel_z * rel_z)
-            thrust_ax += scale * rel_x
-            thrust_ay += scale * rel_y
-            thrust_az += scale * rel_z
+        thrust_ax, thrust_ay, thrust_az = uav_free_motion(x, i, wrenches, uavs, formation, acc)
 
         # cable i: d = r_p - r_i, its rate, and row i of the multiplier equation (Eq. 2.60)
         dx, dy, dz = px - rx, py - ry, pz - rz

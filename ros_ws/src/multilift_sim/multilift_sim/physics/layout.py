@@ -86,7 +86,9 @@ FORMATION_TWO_ALPHA = 3         # 2 alpha_f [1/s] (seed Eq. 2.59)
 FORMATION_BETA_SQ = 4           # beta_f^2 [1/s^2] (seed Eq. 2.59)
 FORMATION_DRAG = 5              # c_pd [N s^2/m^2] (seed Eq. 2.53); 0: no drag
 FORMATION_WIND = 6              # the steady wind [m/s], world, everywhere (3 slots)
-FORMATION_SCALARS = 9
+FORMATION_NULL_SPACE = 9        # 1: q_ddot by the null-space form (Eq. 2.71-2.72, 2.57), the
+#                                 `nullspace` formulation; 0: the multipliers (Eq. 2.59-2.60)
+FORMATION_SCALARS = 10
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
 CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots)

@@ -78,7 +78,7 @@ class FormationModel:
 
     def __init__(self, params: FormationParams, null_space: bool = False):
         self.params = params
-        self.layout = StateLayout(params.n_uavs)
+        self.layout = StateLayout(params.n_uavs, params.rigid_payload)
         n = params.n_uavs
         self._n = n
         self._nq = self.layout.n_coordinates
@@ -195,7 +195,8 @@ class FormationModel:
     def accelerations_from_wrenches(self, x: np.ndarray,
                                     wrenches: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """As accelerations(), from body wrenches (n, 4) (u_T [N], tau [N m], FLU)."""
-        acc, multipliers = np.empty(self._nq), np.empty(self._n)
+        # q_ddot, and with a rigid payload its attitude's rate (physics.rigid_payload)
+        acc, multipliers = np.empty(self.layout.size - self._nq), np.empty(self._n)
         self._physics()['solve'](self._state_array(x), self._wrench_array(wrenches), self._uavs,
                                  self._gusts, self._formation, self._taut, acc, multipliers,
                                  np.empty((self._n, CABLE_COLUMNS)))
@@ -203,10 +204,11 @@ class FormationModel:
 
     def derivative(self, t: float, x: np.ndarray,
                    rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
-        """State derivative ``x_dot = (q_f_dot, q_f_ddot)``, shape (2(6n+3),)."""
+        """State derivative ``x_dot = (q_f_dot, q_f_ddot)``, shape (2(6n+3),) (with a rigid
+        payload, then its attitude block's rate)."""
         x = np.asarray(x, dtype=float)
         q_ddot, _ = self.accelerations(t, x, rotor_speeds)
-        return np.concatenate((x[self._nq:], q_ddot))
+        return np.concatenate((x[self._nq:2 * self._nq], q_ddot))
 
     def step(self, t: float, x: np.ndarray, rotor_speeds: Sequence[ArrayLike],
              dt: float) -> np.ndarray:
@@ -255,6 +257,9 @@ class FormationModel:
                                + self.payload_mass * payload_velocity @ payload_velocity)
         rotational = np.sum(rotational_kinetic_energy(self.uav_inertia, layout.uav_euler(x),
                                                       layout.uav_euler_rates(x)))
+        if layout.rigid_payload:  # the payload's own spin, 1/2 omega_p . J_p omega_p
+            omega = layout.payload_body_rates(x)
+            rotational += 0.5 * float(np.dot(self.params.payload_inertia, omega * omega))
         return float(translational + rotational)
 
     def potential_energy(self, x: np.ndarray) -> float:

@@ -16,10 +16,10 @@ from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (
     ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, FORMATION_BETA_SQ,
     FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
-    FORMATION_PAYLOAD_MASS,
-    FORMATION_SCALARS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_COLUMNS,
-    GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, UAV_COLUMNS, UAV_DRAG,
-    UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ, UAV_MASS)
+    FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS, FORMATION_SCALARS, FORMATION_TWO_ALPHA,
+    FORMATION_WIND, GUST_CENTER, GUST_COLUMNS, GUST_DIRECTION, GUST_GRADIENT_DISTANCE,
+    GUST_REFERENCE_SPEED, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ,
+    UAV_MASS, UAV_PAYLOAD_ATTACH)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -35,6 +35,11 @@ class FormationParams:
     gusts: tuple[Gust, ...] = ()             # 1-cosine gusts acting on the payload
     gravity: float = 9.81                    # g [m/s^2], along -z of the world frame
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world, everywhere
+    # a rigid-body payload (issue 20; physics.rigid_payload): its principal moments J_p
+    # [kg m^2] and, per cable, where it holds the payload b_i [m], payload frame (both, or
+    # neither: the seed's point mass)
+    payload_inertia: tuple[float, float, float] | None = None
+    payload_attach_points: tuple[tuple[float, float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         uavs = tuple(self.uavs)
@@ -75,20 +80,45 @@ class FormationParams:
             raise ValueError(f'FormationParams.wind must be a finite 3-vector [m/s], got '
                              f'{self.wind!r}')
         object.__setattr__(self, 'wind', wind)
+        if (self.payload_inertia is None) != (self.payload_attach_points is None):
+            raise ValueError('FormationParams.payload_inertia and payload_attach_points go '
+                             'together (a rigid payload) or not at all (a point payload)')
+        if self.payload_inertia is not None:
+            inertia = tuple(float(v) for v in self.payload_inertia)
+            if len(inertia) != 3 or not all(math.isfinite(v) and v > 0 for v in inertia):
+                raise ValueError(f'FormationParams.payload_inertia must be 3 finite moments '
+                                 f'> 0 [kg m^2], got {self.payload_inertia!r}')
+            points = tuple(tuple(float(v) for v in point)
+                           for point in self.payload_attach_points)
+            if len(points) != len(uavs) or any(len(point) != 3 or not all(
+                    math.isfinite(v) for v in point) for point in points):
+                raise ValueError(f'FormationParams.payload_attach_points must give one finite '
+                                 f'(x, y, z) [m] per cable ({len(uavs)}), got '
+                                 f'{self.payload_attach_points!r}')
+            object.__setattr__(self, 'payload_inertia', inertia)
+            object.__setattr__(self, 'payload_attach_points', points)
 
     @property
     def n_uavs(self) -> int:
         return len(self.uavs)
 
+    @property
+    def rigid_payload(self) -> bool:
+        """Whether the payload is a rigid body (its attitude in the state)."""
+        return self.payload_inertia is not None
+
 
 @dataclass(frozen=True)
 class StateLayout:
-    """Named views into the packed formation state ``x = (q_f, q_f_dot)`` of length 2(6n+3).
+    """Named views into the packed formation state ``x = (q_f, q_f_dot)`` of length 2(6n+3),
+    and with a rigid payload its attitude after them (`physics.layout` PAYLOAD_ATTITUDE: the
+    unit quaternion (w, x, y, z), payload frame -> world, and its body rates [rad/s]).
 
     Each accessor returns a view (writable when x is a contiguous float array), not a copy.
     """
 
     n_uavs: int
+    rigid_payload: bool = False
 
     def __post_init__(self) -> None:
         if self.n_uavs < 1:
@@ -101,8 +131,8 @@ class StateLayout:
 
     @property
     def size(self) -> int:
-        """Length of the state x: 2 (6n + 3)."""
-        return 2 * self.n_coordinates
+        """Length of the state x: 2 (6n + 3), plus 7 with a rigid payload."""
+        return 2 * self.n_coordinates + (slots.PAYLOAD_ATTITUDE if self.rigid_payload else 0)
 
     def coordinates(self, x: np.ndarray) -> np.ndarray:
         """q_f, shape (6n + 3,)."""
@@ -110,7 +140,17 @@ class StateLayout:
 
     def rates(self, x: np.ndarray) -> np.ndarray:
         """q_f_dot, shape (6n + 3,)."""
-        return x[self.n_coordinates:]
+        return x[self.n_coordinates:2 * self.n_coordinates]
+
+    def payload_quaternion(self, x: np.ndarray) -> np.ndarray:
+        """A rigid payload's attitude, the unit quaternion (w, x, y, z), shape (4,)."""
+        base = 2 * self.n_coordinates + slots.PAYLOAD_QUATERNION
+        return x[base:base + 4]
+
+    def payload_body_rates(self, x: np.ndarray) -> np.ndarray:
+        """A rigid payload's angular velocity omega_p [rad/s], payload frame, shape (3,)."""
+        base = 2 * self.n_coordinates + slots.PAYLOAD_BODY_RATES
+        return x[base:base + 3]
 
     def _uav_block(self, q: np.ndarray) -> np.ndarray:
         return q[:slots.payload_slot(self.n_uavs)].reshape(self.n_uavs, slots.UAV_COORDINATES)
@@ -141,9 +181,17 @@ class StateLayout:
 
     def pack(self, uav_positions: ArrayLike, uav_euler: ArrayLike, payload_position: ArrayLike,
              uav_velocities: ArrayLike | None = None, uav_euler_rates: ArrayLike | None = None,
-             payload_velocity: ArrayLike | None = None) -> np.ndarray:
-        """Packed state from its parts (world frame, SI); omitted rates are zero."""
+             payload_velocity: ArrayLike | None = None,
+             payload_quaternion: ArrayLike | None = None,
+             payload_body_rates: ArrayLike | None = None) -> np.ndarray:
+        """Packed state from its parts (world frame, SI); omitted rates are zero, a rigid
+        payload's omitted attitude the identity."""
         x = np.zeros(self.size)
+        if self.rigid_payload:
+            self.payload_quaternion(x)[:] = (1.0, 0.0, 0.0, 0.0) if payload_quaternion is None \
+                else payload_quaternion
+            if payload_body_rates is not None:
+                self.payload_body_rates(x)[:] = payload_body_rates
         self.uav_positions(x)[:] = np.reshape(uav_positions, (self.n_uavs, 3))
         self.uav_euler(x)[:] = np.reshape(uav_euler, (self.n_uavs, 3))
         self.payload_position(x)[:] = payload_position
@@ -187,6 +235,10 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     formation[FORMATION_DRAG] = params.payload_drag_coefficient
     formation[FORMATION_WIND:FORMATION_WIND + 3] = params.wind
     formation[FORMATION_NULL_SPACE] = 0.0  # the multipliers' form (nullspace.NullSpaceModel: 1)
+    formation[FORMATION_PAYLOAD_INERTIA:FORMATION_PAYLOAD_INERTIA + 3] = (
+        params.payload_inertia if params.rigid_payload else 0.0)
+    uavs[:, UAV_PAYLOAD_ATTACH:UAV_PAYLOAD_ATTACH + 3] = (
+        params.payload_attach_points if params.rigid_payload else 0.0)
     return uavs, gusts, formation
 
 

@@ -21,6 +21,8 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import (air_velocity,  # noqa: F401 - its users' name
                                               payload_force_per_mass, uav_free_motion)
 from multilift_sim.physics.nullspace import nullspace_solve
+from multilift_sim.physics.rigid_payload import (normalize_quaternion, rigid_residuals,
+                                                 rigid_solve)
 from multilift_sim.physics.layout import (
     CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ,
     FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
@@ -87,6 +89,10 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     if formation[FORMATION_NULL_SPACE] != 0.0:  # the `nullspace` formulation (every cable taut)
         nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
         return
+    if x.shape[0] > 2 * (UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES):
+        # a rigid-body payload (its attitude after q_f_dot: physics.rigid_payload)
+        rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers)
+        return
     n = uavs.shape[0]
     p = UAV_COORDINATES * n
     nq = p + PAYLOAD_COORDINATES
@@ -144,10 +150,13 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
 @jit
 def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, work, cables):
     """One classic RK4 step of h [s] from x with the wrenches held, into out (which may be
-    x); the multipliers [N/m] of its first stage (at x) into multipliers (n,)."""
+    x); the multipliers [N/m] of its first stage (at x) into multipliers (n,). A rigid
+    payload's attitude block after q_f_dot steps with the rest (its rate from `solve` at
+    acc[6n + 3:]), its quaternion scaled back to unit length at the end."""
     n = uavs.shape[0]
     nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
-    size = 2 * nq
+    size = x.shape[0]
+    extra = size - 2 * nq  # a rigid payload's attitude (physics.rigid_payload), or none
     half, sixth = 0.5 * h, h / 6.0
     k1, k2, k3, k4 = work[WORK_K1], work[WORK_K2], work[WORK_K3], work[WORK_K4]
     stage, acc = work[WORK_STAGE], work[WORK_ACC]
@@ -156,6 +165,8 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
     for j in range(nq):  # k = (q_dot, q_ddot): the state derivative
         k1[j] = x[nq + j]
         k1[nq + j] = acc[j]
+    for j in range(extra):
+        k1[2 * nq + j] = acc[nq + j]
     for k in (WORK_K2, WORK_K3, WORK_K4):  # stage k from x + (h/2 k1, h/2 k2, h k3)
         step, previous = (h if k == WORK_K4 else half), work[k - 1]
         for j in range(size):
@@ -165,17 +176,25 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
         for j in range(nq):
             derivative[j] = stage[nq + j]
             derivative[nq + j] = acc[j]
+        for j in range(extra):
+            derivative[2 * nq + j] = acc[nq + j]
     for j in range(size):
         out[j] = x[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
+    if extra:
+        normalize_quaternion(out, 2 * nq)
 
 
 @jit
 def residuals(x, uavs, g, g_dot):
     """g_i = |r_p - r_i|^2 - l_i^2 [m^2] (Eq. 2.42) into g (n,) and g_dot_i =
-    2 (r_p - r_i) . (v_p - v_i) [m^2/s] (Eq. 2.56) into g_dot (n,), at state x."""
+    2 (r_p - r_i) . (v_p - v_i) [m^2/s] (Eq. 2.56) into g_dot (n,), at state x (with a rigid
+    payload's attitude: its attach points', `rigid_payload.rigid_residuals`)."""
     n = uavs.shape[0]
     p = UAV_COORDINATES * n
     nq = p + PAYLOAD_COORDINATES
+    if x.shape[0] > 2 * nq:
+        rigid_residuals(x, uavs, g, g_dot)
+        return
     for i in range(n):
         b = UAV_COORDINATES * i + POSITION
         dx = x[p] - x[b]
@@ -194,7 +213,7 @@ def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
     Algorithm 1), the `taut` cables constrained: (the state at the end, the multipliers
     [N/m] at x, g [m^2] and g_dot [m^2/s] at the end). x is not written."""
     n = uavs.shape[0]
-    size = 2 * (UAV_COORDINATES * n + PAYLOAD_COORDINATES)
+    size = x.shape[0]
     work = np.empty((WORK_ROWS, size))
     cables = np.empty((n, CABLE_COLUMNS))
     first = np.empty(n)

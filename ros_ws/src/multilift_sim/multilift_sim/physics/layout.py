@@ -33,13 +33,22 @@ def n_coordinates(n_uavs: int) -> int:
     return UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES
 
 
+# a rigid-body payload's attitude (issue 20; physics.rigid_payload), appended to x after
+# q_f_dot, at 2 (6n + 3): its unit quaternion (w, x, y, z), payload frame -> world, then its
+# angular velocity omega_p [rad/s] in the payload frame. A point payload has none.
+PAYLOAD_QUATERNION = 0      # (w, x, y, z) (4 slots)
+PAYLOAD_BODY_RATES = 4      # omega_p [rad/s], payload frame (3)
+PAYLOAD_ATTITUDE = 7        # the block's length
+
+
 # -- a UAV's constants (one row per UAV) ------------------------------------------------------
 UAV_MASS = 0                # m_i [kg]
 UAV_LENGTH_SQ = 1           # l_i^2 [m^2], its cable's length squared
 UAV_INV_INERTIA = 2         # 1/I_xx, 1/I_yy, 1/I_zz [1/(kg m^2)], body FLU axes (3 slots)
 UAV_GYRO = 5                # (I_zz - I_yy)/I_xx, (I_xx - I_zz)/I_yy, (I_yy - I_xx)/I_zz (3)
 UAV_DRAG = 8                # c_d [N s^2/m^2]: the UAV's quadratic drag in the wind; 0: none
-UAV_COLUMNS = 9
+UAV_PAYLOAD_ATTACH = 9      # b_i [m]: where its cable holds a rigid payload, payload frame (3)
+UAV_COLUMNS = 12
 
 # -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
@@ -88,7 +97,9 @@ FORMATION_DRAG = 5              # c_pd [N s^2/m^2] (seed Eq. 2.53); 0: no drag
 FORMATION_WIND = 6              # the steady wind [m/s], world, everywhere (3 slots)
 FORMATION_NULL_SPACE = 9        # 1: q_ddot by the null-space form (Eq. 2.71-2.72, 2.57), the
 #                                 `nullspace` formulation; 0: the multipliers (Eq. 2.59-2.60)
-FORMATION_SCALARS = 10
+FORMATION_PAYLOAD_INERTIA = 10  # a rigid payload's principal moments J_p [kg m^2], payload
+#                                 frame (3 slots; whether it is rigid: x's length)
+FORMATION_SCALARS = 13
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
 CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots)

@@ -1,0 +1,229 @@
+"""A rigid-body payload on the formation's cables (issue 20): the DAE's solve and residuals when
+x carries the payload's attitude (`layout.PAYLOAD_ATTITUDE` after q_f_dot). World frame (z up),
+SI units; the slots are `physics.layout`'s; docs/rigid_payload.md writes the equations out.
+
+Cable i holds the payload at b_i (`UAV_PAYLOAD_ATTACH`, payload frame) and UAV i at its centre
+of mass: with R_p the payload's attitude and e_i = R_p b_i,
+
+    d_i = r_p + e_i - r_i,    g_i = |d_i|^2 - l_i^2,
+    d_i_dot = v_p + w x e_i - v_i              (w = R_p omega_p, world),
+    d_i_ddot = a_p + R_p (alpha_p x b_i) + w x (w x e_i) - a_i.
+
+The cable's pull 2 lambda_i d_i acts on UAV i and -2 lambda_i d_i on the payload at b_i, whose
+moment is b_i x (-2 lambda_i f_i), f_i = R_p^T d_i. With c_i = b_i x f_i the Baumgarte rows
+(seed Eq. 2.59) become A Lambda = b with
+
+    A_ij = 4 d_i.d_j / m_p + 4 c_i.J_p^-1 c_j + delta_ij 4 |d_i|^2 / m_i,
+    b_i = 2 |d_i_dot|^2 + 2 d_i.(a_p0 - a_i0) + 2 c_i.alpha_0 + 2 d_i.(w x (w x e_i))
+          + 2 alpha_f g_i_dot + beta_f^2 g_i,
+
+a_p0, a_i0 the accelerations without the cables (gravity cancels), alpha_0 = J_p^-1 (-omega_p
+x J_p omega_p). A = Delta + U W U^T with U_i = 2 (d_i, c_i) and W = diag(I / m_p, J_p^-1), so
+the Woodbury identity leaves a 6 x 6 system, S = W^-1 + sum_i U_i U_i^T / delta_i: the point
+payload's 3 x 3 (`formation_dae.cable_multipliers`) with the rotation's three rows added.
+With every b_i = 0 it is the point payload's DAE (c_i = 0) and the attitude spins free.
+"""
+import math
+
+import numpy as np
+
+from multilift_sim.kernels import jit
+from multilift_sim.physics.free_motion import payload_force_per_mass, uav_free_motion
+from multilift_sim.physics.layout import (FORMATION_BETA_SQ, FORMATION_GRAVITY,
+                                          FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
+                                          FORMATION_TWO_ALPHA, PAYLOAD_BODY_RATES,
+                                          PAYLOAD_COORDINATES, PAYLOAD_QUATERNION, POSITION,
+                                          UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS,
+                                          UAV_PAYLOAD_ATTACH)
+from multilift_sim.physics.nullspace import dense_solve
+
+
+@jit
+def payload_rotation(x, base):
+    """R_p (3, 3), payload frame -> world, of the unit quaternion (w, x, y, z) at x[base:]."""
+    w, qx = x[base + PAYLOAD_QUATERNION], x[base + PAYLOAD_QUATERNION + 1]
+    qy, qz = x[base + PAYLOAD_QUATERNION + 2], x[base + PAYLOAD_QUATERNION + 3]
+    r = np.empty((3, 3))
+    r[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
+    r[0, 1] = 2.0 * (qx * qy - w * qz)
+    r[0, 2] = 2.0 * (qx * qz + w * qy)
+    r[1, 0] = 2.0 * (qx * qy + w * qz)
+    r[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
+    r[1, 2] = 2.0 * (qy * qz - w * qx)
+    r[2, 0] = 2.0 * (qx * qz - w * qy)
+    r[2, 1] = 2.0 * (qy * qz + w * qx)
+    r[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
+    return r
+
+
+@jit
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@jit
+def cable_geometry(x, uavs, i, rotation, omega_world, base):
+    """Cable i's (d_i, d_i_dot, e_i = R_p b_i) at x, world [m, m/s, m], as 3 + 3 + 3 floats."""
+    n = uavs.shape[0]
+    p = UAV_COORDINATES * n
+    nq = p + PAYLOAD_COORDINATES
+    r = UAV_COORDINATES * i + POSITION
+    b0, b1, b2 = (uavs[i, UAV_PAYLOAD_ATTACH], uavs[i, UAV_PAYLOAD_ATTACH + 1],
+                  uavs[i, UAV_PAYLOAD_ATTACH + 2])
+    e0 = rotation[0, 0] * b0 + rotation[0, 1] * b1 + rotation[0, 2] * b2
+    e1 = rotation[1, 0] * b0 + rotation[1, 1] * b1 + rotation[1, 2] * b2
+    e2 = rotation[2, 0] * b0 + rotation[2, 1] * b1 + rotation[2, 2] * b2
+    spin0, spin1, spin2 = _cross(omega_world[0], omega_world[1], omega_world[2], e0, e1, e2)
+    d0 = x[p] + e0 - x[r]
+    d1 = x[p + 1] + e1 - x[r + 1]
+    d2 = x[p + 2] + e2 - x[r + 2]
+    v0 = x[nq + p] + spin0 - x[nq + r]
+    v1 = x[nq + p + 1] + spin1 - x[nq + r + 1]
+    v2 = x[nq + p + 2] + spin2 - x[nq + r + 2]
+    return d0, d1, d2, v0, v1, v2, e0, e1, e2
+
+
+@jit
+def world_rates(x, base, rotation):
+    """The payload's angular velocity in the world frame, R_p omega_p (3,) [rad/s]."""
+    w = np.empty(3)
+    for k in range(3):
+        w[k] = (rotation[k, 0] * x[base + PAYLOAD_BODY_RATES]
+                + rotation[k, 1] * x[base + PAYLOAD_BODY_RATES + 1]
+                + rotation[k, 2] * x[base + PAYLOAD_BODY_RATES + 2])
+    return w
+
+
+@jit
+def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
+    """q_ddot into acc[:6n + 3] [m/s^2, rad/s^2], the attitude block's rate (quaternion rate,
+    then alpha_p [rad/s^2], payload frame) into acc[6n + 3:6n + 10], and Lambda into
+    multipliers (n,) [N/m] at state x (see the module docstring); only `taut` cables pull."""
+    n = uavs.shape[0]
+    p = UAV_COORDINATES * n
+    nq = p + PAYLOAD_COORDINATES
+    base = 2 * nq
+    gravity = formation[FORMATION_GRAVITY]
+    payload_mass = formation[FORMATION_PAYLOAD_MASS]
+    inertia = formation[FORMATION_PAYLOAD_INERTIA:FORMATION_PAYLOAD_INERTIA + 3]
+    rotation = payload_rotation(x, base)
+    omega = x[base + PAYLOAD_BODY_RATES:base + PAYLOAD_BODY_RATES + 3]
+    w = world_rates(x, base, rotation)
+    drag0, drag1, drag2 = payload_force_per_mass(x[p], x[p + 1], x[p + 2], x[nq + p],
+                                                 x[nq + p + 1], x[nq + p + 2], gusts, formation)
+    # alpha_0 = J^-1 (-omega x J omega), principal axes (Euler's equations without the cables)
+    h0, h1, h2 = _cross(omega[0], omega[1], omega[2], inertia[0] * omega[0],
+                        inertia[1] * omega[1], inertia[2] * omega[2])
+    alpha0 = np.array([-h0 / inertia[0], -h1 / inertia[1], -h2 / inertia[2]])
+    two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
+    d = np.zeros((n, 3))
+    c = np.zeros((n, 3))
+    rhs = np.zeros(n)
+    inv_delta = np.zeros(n)
+    thrust = np.empty((n, 3))
+    for i in range(n):
+        thrust[i, 0], thrust[i, 1], thrust[i, 2] = uav_free_motion(x, i, wrenches, uavs,
+                                                                   formation, acc)
+        if not taut[i]:
+            continue
+        d0, d1, d2, v0, v1, v2, e0, e1, e2 = cable_geometry(x, uavs, i, rotation, w, base)
+        d[i, 0], d[i, 1], d[i, 2] = d0, d1, d2
+        # f_i = R_p^T d_i, c_i = b_i x f_i (payload frame)
+        f0 = rotation[0, 0] * d0 + rotation[1, 0] * d1 + rotation[2, 0] * d2
+        f1 = rotation[0, 1] * d0 + rotation[1, 1] * d1 + rotation[2, 1] * d2
+        f2 = rotation[0, 2] * d0 + rotation[1, 2] * d1 + rotation[2, 2] * d2
+        c[i, 0], c[i, 1], c[i, 2] = _cross(uavs[i, UAV_PAYLOAD_ATTACH],
+                                           uavs[i, UAV_PAYLOAD_ATTACH + 1],
+                                           uavs[i, UAV_PAYLOAD_ATTACH + 2], f0, f1, f2)
+        s0, s1, s2 = _cross(w[0], w[1], w[2], e0, e1, e2)
+        cp0, cp1, cp2 = _cross(w[0], w[1], w[2], s0, s1, s2)  # w x (w x e_i)
+        offset_sq = d0 * d0 + d1 * d1 + d2 * d2
+        rhs[i] = (2.0 * (v0 * v0 + v1 * v1 + v2 * v2)
+                  + 2.0 * (d0 * (drag0 - thrust[i, 0]) + d1 * (drag1 - thrust[i, 1])
+                           + d2 * (drag2 - thrust[i, 2]))
+                  + 2.0 * (c[i, 0] * alpha0[0] + c[i, 1] * alpha0[1] + c[i, 2] * alpha0[2])
+                  + 2.0 * (d0 * cp0 + d1 * cp1 + d2 * cp2)
+                  + two_alpha * 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
+                  + beta_sq * (offset_sq - uavs[i, UAV_LENGTH_SQ]))
+        inv_delta[i] = 0.25 * uavs[i, UAV_MASS] / offset_sq
+    # Woodbury: S = diag(m_p I, J) + sum_i U_i U_i^T / delta_i, U_i = 2 (d_i, c_i)
+    s = np.zeros((6, 6))
+    for k in range(3):
+        s[k, k] = payload_mass
+        s[3 + k, 3 + k] = inertia[k]
+    sb = np.zeros(6)
+    u = np.empty(6)
+    for i in range(n):
+        if not taut[i]:
+            continue
+        for k in range(3):
+            u[k] = 2.0 * d[i, k]
+            u[3 + k] = 2.0 * c[i, k]
+        for a in range(6):
+            sb[a] += u[a] * inv_delta[i] * rhs[i]
+            for b in range(6):
+                s[a, b] += u[a] * u[b] * inv_delta[i]
+    y = dense_solve(s, sb)
+    pull0 = pull1 = pull2 = 0.0     # sum_j lambda_j d_j (world)
+    turn0 = turn1 = turn2 = 0.0     # sum_j lambda_j c_j (payload frame)
+    for i in range(n):
+        if not taut[i]:
+            multipliers[i] = 0.0
+        else:
+            projection = 0.0
+            for k in range(3):
+                projection += 2.0 * d[i, k] * y[k] + 2.0 * c[i, k] * y[3 + k]
+            multipliers[i] = (rhs[i] - projection) * inv_delta[i]
+        lam = multipliers[i]
+        r = UAV_COORDINATES * i + POSITION
+        pull = 2.0 * lam / uavs[i, UAV_MASS]
+        acc[r] = thrust[i, 0] + pull * d[i, 0]
+        acc[r + 1] = thrust[i, 1] + pull * d[i, 1]
+        acc[r + 2] = thrust[i, 2] + pull * d[i, 2] - gravity
+        pull0 += lam * d[i, 0]
+        pull1 += lam * d[i, 1]
+        pull2 += lam * d[i, 2]
+        turn0 += lam * c[i, 0]
+        turn1 += lam * c[i, 1]
+        turn2 += lam * c[i, 2]
+    scale = 2.0 / payload_mass
+    acc[p] = drag0 - scale * pull0
+    acc[p + 1] = drag1 - scale * pull1
+    acc[p + 2] = drag2 - scale * pull2 - gravity
+    # the attitude block: q_dot = q (x) (0, omega) / 2, alpha = alpha_0 - 2 J^-1 sum lambda c
+    qw, qx = x[base + PAYLOAD_QUATERNION], x[base + PAYLOAD_QUATERNION + 1]
+    qy, qz = x[base + PAYLOAD_QUATERNION + 2], x[base + PAYLOAD_QUATERNION + 3]
+    o0, o1, o2 = omega[0], omega[1], omega[2]
+    acc[nq + PAYLOAD_QUATERNION] = 0.5 * (-qx * o0 - qy * o1 - qz * o2)
+    acc[nq + PAYLOAD_QUATERNION + 1] = 0.5 * (qw * o0 + qy * o2 - qz * o1)
+    acc[nq + PAYLOAD_QUATERNION + 2] = 0.5 * (qw * o1 + qz * o0 - qx * o2)
+    acc[nq + PAYLOAD_QUATERNION + 3] = 0.5 * (qw * o2 + qx * o1 - qy * o0)
+    acc[nq + PAYLOAD_BODY_RATES] = alpha0[0] - 2.0 * turn0 / inertia[0]
+    acc[nq + PAYLOAD_BODY_RATES + 1] = alpha0[1] - 2.0 * turn1 / inertia[1]
+    acc[nq + PAYLOAD_BODY_RATES + 2] = alpha0[2] - 2.0 * turn2 / inertia[2]
+
+
+@jit
+def rigid_residuals(x, uavs, g, g_dot):
+    """g_i = |d_i|^2 - l_i^2 [m^2] into g (n,) and g_dot_i = 2 d_i . d_i_dot [m^2/s] into
+    g_dot (n,) at a state x with the payload's attitude."""
+    n = uavs.shape[0]
+    base = 2 * (UAV_COORDINATES * n + PAYLOAD_COORDINATES)
+    rotation = payload_rotation(x, base)
+    w = world_rates(x, base, rotation)
+    for i in range(n):
+        d0, d1, d2, v0, v1, v2, _, _, _ = cable_geometry(x, uavs, i, rotation, w, base)
+        g[i] = d0 * d0 + d1 * d1 + d2 * d2 - uavs[i, UAV_LENGTH_SQ]
+        g_dot[i] = 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
+
+
+@jit
+def normalize_quaternion(x, base):
+    """The payload's quaternion at x[base:] scaled back to unit length (after an RK4 step, so
+    R_p stays orthonormal)."""
+    norm = 0.0
+    for k in range(4):
+        norm += x[base + PAYLOAD_QUATERNION + k] * x[base + PAYLOAD_QUATERNION + k]
+    norm = math.sqrt(norm)
+    for k in range(4):
+        x[base + PAYLOAD_QUATERNION + k] /= norm

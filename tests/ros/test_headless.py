@@ -224,3 +224,15 @@ def test_sensors_fly_alike_through_ros_and_headless(tmp_path):
     for mode in ('ros', 'headless'):
         summary = json.loads((tmp_path / mode / 'summary.json').read_text())
         assert summary['sim']['seeds'] == {'sensors': 1}
+
+
+def test_a_rigid_payload_flies_alike_through_ros_and_headless(tmp_path):
+    """`box_lift` (docs/rigid_payload.md): the simulator node flies the box's attitude as the
+    headless run does (the same UAV places to rounding) and publishes it on /payload/odom."""
+    ros_run, headless_run = _ros_and_headless(tmp_path, 'box_lift', '3.0', 'box_lift')
+    with AnyReader([tmp_path / 'ros']) as reader:
+        odom = [c for c in reader.connections if c.topic == '/payload/odom']
+        tilt = [reader.deserialize(raw, c.msgtype).pose.pose.orientation.w
+                for c, _, raw in reader.messages(odom)]
+    assert len(tilt) == 301 and min(tilt) < 1.0 - 1e-6
+    assert np.abs(ros_run.payload_position() - headless_run.payload_position()).max() < 1e-9

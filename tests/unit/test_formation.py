@@ -331,7 +331,7 @@ def _scenario(formation, n, cable_length=10.26):
     from types import SimpleNamespace as NS
     uavs = tuple(NS(vehicle=VEHICLE, position=(1.0, 2.0, 3.0), cable_length=cable_length)
                  for _ in range(n))
-    return NS(n_uavs=n, uavs=uavs, payload=NS(mass=0.9), control=GAINS,
+    return NS(n_uavs=n, uavs=uavs, payload=NS(mass=0.9, attach_points=None), control=GAINS,
               simulation=NS(gravity=G), formation=formation)
 
 

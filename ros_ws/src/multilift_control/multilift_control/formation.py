@@ -192,7 +192,7 @@ class FormationFollower:
         if 'altitude_offset' not in options:
             start, _ = formation_geometry.hanging_payload(
                 constraints.nominal_positions(scenario.uavs[0].position),
-                [u.cable_length for u in scenario.uavs])
+                [u.cable_length for u in scenario.uavs], scenario.payload.attach_points)
             options['altitude_offset'] = float(start[index, 2] - start[0, 2])
         return cls(scenario.uavs[index].vehicle, index, constraints, masses, scenario.control,
                    float(masses[index]), scenario.simulation.gravity, config.alpha_vc,

@@ -147,7 +147,12 @@ def scenario_configuration(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
 
 def scenario_equilibrium(scenario: Scenario) -> Equilibrium:
     """The static equilibrium (Eq. 2.73) of the scenario's formation at its hanging rest,
-    UAVs at the scenario's yaw angles."""
+    UAVs at the scenario's yaw angles. ValueError for a rigid-body payload (its modes: not
+    yet, docs/rigid_payload.md)."""
+    if scenario.payload.type != 'point':
+        raise ValueError(f'{scenario.name}: the modes of a {scenario.payload.type} payload are '
+                         'not analysed yet (multilift modal: point payloads; '
+                         'docs/rigid_payload.md)')
     uavs, payload = scenario_configuration(scenario)
     return static_equilibrium(scenario.formation_params(0.0, 0.0), uavs, payload,
                               [u.yaw for u in scenario.uavs])

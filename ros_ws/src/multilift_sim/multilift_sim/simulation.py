@@ -23,6 +23,7 @@ from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
                                           ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
 from multilift_sim.physics.measurement import odometry_states
+from multilift_sim.physics.rigid_payload import payload_rotation
 from multilift_sim.physics.sensors import sensed_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.schedules import event_array, event_records, sensor_arrays, wind_series
@@ -56,6 +57,9 @@ class Snapshot:
     # what the controllers receive of every UAV (n, MEASURED_COLUMNS): the odometry's
     # MEASURED_* slots, or with `sensors:` their measurement (physics.sensors)
     measured: np.ndarray
+    # a rigid payload's (orientation (x, y, z, w), body rates [rad/s], R_p (3, 3) payload frame
+    # -> world); None for a point payload
+    payload_attitude: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
 
 def stop_message(status: int, cable: int, value: float, t: float, sim) -> str:
@@ -98,9 +102,9 @@ def initial_state(scenario: Scenario) -> np.ndarray:
     if scenario.payload.swing:
         payload = swing_about_uav_axis(payload, uavs[0], uavs[1], scenario.payload.swing)
     euler = np.array([[0.0, 0.0, u.yaw] for u in scenario.uavs])
-    layout = StateLayout(scenario.n_uavs)
+    layout = StateLayout(scenario.n_uavs, scenario.payload.type == 'rigid_body')
     assert formation is not None
-    return layout.pack(uavs, euler, payload)
+    return layout.pack(uavs, euler, payload)  # a rigid payload level (the identity attitude)
 
 
 def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
@@ -108,7 +112,8 @@ def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     f = scenario.formation
     uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position, f.offsets,
                              f.distance, f.half_angle)
-    return hanging_payload(uavs, [u.cable_length for u in scenario.uavs])
+    return hanging_payload(uavs, [u.cable_length for u in scenario.uavs],
+                           scenario.payload.attach_points)
 
 
 @dataclass(frozen=True)
@@ -211,8 +216,14 @@ class FormationSimulator:
             body_rates=row[MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3],
             body_velocity=row[ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3],
             orientation=row[ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4]) for row in odometry)
+        attitude = None
+        layout = self.model.layout
+        if layout.rigid_payload:
+            w, x, y, z = layout.payload_quaternion(self.state)
+            attitude = (np.array([x, y, z, w]), layout.payload_body_rates(self.state).copy(),
+                        payload_rotation(self.state, 2 * nq))
         return Snapshot(self.t_ns, uavs, self.state[6 * n:nq].copy(),
-                        self.state[nq + 6 * n:].copy(), odometry, measured)
+                        self.state[nq + 6 * n:2 * nq].copy(), odometry, measured, attitude)
 
     @property
     def taut(self) -> np.ndarray:

@@ -142,7 +142,10 @@ class TickRecord(NamedTuple):
 def not_flown(scenario: Scenario) -> str | None:
     """Why the engine does not fly `scenario` as FormationSimulator does, or None: it flies the
     seed's DAE (`simulation.integrator: baumgarte`, rigid or slack cables) with one rotor
-    count for every UAV (the others go tick by tick: `headless.run_headless`)."""
+    count for every UAV and a point payload (the others go tick by tick:
+    `headless.run_headless`; a rigid payload's state is longer than the engine's records)."""
+    if scenario.payload.type != 'point':
+        return f'payload.type is {scenario.payload.type!r} (the engine flies point payloads)'
     if scenario.simulation.integrator != 'baumgarte':
         return f'simulation.integrator is {scenario.simulation.integrator!r}, not baumgarte'
     rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}

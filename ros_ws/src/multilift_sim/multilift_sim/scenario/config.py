@@ -64,6 +64,13 @@ class PayloadConfig:
     alpha: float                     # release angle alpha of seed Eq. 2.33 [rad] (n = 1)
     beta: float                      # release angle beta of seed Eq. 2.33 [rad] (n = 1)
     swing: float                     # release angle out of the UAVs-payload plane [rad] (n = 2)
+    type: str = 'point'              # one of payload_types.PAYLOAD_TYPES
+    # rigid_body: its shape (payload_types.SHAPES) and size [m], principal inertia [kg m^2]
+    # and each cable's attach point [m], payload frame (UAV i's cable: entry i)
+    shape: str = ''
+    size: tuple[float, ...] = ()
+    inertia: tuple[float, float, float] | None = None
+    attach_points: tuple[tuple[float, float, float], ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -187,6 +194,8 @@ class Scenario:
             gravity=sim.gravity, wind=self.wind,
             baumgarte_alpha=sim.baumgarte_alpha if baumgarte_alpha is None else baumgarte_alpha,
             baumgarte_beta=sim.baumgarte_beta if baumgarte_beta is None else baumgarte_beta,
+            payload_inertia=self.payload.inertia,
+            payload_attach_points=self.payload.attach_points,
         )
 
     def with_duration(self, duration: float) -> 'Scenario':

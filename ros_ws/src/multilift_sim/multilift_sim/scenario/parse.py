@@ -11,6 +11,8 @@ from typing import Any
 from multilift_sim.disturbances import Gust
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
+from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_rigid_body_inertia,
+                                         solid_inertia)
 from multilift_sim.physics.layout import EVENT_KINDS, SENSED_QUANTITIES
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
                                            ControlConfig, EventConfig, FormationConfig,
@@ -97,6 +99,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
         u.done()
 
     p = top.section('payload')
+    payload_type = p.text('type', 'point', choices=PAYLOAD_TYPES)
     payload = PayloadConfig(mass=p.positive('mass'),
                             drag_coefficient=p.non_negative('drag_coefficient', 0.0),
                             alpha=math.radians(p.number('alpha_deg', 0.0,
@@ -107,6 +110,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
                             swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
                                                         'must be within (-90, 90) degrees')))
     swing = math.degrees(payload.swing)
+    if payload_type == 'rigid_body':
+        payload = _rigid_body(p, payload, len(uavs))
     p.done()
     if len(uavs) > 1 and (payload.alpha or payload.beta):
         raise p.fail('alpha_deg', math.degrees(payload.alpha),
@@ -197,16 +202,45 @@ def scenario_of(data: Any, where: str) -> Scenario:
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
     windy = any(wind) or turbulence is not None or any(u.vehicle.drag_coefficient
                                                        for u in scenario.uavs)
+    rigid = payload.type == 'rigid_body'
     for used, what in ((windy, 'wind and vehicle.drag_coefficient'), (events, 'events'),
                        (lagging, f'vehicle.motor_time_constant / motor_rate_limit '
-                                 f'(uav{lagging[0] if lagging else 0})')):
+                                 f'(uav{lagging[0] if lagging else 0})'),
+                       (rigid, 'payload.type: rigid_body')):
         if used and sim.integrator != 'baumgarte':
             raise ScenarioError(f'{where}: {what} need simulation.integrator: baumgarte, got '
                                 f'{sim.integrator!r}')
+    if rigid and (cable_model != 'rigid' or len(uavs) < 2):
+        raise ScenarioError(f'{where}: payload.type: rigid_body needs n >= 2 UAVs and '
+                            f'cable_model: rigid (slack cables on a rigid body: not yet)')
     if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario
+
+
+def _rigid_body(p: Section, payload: PayloadConfig, n: int) -> PayloadConfig:
+    """`payload.type: rigid_body` (payload_types): its shape and size, inertia (default the
+    uniform solid's; validated as a rigid body's) and one attach point per cable."""
+    shape = p.text('shape', choices=tuple(SHAPES))
+    count = SHAPE_SIZES[shape]
+    size = p.vector('size', length=count, check=lambda v: v > 0, rule='must be > 0')
+    inertia = solid_inertia(shape, payload.mass, size)
+    if p.has('inertia'):
+        inertia = p.vector('inertia', check=lambda v: v > 0, rule='must be > 0')
+    if not is_rigid_body_inertia(inertia):
+        raise p.fail('inertia', list(inertia), 'is no rigid body\'s: each principal moment must '
+                     'be at most the sum of the other two')
+    raw = p.sequence('attach_points')
+    if len(raw) != n:
+        raise p.fail('attach_points', raw, f'must give one [x, y, z] per cable ({n})')
+    holder = Section({str(k): v for k, v in enumerate(raw)}, p.key('attach_points'), p.where)
+    points = tuple(holder.vector(str(k)) for k in range(n))
+    holder.done()
+    if payload.swing:
+        raise p.fail('swing_deg', math.degrees(payload.swing), 'is for a point payload')
+    return dataclasses.replace(payload, type='rigid_body', shape=shape, size=size,
+                               inertia=inertia, attach_points=points)
 
 
 def _sensors(d: Section, sim: SimulationConfig) -> SensorConfig:
@@ -311,6 +345,7 @@ def _check_feasible(scenario: Scenario) -> None:
         uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position,
                                  f.offsets, f.distance, f.half_angle)
         try:
-            hanging_payload(uavs, [u.cable_length for u in scenario.uavs])
+            hanging_payload(uavs, [u.cable_length for u in scenario.uavs],
+                            scenario.payload.attach_points)
         except ValueError as exc:
             raise ScenarioError(f'{scenario.source}: formation: {exc}') from None

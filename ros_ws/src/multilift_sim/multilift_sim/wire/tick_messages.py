@@ -74,24 +74,33 @@ class SimulatorMessages:
         uavs = snap.odometry[:, ODOMETRY_NUMBERS].tolist()
         measured = measured_odometry(snap.measured[None])[0].tolist() if self._measured \
             else None
+        payload_velocity, payload_pose = snap.payload_velocity.tolist(), None
+        if snap.payload_attitude is not None:  # a rigid payload: its pose, twist in its frame
+            quaternion, rates, rotation = snap.payload_attitude
+            payload_velocity = (rotation.T @ snap.payload_velocity).tolist()
+            payload_pose = (tuple(quaternion.tolist()), tuple(rates.tolist()))
         return self.state_of(
             snap.t_ns, None if snapshot is None else np.concatenate(snapshot).tolist(),
             None if snapshot is None else len(snapshot[-1]), uavs,
-            snap.payload_position.tolist(), snap.payload_velocity.tolist(), vec3(gust),
-            measured, None if wind is None else vec3(wind))
+            snap.payload_position.tolist(), payload_velocity, vec3(gust),
+            measured, None if wind is None else vec3(wind), payload_pose)
 
     def state_of(self, t_ns: int, snapshot: list[float] | None, previous: int | None,
                  uavs: Sequence[Sequence[float]], payload_position: Sequence[float],
                  payload_velocity: Sequence[float], gust: Sequence[float],
                  measured: Sequence[Sequence[float]] | None = None,
-                 wind: Sequence[float] | None = None) -> list[Message]:
+                 wind: Sequence[float] | None = None,
+                 payload_pose: tuple[Sequence[float], Sequence[float]] | None = None
+                 ) -> list[Message]:
         """`state` from plain numbers (the one packing of both): `snapshot` the
         FormationSnapshot's numbers in a row (`cdr.FormationSnapshot.pack_row`; None at the
         last tick) with `previous` rotor speeds at its end, per UAV its odometry's 13 numbers
         (position, orientation (x, y, z, w), body-frame velocity, body rates: msgvalues
         .odometry) and (with `sensors:`) those of what its controllers receive, the payload's
         position and velocity, the gust and (where the air moves everywhere) the wind, world
-        [m, m/s]."""
+        [m, m/s]; a rigid payload's `payload_pose` (its orientation (x, y, z, w) and body rates
+        [rad/s]; its velocity then in its own frame, as nav_msgs/Odometry's twist is)."""
+        orientation, spin = (IDENTITY, _ZERO) if payload_pose is None else payload_pose
         out = [(CLOCK, self._clock.pack(t_ns))]
         if snapshot is not None:
             out.append((FORMATION_SNAPSHOT, self._snapshot.pack_row(t_ns, snapshot, previous)))
@@ -100,13 +109,13 @@ class SimulatorMessages:
         if measured is not None:
             for uav, (topic, packer) in zip(measured, self._measured):
                 out.append((topic, packer.pack_row(t_ns, uav)))
-        out.append((PAYLOAD_ODOM, self._payload.pack(t_ns, payload_position, IDENTITY,
-                                                     payload_velocity, _ZERO)))
+        out.append((PAYLOAD_ODOM, self._payload.pack(t_ns, payload_position, orientation,
+                                                     payload_velocity, spin)))
         out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *gust)))
         if self._wind is not None:
             out.append((WIND, self._wind.pack(t_ns, *wind)))
         out.append((TF, self._tf.pack(t_ns, [u[:3] for u in uavs] + [payload_position],
-                                      [u[3:7] for u in uavs] + [IDENTITY])))
+                                      [u[3:7] for u in uavs] + [orientation])))
         return out
 
     def events(self, t_ns: int, rows: np.ndarray) -> list[Message]:

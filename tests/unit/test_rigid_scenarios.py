@@ -1,0 +1,118 @@
+"""Rigid-body payloads in scenarios (issue 20 items 1 and 4): `payload.type: rigid_body`
+validated (its shape, a rigid body's inertia, one attach point per cable), `box_lift` and
+`beam_lift` starting on the constraint manifold and flying the §4.2 mission within Algorithm
+1's tolerance, the point payloads unchanged, and the payload's attitude in the messages."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from conftest import SCENARIOS
+from multilift_control.engine.arrays import engine_flies
+from multilift_control.headless import fly
+from multilift_sim import scenario as scenario_io
+from multilift_sim.dynamics import FormationModel
+from multilift_sim.payload_types import solid_inertia
+from multilift_sim.simulation import initial_state
+
+
+def _edited(name: str, **payload) -> str:
+    data = yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
+    data['payload'].update(payload)
+    for key in [k for k, v in payload.items() if v is None]:
+        del data['payload'][key]
+    return yaml.safe_dump(data)
+
+
+def test_the_box_starts_level_on_every_cable_with_the_solid_s_inertia():
+    scenario = scenario_io.load('box_lift')
+    payload = scenario.payload
+    assert payload.type == 'rigid_body' and payload.shape == 'box'
+    assert payload.inertia == pytest.approx(
+        (2.0 / 12 * (0.36 + 0.16), 2.0 / 12 * (1.0 + 0.16), 2.0 / 12 * (1.0 + 0.36)))
+    model = FormationModel(scenario.formation_params())
+    x = initial_state(scenario)
+    assert x.size == model.layout.size == 2 * (6 * 4 + 3) + 7
+    g, g_dot = model.constraint_residuals(x)
+    assert np.abs(g).max() < 1e-12 and np.abs(g_dot).max() == 0.0
+    assert model.layout.payload_quaternion(x).tolist() == [1.0, 0.0, 0.0, 0.0]
+    # each UAV over its corner's side, the box under the rectangle's centre
+    uavs, payload_position = model.layout.uav_positions(x), model.layout.payload_position(x)
+    assert np.allclose(uavs[:, :2].mean(axis=0), payload_position[:2])
+    assert not engine_flies(scenario)  # tick by tick (the engine flies point payloads)
+
+
+def test_cylinder_inertia_and_the_point_payload_unchanged():
+    assert solid_inertia('cylinder', 1.5, (3.0, 0.03)) == pytest.approx(
+        (0.5 * 1.5 * 0.03 ** 2, 1.5 / 12 * (3 * 0.03 ** 2 + 9.0), 1.5 / 12 * (3 * 0.03 ** 2 + 9.0)))
+    twin = scenario_io.load('twin_lift')
+    assert twin.payload.type == 'point' and twin.formation_params().payload_inertia is None
+    assert initial_state(twin).size == 2 * (6 * 2 + 3)
+
+
+@pytest.mark.parametrize('payload,message', [
+    ({'inertia': [0.1, 0.1, 0.5]}, r"payload\.inertia: \[0\.1, 0\.1, 0\.5\] is no rigid body's"),
+    ({'attach_points': [[0.5, 0.3, 0.2]]}, r'attach_points: .* one \[x, y, z\] per cable \(4\)'),
+    ({'shape': 'sphere'}, r'payload\.shape: .sphere. must be one of box, cylinder'),
+    ({'size': [1.0, 0.6]}, r'payload\.size: .* must be a list of 3 numbers'),
+    ({'type': 'blob'}, r'payload\.type: .blob. must be one of point, rigid_body'),
+    ({'spin': 1.0}, r'payload\.spin: unknown key')])
+def test_bad_rigid_payloads_name_key_and_rule(payload, message):
+    with pytest.raises(scenario_io.ScenarioError, match=message):
+        scenario_io.loads(_edited('box_lift', **payload))
+
+
+def test_a_rigid_payload_needs_the_baumgarte_dae_and_rigid_cables():
+    data = yaml.safe_load((SCENARIOS / 'box_lift.yaml').read_text())
+    data['cable_model'] = 'slack'
+    with pytest.raises(scenario_io.ScenarioError, match='rigid_body needs .* cable_model: rigid'):
+        scenario_io.loads(yaml.safe_dump(data))
+    data['cable_model'] = 'rigid'
+    data['simulation']['integrator'] = 'nullspace'
+    with pytest.raises(scenario_io.ScenarioError, match='rigid_body need simulation.integrator'):
+        scenario_io.loads(yaml.safe_dump(data))
+
+
+@pytest.mark.parametrize('name', ['box_lift', 'beam_lift'])
+def test_the_lifts_fly_the_mission_within_the_tolerance(name):
+    """40 s of the §4.2 mission (the climb, the +x leg, the first corner): |g| far inside
+    eps_g, the rotors unsaturated, the leader within 0.3 m rms of its path, the body's
+    quaternion of unit length and its tilt moderate."""
+    scenario = scenario_io.load(name).with_duration(40.0)
+    run = fly(scenario)
+    summary = run.summary()
+    assert run.error is None
+    assert summary['sim']['max_abs_constraint'] < 1e-6
+    assert max(summary['sim']['saturated_time']) == 0.0
+    assert summary['leader']['rms_tracking_error'] < 0.3
+    layout = run.simulator.model.layout
+    quaternion = layout.payload_quaternion(run.simulator.state)
+    assert abs(np.linalg.norm(quaternion) - 1.0) < 1e-14
+    tilt = 2.0 * math.degrees(math.asin(min(1.0, math.hypot(quaternion[1], quaternion[2]))))
+    assert tilt < 20.0
+
+
+def test_the_payload_s_attitude_is_in_its_odometry_and_tf(tmp_path):
+    """The headless bag's /payload/odom carries the box's orientation (not the identity once
+    it tilts in the climb) and body rates, and /tf's payload frame the same rotation."""
+    from pathlib import Path
+
+    from rosbags.highlevel import AnyReader
+
+    from multilift_tools.headless_bag import record_headless
+    scenario = scenario_io.load('box_lift').with_duration(3.0)
+    record_headless(scenario, tmp_path / 'bag')
+    with AnyReader([Path(tmp_path / 'bag')]) as reader:
+        odom = [c for c in reader.connections if c.topic == '/payload/odom']
+        tf = [c for c in reader.connections if c.topic == '/tf']
+        poses = [reader.deserialize(raw, c.msgtype).pose.pose.orientation
+                 for c, _, raw in reader.messages(odom)]
+        frames = [[t for t in reader.deserialize(raw, c.msgtype).transforms
+                   if t.child_frame_id == 'payload'][0].transform.rotation
+                  for c, _, raw in reader.messages(tf)]
+    last, frame = poses[-1], frames[-1]
+    assert (last.x, last.y, last.z, last.w) == (frame.x, frame.y, frame.z, frame.w)
+    assert abs(last.w) < 1.0 - 1e-6 and (poses[0].x, poses[0].w) == (0.0, 1.0)

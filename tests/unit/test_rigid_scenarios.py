@@ -95,9 +95,10 @@ def test_the_lifts_fly_the_mission_within_the_tolerance(name):
     assert tilt < 20.0
 
 
-def test_the_payload_s_attitude_is_in_its_odometry_and_tf(tmp_path):
+def test_the_payload_s_attitude_is_in_its_odometry_tf_and_plots(tmp_path):
     """The headless bag's /payload/odom carries the box's orientation (not the identity once
-    it tilts in the climb) and body rates, and /tf's payload frame the same rotation."""
+    it tilts in the climb) and body rates, /tf's payload frame the same rotation, and
+    `multilift plot` draws the payload's attitude (a figure a point payload skips)."""
     from pathlib import Path
 
     from rosbags.highlevel import AnyReader
@@ -116,3 +117,6 @@ def test_the_payload_s_attitude_is_in_its_odometry_and_tf(tmp_path):
     last, frame = poses[-1], frames[-1]
     assert (last.x, last.y, last.z, last.w) == (frame.x, frame.y, frame.z, frame.w)
     assert abs(last.w) < 1.0 - 1e-6 and (poses[0].x, poses[0].w) == (0.0, 1.0)
+    from multilift_tools.figures import plot_main
+    assert plot_main([str(tmp_path / 'bag'), '--out', str(tmp_path / 'plots')]) == 0
+    assert (tmp_path / 'plots' / 'payload_attitude.png').stat().st_size > 15_000

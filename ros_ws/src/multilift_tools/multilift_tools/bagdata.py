@@ -224,8 +224,14 @@ class Run:
         return self.topic(PAYLOAD_ODOM)['position']
 
     def payload_velocity(self) -> np.ndarray:
-        """(T, 3) payload velocity [m/s]; child frame `payload` has the axes of `world`."""
+        """(T, 3) payload velocity [m/s] in the child frame `payload` (a point payload's has the
+        axes of `world`; a rigid body's turns with it, docs/rigid_payload.md)."""
         return self.topic(PAYLOAD_ODOM)['linear']
+
+    def payload_euler(self) -> np.ndarray:
+        """(T, 3) the payload's ZYX Euler angles (roll, pitch, yaw) [rad] from /payload/odom's
+        orientation: zero for a point payload, a rigid body's attitude otherwise."""
+        return euler_from_quaternion(self.topic(PAYLOAD_ODOM)['orientation'])
 
     # -- cables ----------------------------------------------------------------------------
     @property

@@ -199,6 +199,29 @@ def fig_attitude(ctx: Context) -> Figure:
     return fig
 
 
+def fig_payload_attitude(ctx: Context) -> Figure:
+    """A rigid payload's roll, pitch and yaw [deg] (/payload/odom, docs/rigid_payload.md)."""
+    run = ctx.run
+    series = run.topic(PAYLOAD_ODOM)
+    euler = np.degrees(run.payload_euler())
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7), layout='constrained')
+    for k, (ax, name) in enumerate(zip(axes, ('roll', 'pitch', 'yaw'))):
+        ax.plot(series.t, euler[:, k], color='0.2', lw=1.2)
+        ax.set_ylabel(f'payload {name} [deg]')
+    axes[0].set_title(f'{run.label}: payload attitude (ZYX Euler angles of its frame in '
+                      f'{WORLD})', fontsize='medium')
+    finish_time_axes(axes)
+    return fig
+
+
+def _lacks_payload_attitude(run: Run) -> list[str]:
+    if not run.has(PAYLOAD_ODOM):
+        return [PAYLOAD_ODOM]
+    orientation = run.topic(PAYLOAD_ODOM)['orientation']
+    rotates = bool(np.any(orientation[:, :3] != 0.0))
+    return [] if rotates else ['a rigid payload (a point payload has no attitude)']
+
+
 def fig_thrust(ctx: Context) -> Figure:
     """Collective thrust per UAV [N]: set-point and, with k_T known, k_T sum(omega^2)."""
     run = ctx.run
@@ -358,6 +381,7 @@ FIGURES: tuple[FigureSpec, ...] = (
     FigureSpec('thrust', fig_thrust, _topics(uav_topic(1, ATTITUDE_SETPOINT))),
     FigureSpec('rotor_speeds', fig_rotor_speeds, _topics(uav_topic(1, ROTOR_CMD))),
     FigureSpec('payload_position', fig_payload_position, _topics(PAYLOAD_ODOM)),
+    FigureSpec('payload_attitude', fig_payload_attitude, _lacks_payload_attitude),
     FigureSpec('leader_tracking', fig_leader_tracking, _topics(REFERENCE_TOPIC)),
 )
 

@@ -120,3 +120,37 @@ def test_the_payload_s_attitude_is_in_its_odometry_tf_and_plots(tmp_path):
     from multilift_tools.figures import plot_main
     assert plot_main([str(tmp_path / 'bag'), '--out', str(tmp_path / 'plots')]) == 0
     assert (tmp_path / 'plots' / 'payload_attitude.png').stat().st_size > 15_000
+
+
+@pytest.mark.parametrize('name,kind', [('box_lift', 1), ('beam_lift', 3)])
+def test_the_markers_draw_the_body_and_end_the_cables_at_its_attach_points(name, kind):
+    """/visualization/markers of a rigid payload: its shape (a CUBE of the box's size, a
+    CYLINDER of the beam's length laid along its x axis) at its pose, each cable from its UAV
+    to its attach point r_p + R_p b_i."""
+    from multilift_sim.physics.rigid_payload import payload_rotation
+    from multilift_sim.simulation import FormationSimulator
+    from multilift_sim.wire.scene import CABLE_SEGMENTS, FormationScene
+
+    scenario = scenario_io.load(name)
+    simulator = FormationSimulator(scenario)
+    layout = simulator.model.layout
+    hover = [np.full(4, 1900.0)] * scenario.n_uavs
+    for _ in range(150):
+        simulator.advance(hover, [np.zeros(4, bool)] * scenario.n_uavs)
+    snap = simulator.snapshot()
+    scene = FormationScene(scenario)
+    scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
+                 snap.payload_position, [1.0] * scenario.n_uavs, None,
+                 snap.payload_attitude[0])
+    assert scene.payload.type == kind
+    rotation = payload_rotation(simulator.state, 2 * layout.n_coordinates)
+    for cable, attach in zip(scene.cables, scenario.payload.attach_points):
+        end = snap.payload_position + rotation @ np.array(attach)
+        assert np.abs(np.array(cable.points[2 * CABLE_SEGMENTS - 1]) - end).max() < 1e-12
+    # the drawn body's axes: the box's x (the cylinder's marker z) along the payload's x
+    x, y, z, w = scene.payload.orientation
+    drawn = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    axis = drawn[:, 0] if kind == 1 else drawn[:, 2]
+    assert np.abs(axis - rotation[:, 0]).max() < 1e-12

@@ -74,7 +74,9 @@ class FormationMarkers:
         if not isinstance(stamp, Time):
             stamp = stamp_from_ns(int(stamp))
         self.scene.update([u.position for u in snapshot.uavs], [u.euler for u in snapshot.uavs],
-                          snapshot.payload_position, tensions, taut)
+                          snapshot.payload_position, tensions, taut,
+                          None if snapshot.payload_attitude is None
+                          else snapshot.payload_attitude[0])
         for marker in self._all:
             marker.header.stamp = stamp
         for marker, spec in self._moving:

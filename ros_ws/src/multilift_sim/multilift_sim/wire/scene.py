@@ -11,7 +11,10 @@ markers (world frame, z up, metres):
 - ns `uav_heading`, id i, ARROW: the body x axis (front), 2 arm lengths long;
 - ns `cable`, id i, LINE_LIST of CABLE_SEGMENTS segments: UAV i's centre of mass to the
   payload, coloured by tension; solid while taut, dashed while slack (`cable_model: slack`);
-- ns `payload`, id 0, SPHERE: the payload, PAYLOAD_DIAMETER across;
+- ns `payload`, id 0, SPHERE: the payload, PAYLOAD_DIAMETER across; a rigid body
+  (docs/rigid_payload.md) its shape at its pose: a CUBE of its size (box) or a CYLINDER of
+  its length and radius, laid along its x axis (cylinder), and the cables end at its attach
+  points;
 - ns `mission_path`, id 0, LINE_STRIP: the leader's reference path through the corners of
   `scenario.mission` (start, then the end of each segment);
 - ns `gust_zone`, id k (from 0), CYLINDER: where gust k blows, radius H (its gradient distance)
@@ -41,7 +44,7 @@ GUST_ALPHA = 0.15  # opacity of a gust zone
 GUST_MARGIN = 1.0  # [m] a gust zone reaches this far above and below the payload's heights
 
 # visualization_msgs/Marker types and action used here
-ARROW, SPHERE, CYLINDER, LINE_STRIP, LINE_LIST = 0, 2, 3, 4, 5
+ARROW, CUBE, SPHERE, CYLINDER, LINE_STRIP, LINE_LIST = 0, 1, 2, 3, 4, 5
 ADD = 0
 
 _LEADER = (0.95, 0.55, 0.05)  # orange
@@ -80,6 +83,28 @@ def mission_corners(scenario: Scenario) -> list[tuple[float, float, float]]:
         last = corners[-1]
         corners.append(tuple(last[k] + segment.velocity[k] * duration for k in range(3)))
     return corners
+
+
+def _rotate(q: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
+    """v rotated by the unit quaternion q = (x, y, z, w): R(q) v."""
+    x, y, z, w = q
+    # v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)
+    cx, cy, cz = y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]
+    return (v[0] + 2.0 * (w * cx + y * cz - z * cy),
+            v[1] + 2.0 * (w * cy + z * cx - x * cz),
+            v[2] + 2.0 * (w * cz + x * cy - y * cx))
+
+
+def _compose(a: Sequence[float], b: Sequence[float]) -> list[float]:
+    """The quaternion product a b, (x, y, z, w) each: rotate by b, then by a."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return [aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz]
+
+
+# a marker CYLINDER's axis is its z: laid along the payload's x by a quarter turn about y
+_ALONG_X = (0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5))
 
 
 @dataclass
@@ -154,8 +179,19 @@ class FormationScene:
                 'cable', i + 1, LINE_LIST, scale=(CABLE_WIDTH, 0.0, 0.0),
                 color=_rgba(tension_color(0.0, self.reference_tension)),
                 points=[(0.0, 0.0, 0.0)] * (2 * CABLE_SEGMENTS)))
-        self.payload = MarkerSpec('payload', 0, SPHERE, scale=(PAYLOAD_DIAMETER,) * 3,
-                                  color=_rgba(_PAYLOAD))
+        payload = scenario.payload
+        self.attach_points = payload.attach_points  # a rigid body's, payload frame [m]
+        if payload.type == 'rigid_body' and payload.shape == 'box':
+            self.payload = MarkerSpec('payload', 0, CUBE, scale=tuple(payload.size),
+                                      color=_rgba(_PAYLOAD))
+        elif payload.type == 'rigid_body':  # a cylinder along its x axis
+            length, radius = payload.size
+            self.payload = MarkerSpec('payload', 0, CYLINDER,
+                                      scale=(2.0 * radius, 2.0 * radius, length),
+                                      color=_rgba(_PAYLOAD))
+        else:
+            self.payload = MarkerSpec('payload', 0, SPHERE, scale=(PAYLOAD_DIAMETER,) * 3,
+                                      color=_rgba(_PAYLOAD))
         self.specs = ([m for trio in zip(self.bodies, self.headings, self.cables)
                        for m in trio] + [self.payload] + _static_specs(scenario))
 
@@ -165,11 +201,11 @@ class FormationScene:
 
     def update(self, uav_positions: Sequence[Sequence[float]],
                uav_euler: Sequence[Sequence[float]], payload_position: Sequence[float],
-               tensions: Sequence[float],
-               taut: Sequence[bool] | None = None) -> list[MarkerSpec]:
+               tensions: Sequence[float], taut: Sequence[bool] | None = None,
+               payload_orientation: Sequence[float] | None = None) -> list[MarkerSpec]:
         """Write one tick's formation into the specs (UAV positions [m] and ZYX Euler angles
         [rad], payload position [m], cable tensions [N], which cables are taut: None for
-        all); returns `specs`."""
+        all; a rigid payload's orientation (x, y, z, w)); returns `specs`."""
         n = self.n_uavs
         if len(uav_positions) != n or len(tensions) != n:
             raise ValueError(f'formation_markers: scenario {self.scenario.name} has {n} UAVs, '
@@ -178,16 +214,24 @@ class FormationScene:
         payload = (float(payload_position[0]), float(payload_position[1]),
                    float(payload_position[2]))
         self.payload.position[:] = payload
+        ends = [payload] * n  # where each cable holds the payload, world [m]
+        if self.attach_points is not None:
+            q = (0.0, 0.0, 0.0, 1.0) if payload_orientation is None else tuple(
+                float(v) for v in payload_orientation)
+            self.payload.orientation[:] = (_compose(q, _ALONG_X)
+                                           if self.payload.type == CYLINDER else list(q))
+            ends = [tuple(p + r for p, r in zip(payload, _rotate(q, b)))
+                    for b in self.attach_points]
         if taut is None:
             taut = [True] * n
-        for position, euler, tension, is_taut, body, heading, cable in zip(
-                uav_positions, uav_euler, tensions, taut, self.bodies, self.headings,
+        for position, euler, tension, is_taut, end, body, heading, cable in zip(
+                uav_positions, uav_euler, tensions, taut, ends, self.bodies, self.headings,
                 self.cables):
             xyz = (float(position[0]), float(position[1]), float(position[2]))
             body.position[:] = xyz
             body.orientation[:] = quaternion(euler)
             heading.position[:] = xyz
             heading.orientation[:] = body.orientation
-            cable.points[:] = _cable_points(xyz, payload, bool(is_taut))
+            cable.points[:] = _cable_points(xyz, end, bool(is_taut))
             cable.color[:3] = tension_color(float(tension), self.reference_tension)
         return self.specs

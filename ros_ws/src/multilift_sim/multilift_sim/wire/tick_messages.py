@@ -138,14 +138,18 @@ class SimulatorMessages:
         """/visualization/markers: the formation of `snap` drawn (cables by tension)."""
         return self.markers_of(snap.t_ns, [u.position for u in snap.uavs],
                                [u.euler for u in snap.uavs], snap.payload_position, tension,
-                               taut)
+                               taut, None if snap.payload_attitude is None
+                               else snap.payload_attitude[0])
 
     def markers_of(self, t_ns: int, positions: Sequence[Sequence[float]],
                    euler: Sequence[Sequence[float]], payload_position: Sequence[float],
-                   tension: Sequence[float], taut: Sequence[bool]) -> Message:
+                   tension: Sequence[float], taut: Sequence[bool],
+                   payload_orientation: Sequence[float] | None = None) -> Message:
         """`markers` from plain numbers: every UAV's position [m] and ZYX Euler angles [rad],
-        the payload's position [m], the cables' tension [N] and which are taut."""
-        self._scene.update(positions, euler, payload_position, tension, taut)
+        the payload's position [m] (and a rigid one's orientation (x, y, z, w)), the cables'
+        tension [N] and which are taut."""
+        self._scene.update(positions, euler, payload_position, tension, taut,
+                           payload_orientation)
         return MARKERS, self._markers.pack(t_ns)
 
 

@@ -97,8 +97,9 @@ def test_the_lifts_fly_the_mission_within_the_tolerance(name):
 
 def test_the_payload_s_attitude_is_in_its_odometry_tf_and_plots(tmp_path):
     """The headless bag's /payload/odom carries the box's orientation (not the identity once
-    it tilts in the climb) and body rates, /tf's payload frame the same rotation, and
-    `multilift plot` draws the payload's attitude (a figure a point payload skips)."""
+    it tilts in the climb) and body rates, /tf's payload frame the same rotation and a frame
+    per attach point under it, and `multilift plot` draws the payload's attitude (a figure a
+    point payload skips)."""
     from pathlib import Path
 
     from rosbags.highlevel import AnyReader
@@ -114,6 +115,12 @@ def test_the_payload_s_attitude_is_in_its_odometry_tf_and_plots(tmp_path):
         frames = [[t for t in reader.deserialize(raw, c.msgtype).transforms
                    if t.child_frame_id == 'payload'][0].transform.rotation
                   for c, _, raw in reader.messages(tf)]
+        connection, _, raw = next(iter(reader.messages(tf)))
+        attach = [(t.header.frame_id, t.child_frame_id, t.transform.translation.x)
+                  for t in reader.deserialize(raw, connection.msgtype).transforms
+                  if t.child_frame_id.startswith('payload/')]
+    assert attach == [('payload', f'payload/attach{i}', x)
+                      for i, x in enumerate((0.5, -0.5, -0.5, 0.5), start=1)]
     last, frame = poses[-1], frames[-1]
     assert (last.x, last.y, last.z, last.w) == (frame.x, frame.y, frame.z, frame.w)
     assert abs(last.w) < 1.0 - 1e-6 and (poses[0].x, poses[0].w) == (0.0, 1.0)

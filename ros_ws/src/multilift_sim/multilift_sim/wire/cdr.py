@@ -338,15 +338,17 @@ class RotorCommand:
 
 
 class TFMessage:
-    """tf2_msgs/TFMessage of one TransformStamped per child frame, all from `frame`:
-    pack(t_ns, translations, rotations), one (x, y, z) and one (x, y, z, w) per child."""
+    """tf2_msgs/TFMessage of one TransformStamped per child frame, each from `frame` (or from
+    its entry of `parents`): pack(t_ns, translations, rotations), one (x, y, z) and one
+    (x, y, z, w) per child."""
 
-    def __init__(self, children: Sequence[str], frame: str = WORLD_FRAME) -> None:
+    def __init__(self, children: Sequence[str], frame: str = WORLD_FRAME,
+                 parents: Sequence[str] | None = None) -> None:
         layout = Layout()
         layout.primitive('I')
         self._names = []
-        for child in children:
-            frame_data = layout.header(frame)
+        for k, child in enumerate(children):
+            frame_data = layout.header(frame if parents is None else parents[k])
             child_data = layout.string(child)
             layout.primitive('d', 7)
             self._names.append((len(frame_data) + 1, frame_data, len(child_data) + 1,

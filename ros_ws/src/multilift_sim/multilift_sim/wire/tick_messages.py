@@ -15,8 +15,8 @@ import numpy as np
 
 from multilift_sim import kernels
 from multilift_sim.wire import cdr
-from multilift_sim.wire.msgvalues import (IDENTITY, PAYLOAD_FRAME, SNAPSHOT_BLOCKS, formation_event,
-                                          formation_snapshot, uav_frame, vec3)
+from multilift_sim.wire.msgvalues import (IDENTITY, PAYLOAD_FRAME, SNAPSHOT_BLOCKS, WORLD_FRAME,
+                                          formation_event, formation_snapshot, uav_frame, vec3)
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS,
                                           MEASURED_POSITION, ODOMETRY_BODY_VELOCITY,
                                           ODOMETRY_COLUMNS, ODOMETRY_QUATERNION)
@@ -53,7 +53,13 @@ class SimulatorMessages:
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
         self._gust = cdr.Vector3Stamped()
         self._wind = cdr.Vector3Stamped() if scenario.has_wind else None  # /formation/wind
-        self._tf = cdr.TFMessage([uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME])
+        # /tf: world -> each UAV, world -> payload, and a rigid payload's attach points
+        # (payload -> payload/attach{i}: where cable i holds it, docs/rigid_payload.md)
+        self._attach = list(scenario.payload.attach_points or ())
+        frames = [uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME]
+        attach_frames = [f'{PAYLOAD_FRAME}/attach{i}' for i in range(1, len(self._attach) + 1)]
+        self._tf = cdr.TFMessage(frames + attach_frames, parents=[WORLD_FRAME] * len(frames)
+                                 + [PAYLOAD_FRAME] * len(attach_frames))
         self._state = cdr.formation_state(n)
         self._scene = FormationScene(scenario)
         self._markers = cdr.MarkerArray(self._scene.specs)
@@ -114,8 +120,9 @@ class SimulatorMessages:
         out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *gust)))
         if self._wind is not None:
             out.append((WIND, self._wind.pack(t_ns, *wind)))
-        out.append((TF, self._tf.pack(t_ns, [u[:3] for u in uavs] + [payload_position],
-                                      [u[3:7] for u in uavs] + [orientation])))
+        out.append((TF, self._tf.pack(
+            t_ns, [u[:3] for u in uavs] + [payload_position] + self._attach,
+            [u[3:7] for u in uavs] + [orientation] + [IDENTITY] * len(self._attach))))
         return out
 
     def events(self, t_ns: int, rows: np.ndarray) -> list[Message]:

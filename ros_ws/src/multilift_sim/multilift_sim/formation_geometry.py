@@ -74,21 +74,25 @@ def nominal_positions(geometry: str, n: int, leader_position, offsets=(), distan
     return out
 
 
-def hanging_payload(uav_positions: np.ndarray, cable_lengths,
-                    attach_points=None) -> tuple[np.ndarray, np.ndarray]:
+def hanging_payload(uav_positions: np.ndarray, cable_lengths, attach_points=None,
+                    uav_offsets=None) -> tuple[np.ndarray, np.ndarray]:
     """(uav_positions, payload_position) with every cable at its length, payload below.
 
     The payload sits under the UAVs' horizontal centroid (their equilibrium point when that
     is equidistant, as for the twin-lift, the V of three and circles); the leader keeps its
     altitude and each follower's altitude is set so its cable has exactly its length. A rigid
     payload (`attach_points` b_i (n, 3), its frame, level: the identity attitude) hangs with
-    its centre under the centroid of r_i - b_i, cable i from UAV i to r_p + b_i.
+    its centre under the centroid of r_i - b_i, cable i from UAV i to r_p + b_i; a cable held
+    off its UAV's centre (`uav_offsets` R_i a_i (n, 3), world) starts at r_i + R_i a_i.
     Raises ValueError naming the cable when a UAV is farther from that point than its cable.
     """
     uavs = np.array(uav_positions, dtype=float)
     lengths = np.asarray(cable_lengths, dtype=float)
     attach = np.zeros((len(uavs), 3)) if attach_points is None else np.asarray(
         attach_points, dtype=float)
+    offsets = np.zeros((len(uavs), 3)) if uav_offsets is None else np.asarray(uav_offsets,
+                                                                               dtype=float)
+    uavs = uavs + offsets  # the cables' upper ends
     centre = (uavs[:, :2] - attach[:, :2]).mean(axis=0)
     spans = np.linalg.norm(uavs[:, :2] - attach[:, :2] - centre, axis=1)
     for i, (span, length) in enumerate(zip(spans, lengths)):
@@ -99,7 +103,7 @@ def hanging_payload(uav_positions: np.ndarray, cable_lengths,
     drops = np.sqrt(lengths ** 2 - spans ** 2) + attach[:, 2]
     payload = np.array([centre[0], centre[1], uavs[0, 2] - drops[0]])
     uavs[:, 2] = payload[2] + drops
-    return uavs, payload
+    return uavs - offsets, payload
 
 
 def swing_about_uav_axis(payload: np.ndarray, first: np.ndarray, second: np.ndarray,

@@ -19,7 +19,7 @@ from multilift_sim.physics.layout import (
     FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS, FORMATION_SCALARS, FORMATION_TWO_ALPHA,
     FORMATION_WIND, GUST_CENTER, GUST_COLUMNS, GUST_DIRECTION, GUST_GRADIENT_DISTANCE,
     GUST_REFERENCE_SPEED, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ,
-    UAV_MASS, UAV_PAYLOAD_ATTACH)
+    UAV_ATTACH, UAV_MASS, UAV_PAYLOAD_ATTACH)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -40,6 +40,8 @@ class FormationParams:
     # neither: the seed's point mass)
     payload_inertia: tuple[float, float, float] | None = None
     payload_attach_points: tuple[tuple[float, float, float], ...] | None = None
+    # where each cable holds its UAV, a_i [m] in its body frame FLU (None: every centre of mass)
+    uav_attach_points: tuple[tuple[float, float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         uavs = tuple(self.uavs)
@@ -97,6 +99,14 @@ class FormationParams:
                                  f'{self.payload_attach_points!r}')
             object.__setattr__(self, 'payload_inertia', inertia)
             object.__setattr__(self, 'payload_attach_points', points)
+        if self.uav_attach_points is not None:
+            points = tuple(tuple(float(v) for v in point) for point in self.uav_attach_points)
+            if len(points) != len(uavs) or any(len(point) != 3 or not all(
+                    math.isfinite(v) for v in point) for point in points):
+                raise ValueError(f'FormationParams.uav_attach_points must give one finite '
+                                 f'(x, y, z) [m] per UAV ({len(uavs)}), got '
+                                 f'{self.uav_attach_points!r}')
+            object.__setattr__(self, 'uav_attach_points', points)
 
     @property
     def n_uavs(self) -> int:
@@ -239,6 +249,8 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
         params.payload_inertia if params.rigid_payload else 0.0)
     uavs[:, UAV_PAYLOAD_ATTACH:UAV_PAYLOAD_ATTACH + 3] = (
         params.payload_attach_points if params.rigid_payload else 0.0)
+    uavs[:, UAV_ATTACH:UAV_ATTACH + 3] = (0.0 if params.uav_attach_points is None
+                                          else params.uav_attach_points)
     return uavs, gusts, formation
 
 

@@ -99,8 +99,10 @@ def initial_state(scenario: Scenario) -> np.ndarray:
                                          scenario.payload.alpha, scenario.payload.beta)
     formation = scenario.formation
     uavs, payload = formation_start(scenario)
-    if scenario.payload.swing:
-        payload = swing_about_uav_axis(payload, uavs[0], uavs[1], scenario.payload.swing)
+    if scenario.payload.swing:  # about the line through the cables' upper ends
+        offsets = uav_offsets(scenario)
+        ends = uavs if offsets is None else uavs + offsets
+        payload = swing_about_uav_axis(payload, ends[0], ends[1], scenario.payload.swing)
     euler = np.array([[0.0, 0.0, u.yaw] for u in scenario.uavs])
     layout = StateLayout(scenario.n_uavs, scenario.payload.type == 'rigid_body')
     assert formation is not None
@@ -113,7 +115,20 @@ def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position, f.offsets,
                              f.distance, f.half_angle)
     return hanging_payload(uavs, [u.cable_length for u in scenario.uavs],
-                           scenario.payload.attach_points)
+                           scenario.payload.attach_points, uav_offsets(scenario))
+
+
+def uav_offsets(scenario: Scenario) -> np.ndarray | None:
+    """Where each cable holds its level UAV relative to its centre at the start, R_z(yaw) a_i
+    (n, 3) [m], world; None when every cable holds its UAV's centre."""
+    if not any(any(u.attach_point) for u in scenario.uavs):
+        return None
+    out = np.empty((scenario.n_uavs, 3))
+    for i, u in enumerate(scenario.uavs):
+        c, s = math.cos(u.yaw), math.sin(u.yaw)
+        x, y, z = u.attach_point
+        out[i] = (c * x - s * y, s * x + c * y, z)
+    return out
 
 
 @dataclass(frozen=True)

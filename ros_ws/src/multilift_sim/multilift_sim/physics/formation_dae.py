@@ -18,13 +18,16 @@ Woodbury identity (`cable_multipliers`).
 import numpy as np
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.free_motion import (air_velocity,  # noqa: F401 - its users' name
-                                              payload_force_per_mass, uav_free_motion)
+from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  # noqa: F401
+                                              attached_off_centre, cable_moment_arm,
+                                              payload_force_per_mass, rotational_compliance,
+                                              uav_attach_motion, uav_free_motion)
 from multilift_sim.physics.nullspace import nullspace_solve
 from multilift_sim.physics.rigid_payload import (normalize_quaternion, rigid_residuals,
                                                  rigid_solve)
 from multilift_sim.physics.layout import (
-    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ,
+    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST,
+    FORMATION_BETA_SQ,
     FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
     FORMATION_TWO_ALPHA, PAYLOAD_COORDINATES, POSITION, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
@@ -110,17 +113,34 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
         thrust_ax, thrust_ay, thrust_az = uav_free_motion(x, i, wrenches, uavs, formation, acc)
 
         # cable i: d = r_p - r_i, its rate, and row i of the multiplier equation (Eq. 2.60)
+        free_x, free_y, free_z = thrust_ax, thrust_ay, thrust_az  # the cable end's, uncabled
+        k0 = k1 = k2 = 0.0
+        if attached_off_centre(uavs, i):  # held at a_i: d from r_i + R_i a_i (issue 20)
+            attach = np.empty((3, 3))
+            rotation = uav_attach_motion(x, i, wrenches, uavs, attach)
+            rx, ry, rz = rx + attach[0, 0], ry + attach[0, 1], rz + attach[0, 2]
+            vx, vy, vz = vx + attach[1, 0], vy + attach[1, 1], vz + attach[1, 2]
+            free_x, free_y = thrust_ax + attach[2, 0], thrust_ay + attach[2, 1]
+            free_z = thrust_az + attach[2, 2]
+            k0, k1, k2 = cable_moment_arm(uavs, i, rotation, px - rx, py - ry, pz - rz)
         dx, dy, dz = px - rx, py - ry, pz - rz
         dvx, dvy, dvz = pvx - vx, pvy - vy, pvz - vz
         offset_sq = dx * dx + dy * dy + dz * dz
         cables[i, CABLE_RHS] = (
-            2.0 * (dx * (drag_ax - thrust_ax) + dy * (drag_ay - thrust_ay)
-                   + dz * (drag_az - thrust_az))                       # G M^-1 f
+            2.0 * (dx * (drag_ax - free_x) + dy * (drag_ay - free_y)
+                   + dz * (drag_az - free_z))                          # G M^-1 f
             + 2.0 * (dvx * dvx + dvy * dvy + dvz * dvz)                # G_dot q_dot
             + two_alpha * 2.0 * (dx * dvx + dy * dvy + dz * dvz)       # 2 alpha_f g_dot
             + beta_sq * (offset_sq - length_sq))                       # beta_f^2 g
         # G M^-1 G^T = diag(4 |d_i|^2 / m_i) + 4 D D^T / m_p: 1 / delta_i of the diagonal
-        cables[i, CABLE_INV_DELTA] = 0.25 * mass / offset_sq
+        # (held off its centre, the UAV's rotation adds 4 k_i . J_i^-1 k_i to delta_i)
+        if k0 == 0.0 and k1 == 0.0 and k2 == 0.0:
+            cables[i, CABLE_INV_DELTA] = 0.25 * mass / offset_sq
+        else:
+            cables[i, CABLE_INV_DELTA] = 1.0 / (
+                4.0 * offset_sq / mass + 4.0 * rotational_compliance(uavs, i, k0, k1, k2))
+        cables[i, CABLE_MOMENT], cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2] = \
+            k0, k1, k2
         cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], cables[i, CABLE_OFFSET + 2] = \
             dx, dy, dz
         cables[i, CABLE_THRUST], cables[i, CABLE_THRUST + 1], cables[i, CABLE_THRUST + 2] = \
@@ -138,6 +158,10 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
         acc[r] = cables[i, CABLE_THRUST] + pull * dx
         acc[r + 1] = cables[i, CABLE_THRUST + 1] + pull * dy
         acc[r + 2] = cables[i, CABLE_THRUST + 2] + pull * dz - gravity
+        if cables[i, CABLE_MOMENT] != 0.0 or cables[i, CABLE_MOMENT + 1] != 0.0 or \
+                cables[i, CABLE_MOMENT + 2] != 0.0:  # the pull's moment on the UAV's attitude
+            add_cable_torque(x, i, uavs, acc, 2.0 * multiplier, cables[i, CABLE_MOMENT],
+                             cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
         sum_x += multiplier * dx
         sum_y += multiplier * dy
         sum_z += multiplier * dz
@@ -203,6 +227,11 @@ def residuals(x, uavs, g, g_dot):
         dvx = x[nq + p] - x[nq + b]
         dvy = x[nq + p + 1] - x[nq + b + 1]
         dvz = x[nq + p + 2] - x[nq + b + 2]
+        if attached_off_centre(uavs, i):  # from the attach point r_i + R_i a_i
+            attach = np.empty((3, 3))
+            uav_attach_motion(x, i, np.zeros((n, 4)), uavs, attach)
+            dx, dy, dz = dx - attach[0, 0], dy - attach[0, 1], dz - attach[0, 2]
+            dvx, dvy, dvz = dvx - attach[1, 0], dvy - attach[1, 1], dvz - attach[1, 2]
         g[i] = dx * dx + dy * dy + dz * dz - uavs[i, UAV_LENGTH_SQ]
         g_dot[i] = 2.0 * (dx * dvx + dy * dvy + dz * dvz)
 

@@ -48,7 +48,8 @@ UAV_INV_INERTIA = 2         # 1/I_xx, 1/I_yy, 1/I_zz [1/(kg m^2)], body FLU axes
 UAV_GYRO = 5                # (I_zz - I_yy)/I_xx, (I_xx - I_zz)/I_yy, (I_yy - I_xx)/I_zz (3)
 UAV_DRAG = 8                # c_d [N s^2/m^2]: the UAV's quadratic drag in the wind; 0: none
 UAV_PAYLOAD_ATTACH = 9      # b_i [m]: where its cable holds a rigid payload, payload frame (3)
-UAV_COLUMNS = 12
+UAV_ATTACH = 12             # a_i [m]: where its cable holds the UAV, body FLU; 0: its centre (3)
+UAV_COLUMNS = 15
 
 # -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
@@ -106,7 +107,8 @@ CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots)
 CABLE_RHS = 3               # row i of the right-hand side of the multiplier equation
 CABLE_INV_DELTA = 4         # 1 / delta_i = m_i / (4 |d_i|^2) [kg/m^2]
 CABLE_THRUST = 5            # UAV i's thrust (and drag) acceleration u_T R e_z / m_i [m/s^2] (3)
-CABLE_COLUMNS = 8
+CABLE_MOMENT = 8            # k_i = a_i x R_i^T d_i [m^2], body FLU: the pull's moment arm (3)
+CABLE_COLUMNS = 11
 
 # -- an RK4 step's scratch (rows of a (WORK_ROWS, 2 (6n + 3)) array) ---------------------------
 WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives (consecutive rows)

@@ -28,7 +28,10 @@ import math
 import numpy as np
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.free_motion import payload_force_per_mass, uav_free_motion
+from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_centre,
+                                              cable_moment_arm, payload_force_per_mass,
+                                              rotational_compliance, uav_attach_motion,
+                                              uav_free_motion)
 from multilift_sim.physics.layout import (FORMATION_BETA_SQ, FORMATION_GRAVITY,
                                           FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
                                           FORMATION_TWO_ALPHA, PAYLOAD_BODY_RATES,
@@ -62,8 +65,10 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @jit
-def cable_geometry(x, uavs, i, rotation, omega_world, base):
-    """Cable i's (d_i, d_i_dot, e_i = R_p b_i) at x, world [m, m/s, m], as 3 + 3 + 3 floats."""
+def cable_geometry(x, uavs, i, rotation, omega_world, base, attach):
+    """Cable i's (d_i, d_i_dot, e_i = R_p b_i) at x, world [m, m/s, m], as 3 + 3 + 3 floats;
+    `attach` (3, 3): UAV i's attach point's offset, rate and acceleration
+    (`free_motion.uav_attach_motion`; zeros for its centre of mass)."""
     n = uavs.shape[0]
     p = UAV_COORDINATES * n
     nq = p + PAYLOAD_COORDINATES
@@ -74,12 +79,12 @@ def cable_geometry(x, uavs, i, rotation, omega_world, base):
     e1 = rotation[1, 0] * b0 + rotation[1, 1] * b1 + rotation[1, 2] * b2
     e2 = rotation[2, 0] * b0 + rotation[2, 1] * b1 + rotation[2, 2] * b2
     spin0, spin1, spin2 = _cross(omega_world[0], omega_world[1], omega_world[2], e0, e1, e2)
-    d0 = x[p] + e0 - x[r]
-    d1 = x[p + 1] + e1 - x[r + 1]
-    d2 = x[p + 2] + e2 - x[r + 2]
-    v0 = x[nq + p] + spin0 - x[nq + r]
-    v1 = x[nq + p + 1] + spin1 - x[nq + r + 1]
-    v2 = x[nq + p + 2] + spin2 - x[nq + r + 2]
+    d0 = x[p] + e0 - x[r] - attach[0, 0]
+    d1 = x[p + 1] + e1 - x[r + 1] - attach[0, 1]
+    d2 = x[p + 2] + e2 - x[r + 2] - attach[0, 2]
+    v0 = x[nq + p] + spin0 - x[nq + r] - attach[1, 0]
+    v1 = x[nq + p + 1] + spin1 - x[nq + r + 1] - attach[1, 1]
+    v2 = x[nq + p + 2] + spin2 - x[nq + r + 2] - attach[1, 2]
     return d0, d1, d2, v0, v1, v2, e0, e1, e2
 
 
@@ -121,12 +126,21 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
     rhs = np.zeros(n)
     inv_delta = np.zeros(n)
     thrust = np.empty((n, 3))
+    moment = np.zeros((n, 3))  # k_i of a UAV held off its centre (free_motion)
+    attach = np.zeros((3, 3))
     for i in range(n):
         thrust[i, 0], thrust[i, 1], thrust[i, 2] = uav_free_motion(x, i, wrenches, uavs,
                                                                    formation, acc)
         if not taut[i]:
             continue
-        d0, d1, d2, v0, v1, v2, e0, e1, e2 = cable_geometry(x, uavs, i, rotation, w, base)
+        attach[:, :] = 0.0
+        uav_rotation_i = np.eye(3)
+        if attached_off_centre(uavs, i):
+            uav_rotation_i = uav_attach_motion(x, i, wrenches, uavs, attach)
+        d0, d1, d2, v0, v1, v2, e0, e1, e2 = cable_geometry(x, uavs, i, rotation, w, base,
+                                                            attach)
+        moment[i, 0], moment[i, 1], moment[i, 2] = cable_moment_arm(uavs, i, uav_rotation_i,
+                                                                    d0, d1, d2)
         d[i, 0], d[i, 1], d[i, 2] = d0, d1, d2
         # f_i = R_p^T d_i, c_i = b_i x f_i (payload frame)
         f0 = rotation[0, 0] * d0 + rotation[1, 0] * d1 + rotation[2, 0] * d2
@@ -139,13 +153,15 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         cp0, cp1, cp2 = _cross(w[0], w[1], w[2], s0, s1, s2)  # w x (w x e_i)
         offset_sq = d0 * d0 + d1 * d1 + d2 * d2
         rhs[i] = (2.0 * (v0 * v0 + v1 * v1 + v2 * v2)
-                  + 2.0 * (d0 * (drag0 - thrust[i, 0]) + d1 * (drag1 - thrust[i, 1])
-                           + d2 * (drag2 - thrust[i, 2]))
+                  + 2.0 * (d0 * (drag0 - thrust[i, 0] - attach[2, 0])
+                           + d1 * (drag1 - thrust[i, 1] - attach[2, 1])
+                           + d2 * (drag2 - thrust[i, 2] - attach[2, 2]))
                   + 2.0 * (c[i, 0] * alpha0[0] + c[i, 1] * alpha0[1] + c[i, 2] * alpha0[2])
                   + 2.0 * (d0 * cp0 + d1 * cp1 + d2 * cp2)
                   + two_alpha * 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
                   + beta_sq * (offset_sq - uavs[i, UAV_LENGTH_SQ]))
-        inv_delta[i] = 0.25 * uavs[i, UAV_MASS] / offset_sq
+        inv_delta[i] = 1.0 / (4.0 * offset_sq / uavs[i, UAV_MASS] + 4.0 * rotational_compliance(
+            uavs, i, moment[i, 0], moment[i, 1], moment[i, 2]))
     # Woodbury: S = diag(m_p I, J) + sum_i U_i U_i^T / delta_i, U_i = 2 (d_i, c_i)
     s = np.zeros((6, 6))
     for k in range(3):
@@ -180,6 +196,9 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         acc[r] = thrust[i, 0] + pull * d[i, 0]
         acc[r + 1] = thrust[i, 1] + pull * d[i, 1]
         acc[r + 2] = thrust[i, 2] + pull * d[i, 2] - gravity
+        if lam != 0.0 and attached_off_centre(uavs, i):  # the pull's moment on the UAV
+            add_cable_torque(x, i, uavs, acc, 2.0 * lam, moment[i, 0],
+                             moment[i, 1], moment[i, 2])
         pull0 += lam * d[i, 0]
         pull1 += lam * d[i, 1]
         pull2 += lam * d[i, 2]
@@ -211,8 +230,12 @@ def rigid_residuals(x, uavs, g, g_dot):
     base = 2 * (UAV_COORDINATES * n + PAYLOAD_COORDINATES)
     rotation = payload_rotation(x, base)
     w = world_rates(x, base, rotation)
+    attach = np.zeros((3, 3))
     for i in range(n):
-        d0, d1, d2, v0, v1, v2, _, _, _ = cable_geometry(x, uavs, i, rotation, w, base)
+        attach[:, :] = 0.0
+        if attached_off_centre(uavs, i):
+            uav_attach_motion(x, i, np.zeros((n, 4)), uavs, attach)
+        d0, d1, d2, v0, v1, v2, _, _, _ = cable_geometry(x, uavs, i, rotation, w, base, attach)
         g[i] = d0 * d0 + d1 * d1 + d2 * d2 - uavs[i, UAV_LENGTH_SQ]
         g_dot[i] = 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
 

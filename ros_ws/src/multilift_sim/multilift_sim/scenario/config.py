@@ -55,6 +55,8 @@ class UavConfig:
     cable_length: float              # l_i [m]
     position: tuple[float, float, float]  # initial position, world [m]
     yaw: float                       # initial yaw [rad]
+    # where its cable holds it, body FLU [m] (issue 20; default its centre of mass)
+    attach_point: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -196,6 +198,8 @@ class Scenario:
             baumgarte_beta=sim.baumgarte_beta if baumgarte_beta is None else baumgarte_beta,
             payload_inertia=self.payload.inertia,
             payload_attach_points=self.payload.attach_points,
+            uav_attach_points=(tuple(u.attach_point for u in self.uavs)
+                               if any(any(u.attach_point) for u in self.uavs) else None),
         )
 
     def with_duration(self, duration: float) -> 'Scenario':

@@ -95,7 +95,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
         uavs.append(UavConfig(vehicle=vehicle, cable_length=u.positive('cable_length',
                                                                        default_cable),
                               position=u.vector('position', [0.0, 0.0, 0.0]),
-                              yaw=u.number('yaw', 0.0)))
+                              yaw=u.number('yaw', 0.0),
+                              attach_point=u.vector('attach_point', [0.0, 0.0, 0.0])))
         u.done()
 
     p = top.section('payload')
@@ -203,10 +204,16 @@ def scenario_of(data: Any, where: str) -> Scenario:
     windy = any(wind) or turbulence is not None or any(u.vehicle.drag_coefficient
                                                        for u in scenario.uavs)
     rigid = payload.type == 'rigid_body'
+    off_centre = [i + 1 for i, u in enumerate(scenario.uavs) if any(u.attach_point)]
+    if off_centre and cable_model != 'rigid':
+        raise ScenarioError(f'{where}: uavs[{off_centre[0] - 1}].attach_point needs '
+                            f'cable_model: rigid (slack cables off a UAV\'s centre: not yet)')
     for used, what in ((windy, 'wind and vehicle.drag_coefficient'), (events, 'events'),
                        (lagging, f'vehicle.motor_time_constant / motor_rate_limit '
                                  f'(uav{lagging[0] if lagging else 0})'),
-                       (rigid, 'payload.type: rigid_body')):
+                       (rigid, 'payload.type: rigid_body'),
+                       (off_centre,
+                        f'uavs[{off_centre[0] - 1 if off_centre else 0}].attach_point')):
         if used and sim.integrator != 'baumgarte':
             raise ScenarioError(f'{where}: {what} need simulation.integrator: baumgarte, got '
                                 f'{sim.integrator!r}')

@@ -155,12 +155,13 @@ def test_runnable_follows_the_kernel_variable(monkeypatch):
 
 
 @pytest.mark.parametrize('prefix, columns, widths', [
-    ('UAV_', 'UAV_COLUMNS', {'UAV_INV_INERTIA': 3, 'UAV_GYRO': 3, 'UAV_PAYLOAD_ATTACH': 3}),
+    ('UAV_', 'UAV_COLUMNS', {'UAV_INV_INERTIA': 3, 'UAV_GYRO': 3, 'UAV_PAYLOAD_ATTACH': 3,
+                             'UAV_ATTACH': 3}),
     ('GUST_', 'GUST_COLUMNS', {'GUST_CENTER': 2, 'GUST_DIRECTION': 3}),
     ('FORMATION_', 'FORMATION_SCALARS', {'FORMATION_WIND': 3, 'FORMATION_PAYLOAD_INERTIA': 3}),
     ('ACTUATOR_', 'ACTUATOR_COLUMNS', {}),
     ('EVENT_', 'EVENT_COLUMNS', {'EVENT_VELOCITY': 3}),
-    ('CABLE_', 'CABLE_COLUMNS', {'CABLE_OFFSET': 3, 'CABLE_THRUST': 3}),
+    ('CABLE_', 'CABLE_COLUMNS', {'CABLE_OFFSET': 3, 'CABLE_THRUST': 3, 'CABLE_MOMENT': 3}),
     ('WRENCH_', 'WRENCH_COLUMNS', {'WRENCH_TORQUE': 3}),
     ('WORK_', 'WORK_ROWS', {}),
 ])

@@ -131,6 +131,15 @@ def uav_offsets(scenario: Scenario) -> np.ndarray | None:
     return out
 
 
+def payload_attitude(state: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A rigid payload's (orientation (x, y, z, w), body rates [rad/s], R_p (3, 3) payload
+    frame -> world) in a state of n UAVs (Snapshot.payload_attitude; the engine's bag too)."""
+    base = 2 * (6 * n + 3)
+    w, x, y, z = state[base:base + 4]
+    return (np.array([x, y, z, w]), state[base + 4:base + 7].copy(),
+            payload_rotation(state, base))
+
+
 @dataclass(frozen=True)
 class TickCables:
     """What `/formation/state` of a tick needs, kept while the tick is integrated: its
@@ -231,12 +240,7 @@ class FormationSimulator:
             body_rates=row[MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3],
             body_velocity=row[ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3],
             orientation=row[ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4]) for row in odometry)
-        attitude = None
-        layout = self.model.layout
-        if layout.rigid_payload:
-            w, x, y, z = layout.payload_quaternion(self.state)
-            attitude = (np.array([x, y, z, w]), layout.payload_body_rates(self.state).copy(),
-                        payload_rotation(self.state, 2 * nq))
+        attitude = payload_attitude(self.state, n) if self.model.layout.rigid_payload else None
         return Snapshot(self.t_ns, uavs, self.state[6 * n:nq].copy(),
                         self.state[nq + 6 * n:2 * nq].copy(), odometry, measured, attitude)
 

@@ -31,8 +31,10 @@ from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
 from multilift_sim.formulations import make_formulation
 from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, TickCables
-from multilift_sim.wire.tick_messages import SimulatorMessages, measured_odometry, state_rows
+from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot, TickCables,
+                                      payload_attitude)
+from multilift_sim.wire.tick_messages import (SimulatorMessages, measured_odometry, payload_motion,
+                                              state_rows)
 from multilift_sim.topics import MARKER_DECIMATION, scenario_topics
 
 # ticks per compiled call (and between two progress reports): 2.5 s of a 100 Hz mission
@@ -69,6 +71,7 @@ class EngineBag:
         self._reference = int(arrays.leader_mode[0]) == MODE_CASCADE
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
+        self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
         # /formation/wind by tick: the steady wind plus the unsteady wind series (or none)
         self._wind = None
         if scenario.has_wind:
@@ -102,7 +105,17 @@ class EngineBag:
         odometry = odometry.tolist()
         euler = states[:, :6 * n].reshape(count, n, 6)[..., 3:].tolist()
         payload_position = states[:, 6 * n:6 * n + 3].tolist()
-        payload_velocity = states[:, 12 * n + 3:12 * n + 6].tolist()
+        payload_velocity = states[:, 12 * n + 3:12 * n + 6]
+        poses = [None] * count
+        orientations = [None] * count  # a rigid payload's, for the markers
+        if self._rigid:  # its pose and its twist in its frame, as the per-object path packs
+            motions = [payload_motion(payload_attitude(state, n), velocity)
+                       for state, velocity in zip(states, payload_velocity)]
+            payload_velocity = [motion[0] for motion in motions]
+            poses = [motion[1] for motion in motions]
+            orientations = [pose[0] for pose in poses]
+        else:
+            payload_velocity = payload_velocity.tolist()
         gusts = record.gust[:count, 0].tolist()
         speed_lists, saturated = speeds.tolist(), record.saturated[:count, 0].tolist()
         setpoints, thrusts = record.setpoints[:count, 0].tolist(), record.thrust[:count, 0].tolist()
@@ -119,7 +132,7 @@ class EngineBag:
             messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
                                           odometry[k], payload_position[k],
                                           payload_velocity[k], gusts[k], measured[k],
-                                          winds[k])
+                                          winds[k], poses[k])
             messages += self._events_at(tick, t_ns)
             for i in range(n):
                 if not self._controllers:
@@ -131,7 +144,7 @@ class EngineBag:
                                       errors[i][k] if i else None, rates[i][k] if i else None)
             write(messages, t_ns)
             self._formation(tick, t_ns, tension[k], g[k], g_dot[k], taut[k], odometry[k],
-                            euler[k], payload_position[k])
+                            euler[k], payload_position[k], orientations[k])
 
     def last(self) -> None:
         """Write the state at t_max (the engine's current state, which nothing answers) and
@@ -145,11 +158,12 @@ class EngineBag:
         payload_position = state[6 * n:6 * n + 3].tolist()
         measured = measured_odometry(engine.measured()[:1])[0].tolist() if self._sensors \
             else None
+        velocity, pose = payload_motion(payload_attitude(state, n) if self._rigid else None,
+                                        state[12 * n + 3:12 * n + 6])
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
-                                             state[12 * n + 3:12 * n + 6].tolist(),
-                                             memory.gust[0].tolist(), measured,
+                                             velocity, memory.gust[0].tolist(), measured,
                                              None if self._wind is None
-                                             else self._wind[tick].tolist())
+                                             else self._wind[tick].tolist(), pose)
                     + self._events_at(tick, t_ns), t_ns)
         scenario = self._scenario
         model = make_formulation(scenario.simulation.integrator, scenario.formation_params(),
@@ -163,7 +177,8 @@ class EngineBag:
         tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
-                        state[:6 * n].reshape(n, 6)[:, 3:].tolist(), payload_position)
+                        state[:6 * n].reshape(n, 6)[:, 3:].tolist(), payload_position,
+                        None if pose is None else pose[0])
 
     def _events_at(self, tick: int, t_ns: int) -> list:
         """/formation/events of the events that fall on `tick` (the state there shows them)."""
@@ -172,12 +187,14 @@ class EngineBag:
             else []
 
     def _formation(self, tick: int, t_ns: int, tension: list, g: list, g_dot: list,
-                   taut: list, odometry: list, euler: list, payload_position: list) -> None:
+                   taut: list, odometry: list, euler: list, payload_position: list,
+                   payload_orientation=None) -> None:
         """`/formation/state` of a tick and, every MARKER_DECIMATION-th, its markers."""
         messages = [self._simulator.formation_of(t_ns, tension, g, g_dot, taut)]
         if tick % MARKER_DECIMATION == 0:
             messages.append(self._simulator.markers_of(
-                t_ns, [u[:3] for u in odometry], euler, payload_position, tension, taut))
+                t_ns, [u[:3] for u in odometry], euler, payload_position, tension, taut,
+                payload_orientation))
         self._write(messages, t_ns)
 
 

@@ -56,6 +56,7 @@ class FormationArrays(NamedTuple):
     slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
     events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
     wind_series: np.ndarray       # (B, ticks + 1 or 0, 3): the unsteady wind by tick [m/s]
+    state_size: np.ndarray        # (B,) int: the state's length (a rigid payload adds its attitude)
     # what the controllers receive (`sensors:`; simulation.SensorArrays, physics.sensors)
     sensor_errors: np.ndarray     # (B, S or 0, n, MEASURED_COLUMNS): each sample's error
     sensor_delivered: np.ndarray  # (B, S or 0, n) bool: whether the sample arrives
@@ -91,7 +92,7 @@ class FormationArrays(NamedTuple):
 
 class FormationMemory(NamedTuple):
     """What a tick changes, for B formations (first axis)."""
-    state: np.ndarray             # (B, 2(6n + 3)): the formation state at the current tick
+    state: np.ndarray             # (B, state_size): the formation state at the current tick
     taut: np.ndarray              # (B, n) bool: which cables are taut
     rotors: np.ndarray            # (B, n, rotors): rotor speeds [rad/s], NaN before a command
     effectiveness: np.ndarray     # (B, n, rotors): each rotor's share of its thrust, in [0, 1]
@@ -123,7 +124,7 @@ class FormationMemory(NamedTuple):
 class TickRecord(NamedTuple):
     """What ticks leave for a bag: (ticks, B, ...) each; a tick's row k holds the state at the
     tick and the answers to it, and the tension of the integration that starts there."""
-    states: np.ndarray            # (ticks, B, 2(6n + 3))
+    states: np.ndarray            # (ticks, B, state_size): 2(6n + 3), + 7 with a rigid payload
     measured: np.ndarray          # (ticks, B, n, UAV_STATE_SIZE)
     speeds: np.ndarray            # (ticks, B, n, rotors) [rad/s]
     saturated: np.ndarray         # (ticks, B, n, rotors) bool
@@ -142,10 +143,7 @@ class TickRecord(NamedTuple):
 def not_flown(scenario: Scenario) -> str | None:
     """Why the engine does not fly `scenario` as FormationSimulator does, or None: it flies the
     seed's DAE (`simulation.integrator: baumgarte`, rigid or slack cables) with one rotor
-    count for every UAV and a point payload (the others go tick by tick:
-    `headless.run_headless`; a rigid payload's state is longer than the engine's records)."""
-    if scenario.payload.type != 'point':
-        return f'payload.type is {scenario.payload.type!r} (the engine flies point payloads)'
+    count for every UAV (the others go tick by tick: `headless.run_headless`)."""
     if scenario.simulation.integrator != 'baumgarte':
         return f'simulation.integrator is {scenario.simulation.integrator!r}, not baumgarte'
     rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
@@ -196,7 +194,7 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         actuators=actuator_array(params),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
         slack=scenario.cable_model == 'slack', events=event_array(scenario),
-        wind_series=wind_series(scenario),
+        wind_series=wind_series(scenario), state_size=initial_state(scenario).size,
         sensor_errors=sensors.errors, sensor_delivered=sensors.delivered,
         sensor_every=sensors.every, sensor_latency=sensors.latency,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
@@ -283,7 +281,7 @@ def empty_record(arrays: FormationArrays, ticks: int) -> TickRecord:
     batch, n, _ = arrays.uavs.shape
     rotors = arrays.allocation.shape[-1]
     rows = int(arrays.own_rows.max())
-    size = 2 * (6 * n + 3)
+    size = int(arrays.state_size[0])
     return TickRecord(
         states=np.empty((ticks, batch, size)),
         measured=np.empty((ticks, batch, n, UAV_STATE_SIZE)),

@@ -80,11 +80,8 @@ class SimulatorMessages:
         uavs = snap.odometry[:, ODOMETRY_NUMBERS].tolist()
         measured = measured_odometry(snap.measured[None])[0].tolist() if self._measured \
             else None
-        payload_velocity, payload_pose = snap.payload_velocity.tolist(), None
-        if snap.payload_attitude is not None:  # a rigid payload: its pose, twist in its frame
-            quaternion, rates, rotation = snap.payload_attitude
-            payload_velocity = (rotation.T @ snap.payload_velocity).tolist()
-            payload_pose = (tuple(quaternion.tolist()), tuple(rates.tolist()))
+        payload_velocity, payload_pose = payload_motion(snap.payload_attitude,
+                                                        snap.payload_velocity)
         return self.state_of(
             snap.t_ns, None if snapshot is None else np.concatenate(snapshot).tolist(),
             None if snapshot is None else len(snapshot[-1]), uavs,
@@ -174,7 +171,7 @@ def state_rows(states: np.ndarray, n: int, measured: np.ndarray | None = None
     received = rows if measured is None else measured
     snapshot = np.concatenate(
         [received[..., block:block + 3].reshape(k, 3 * n) for block in SNAPSHOT_BLOCKS]
-        + [states[:, 6 * n:nq], states[:, nq + 6 * n:]], axis=1)
+        + [states[:, 6 * n:nq], states[:, nq + 6 * n:2 * nq]], axis=1)
     return snapshot, rows[..., ODOMETRY_NUMBERS]
 
 
@@ -187,3 +184,14 @@ def measured_odometry(measured: np.ndarray) -> np.ndarray:
     rows[..., :MEASURED_COLUMNS] = measured
     kernels.runnable(odometry_rows)(rows)
     return rows[..., ODOMETRY_NUMBERS]
+
+
+def payload_motion(attitude: tuple | None, velocity: np.ndarray) -> tuple[list, tuple | None]:
+    """What /payload/odom and /tf carry of the payload's motion: (its velocity [m/s], in its own
+    frame for a rigid body (R_p^T v_p, as nav_msgs/Odometry's twist is), else world; its pose
+    for `SimulatorMessages.state_of`: (orientation (x, y, z, w), body rates [rad/s]), None for
+    a point payload) from `simulation.payload_attitude`'s triple (or None)."""
+    if attitude is None:
+        return velocity.tolist(), None
+    quaternion, rates, rotation = attitude
+    return (rotation.T @ velocity).tolist(), (tuple(quaternion.tolist()), tuple(rates.tolist()))

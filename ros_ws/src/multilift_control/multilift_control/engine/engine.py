@@ -161,7 +161,8 @@ class Engine:
     # ------------------------------------------------------------------------- state views
     @property
     def state(self) -> np.ndarray:
-        """The formation states (B, 2 (6n + 3)) at the current tick (docs/conventions.md)."""
+        """The formation states (B, 2 (6n + 3); a rigid payload adds its attitude, 7) at the
+        current tick (docs/conventions.md, docs/rigid_payload.md)."""
         return self.memory.state
 
     @property

@@ -42,6 +42,7 @@ class FormationParallelEnv(ParallelEnv):
         size = OBSERVATION_PER_UAV + OBSERVATION_PAYLOAD
         self._observation_space = gymnasium.spaces.Box(-np.inf, np.inf, (size,), np.float64)
         self._action_space = gymnasium.spaces.Box(-1.0, 1.0, (rotors,), np.float64)
+        self._seeded = False  # the batch's random draws seeded (at the first reset)
 
     def observation_space(self, agent: str) -> gymnasium.spaces.Box:
         return self._observation_space
@@ -56,7 +57,7 @@ class FormationParallelEnv(ParallelEnv):
                 for k, agent in enumerate(self.possible_agents)}
 
     def reset(self, seed: int | None = None, options: dict | None = None):
-        if seed is not None or not hasattr(self, '_seeded'):
+        if seed is not None or not self._seeded:
             self.batch.seed([seed])
             self._seeded = True
         self.batch.reset()

@@ -40,6 +40,7 @@ class FormationVectorEnv(VectorEnv):
         self.observation_names = observation_names(self.batch.n)
         self.reward_weights = dict(REWARD_WEIGHTS)
         self._autoreset = np.zeros(num_envs, dtype=bool)
+        self._seeded = False  # the batch's random draws seeded (at the first reset)
 
     def reset(self, *, seed: int | list[int | None] | None = None,
               options: dict | None = None):
@@ -50,7 +51,7 @@ class FormationVectorEnv(VectorEnv):
             seeds = [seed + k for k in range(self.num_envs)]
         else:
             seeds = list(seed)
-        if seed is not None or not hasattr(self, '_seeded'):
+        if seed is not None or not self._seeded:
             self.batch.seed(seeds)
             self._seeded = True
         self.batch.reset()

@@ -329,7 +329,8 @@ def test_follower_rejects_the_leader_index():
 
 def _scenario(formation, n, cable_length=10.26):
     from types import SimpleNamespace as NS
-    uavs = tuple(NS(vehicle=VEHICLE, position=(1.0, 2.0, 3.0), cable_length=cable_length)
+    uavs = tuple(NS(vehicle=VEHICLE, position=(1.0, 2.0, 3.0), cable_length=cable_length,
+                    attach_point=(0.0, 0.0, 0.0), yaw=0.0)
                  for _ in range(n))
     return NS(n_uavs=n, uavs=uavs, payload=NS(mass=0.9, attach_points=None), control=GAINS,
               simulation=NS(gravity=G), formation=formation)

@@ -171,11 +171,12 @@ def test_cables_off_the_uav_centres_in_a_scenario():
     from multilift_control.headless import run_headless
 
     data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
-    for uav in data['uavs']:
-        uav['attach_point'] = [0.02, 0.0, -0.1]
+    data['uavs'][0]['attach_point'] = [0.02, 0.0, -0.1]
+    data['uavs'][1]['attach_point'] = [0.3, 0.1, -0.25]
     data['simulation']['duration'] = 3.0
     scenario = scenario_io.loads(yaml.safe_dump(data))
-    assert scenario.formation_params().uav_attach_points == ((0.02, 0.0, -0.1),) * 2
+    assert scenario.formation_params().uav_attach_points == ((0.02, 0.0, -0.1),
+                                                              (0.3, 0.1, -0.25))
     model = FormationModel(scenario.formation_params())
     g, g_dot = model.constraint_residuals(initial_state(scenario))
     assert np.abs(g).max() < 1e-12 and np.abs(g_dot).max() == 0.0
@@ -184,6 +185,13 @@ def test_cables_off_the_uav_centres_in_a_scenario():
     run = run_headless(scenario)
     assert np.array_equal(engine.state[0], run.simulator.state)
     assert run.summary()['sim']['max_abs_constraint'] < 1e-6
+    # the follower holds the altitude it starts at (its cable's upper end off its centre too)
+    from multilift_control.formation import FormationFollower
+    from multilift_control.laws.layout import FOLLOWER_ALTITUDE_OFFSET
+    start = model.layout.uav_positions(initial_state(scenario))
+    follower = FormationFollower.from_scenario(scenario, 1)
+    assert follower.constants[FOLLOWER_ALTITUDE_OFFSET] == pytest.approx(
+        start[1, 2] - start[0, 2], abs=1e-12)
     for edit, message in ((dict(cable_model='slack'), 'attach_point needs cable_model: rigid'),
                           (dict(simulation=dict(data['simulation'], integrator='nullspace')),
                            r'uavs\[0\]\.attach_point need simulation\.integrator')):

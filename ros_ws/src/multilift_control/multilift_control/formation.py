@@ -32,6 +32,7 @@ from multilift_control.virtual_constraints import FormationGeometry, VirtualCons
 from multilift_sim import formation_geometry  # the start places, world
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario import ControlConfig
+from multilift_sim.simulation import uav_offsets
 
 OWN_THRUST = ('commanded', 'measured')  # where a follower's u_i comes from (FormationFollower)
 _COND_LIMIT = 1e10  # cond(J M^-1 J^T) above which the linear law takes its pseudo-inverse
@@ -192,7 +193,8 @@ class FormationFollower:
         if 'altitude_offset' not in options:
             start, _ = formation_geometry.hanging_payload(
                 constraints.nominal_positions(scenario.uavs[0].position),
-                [u.cable_length for u in scenario.uavs], scenario.payload.attach_points)
+                [u.cable_length for u in scenario.uavs], scenario.payload.attach_points,
+                uav_offsets(scenario))  # the simulator's start (simulation.formation_start)
             options['altitude_offset'] = float(start[index, 2] - start[0, 2])
         return cls(scenario.uavs[index].vehicle, index, constraints, masses, scenario.control,
                    float(masses[index]), scenario.simulation.gravity, config.alpha_vc,

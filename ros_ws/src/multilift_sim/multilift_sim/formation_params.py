@@ -90,23 +90,21 @@ class FormationParams:
             if len(inertia) != 3 or not all(math.isfinite(v) and v > 0 for v in inertia):
                 raise ValueError(f'FormationParams.payload_inertia must be 3 finite moments '
                                  f'> 0 [kg m^2], got {self.payload_inertia!r}')
-            points = tuple(tuple(float(v) for v in point)
-                           for point in self.payload_attach_points)
-            if len(points) != len(uavs) or any(len(point) != 3 or not all(
-                    math.isfinite(v) for v in point) for point in points):
-                raise ValueError(f'FormationParams.payload_attach_points must give one finite '
-                                 f'(x, y, z) [m] per cable ({len(uavs)}), got '
-                                 f'{self.payload_attach_points!r}')
             object.__setattr__(self, 'payload_inertia', inertia)
-            object.__setattr__(self, 'payload_attach_points', points)
+            self._check_points('payload_attach_points', 'cable')
         if self.uav_attach_points is not None:
-            points = tuple(tuple(float(v) for v in point) for point in self.uav_attach_points)
-            if len(points) != len(uavs) or any(len(point) != 3 or not all(
-                    math.isfinite(v) for v in point) for point in points):
-                raise ValueError(f'FormationParams.uav_attach_points must give one finite '
-                                 f'(x, y, z) [m] per UAV ({len(uavs)}), got '
-                                 f'{self.uav_attach_points!r}')
-            object.__setattr__(self, 'uav_attach_points', points)
+            self._check_points('uav_attach_points', 'UAV')
+
+    def _check_points(self, name: str, each: str) -> None:
+        """Field `name` as one finite (x, y, z) [m] per UAV (`each` names what one holds),
+        stored as a tuple of float triples; ValueError otherwise."""
+        value = getattr(self, name)
+        points = tuple(tuple(float(v) for v in point) for point in value)
+        if len(points) != len(self.uavs) or any(len(point) != 3 or not all(
+                math.isfinite(v) for v in point) for point in points):
+            raise ValueError(f'FormationParams.{name} must give one finite (x, y, z) [m] per '
+                             f'{each} ({len(self.uavs)}), got {value!r}')
+        object.__setattr__(self, name, points)
 
     @property
     def n_uavs(self) -> int:

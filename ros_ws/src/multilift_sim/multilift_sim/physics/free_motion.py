@@ -178,9 +178,9 @@ def uav_attach_motion(x, i, wrenches, uavs, out):
     rate = body_acceleration(uavs, i, wrenches[i, WRENCH_TORQUE], wrenches[i, WRENCH_TORQUE + 1],
                              wrenches[i, WRENCH_TORQUE + 2], omega[0], omega[1], omega[2])
     a = (uavs[i, UAV_ATTACH], uavs[i, UAV_ATTACH + 1], uavs[i, UAV_ATTACH + 2])
-    spin = _cross(omega, a)                      # omega x a (body)
-    turn = _cross(omega, spin)                   # omega x (omega x a)
-    push = _cross(rate, a)                       # omega_dot_0 x a
+    spin = cross(omega, a)                      # omega x a (body)
+    turn = cross(omega, spin)                   # omega x (omega x a)
+    push = cross(rate, a)                       # omega_dot_0 x a
     for row in range(3):
         out[0, row] = rotation[row, 0] * a[0] + rotation[row, 1] * a[1] + rotation[row, 2] * a[2]
         out[1, row] = (rotation[row, 0] * spin[0] + rotation[row, 1] * spin[1]
@@ -192,7 +192,8 @@ def uav_attach_motion(x, i, wrenches, uavs, out):
 
 
 @jit
-def _cross(a, b):
+def cross(a, b):
+    """a x b of two 3-vectors (tuples or arrays), as a tuple."""
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
@@ -203,7 +204,7 @@ def cable_moment_arm(uavs, i, rotation, d0, d1, d2):
     h = (rotation[0, 0] * d0 + rotation[1, 0] * d1 + rotation[2, 0] * d2,
          rotation[0, 1] * d0 + rotation[1, 1] * d1 + rotation[2, 1] * d2,
          rotation[0, 2] * d0 + rotation[1, 2] * d1 + rotation[2, 2] * d2)
-    return _cross((uavs[i, UAV_ATTACH], uavs[i, UAV_ATTACH + 1], uavs[i, UAV_ATTACH + 2]), h)
+    return cross((uavs[i, UAV_ATTACH], uavs[i, UAV_ATTACH + 1], uavs[i, UAV_ATTACH + 2]), h)
 
 
 @jit

@@ -29,7 +29,7 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_centre,
-                                              cable_moment_arm, payload_force_per_mass,
+                                              cable_moment_arm, cross, payload_force_per_mass,
                                               rotational_compliance, uav_attach_motion,
                                               uav_free_motion)
 from multilift_sim.physics.layout import (FORMATION_BETA_SQ, FORMATION_GRAVITY,
@@ -60,11 +60,6 @@ def payload_rotation(x, base):
 
 
 @jit
-def _cross(a0, a1, a2, b0, b1, b2):
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-
-
-@jit
 def cable_geometry(x, uavs, i, rotation, omega_world, base, attach):
     """Cable i's (d_i, d_i_dot, e_i = R_p b_i) at x, world [m, m/s, m], as 3 + 3 + 3 floats;
     `attach` (3, 3): UAV i's attach point's offset, rate and acceleration
@@ -78,7 +73,7 @@ def cable_geometry(x, uavs, i, rotation, omega_world, base, attach):
     e0 = rotation[0, 0] * b0 + rotation[0, 1] * b1 + rotation[0, 2] * b2
     e1 = rotation[1, 0] * b0 + rotation[1, 1] * b1 + rotation[1, 2] * b2
     e2 = rotation[2, 0] * b0 + rotation[2, 1] * b1 + rotation[2, 2] * b2
-    spin0, spin1, spin2 = _cross(omega_world[0], omega_world[1], omega_world[2], e0, e1, e2)
+    spin0, spin1, spin2 = cross(omega_world, (e0, e1, e2))
     d0 = x[p] + e0 - x[r] - attach[0, 0]
     d1 = x[p + 1] + e1 - x[r + 1] - attach[0, 1]
     d2 = x[p + 2] + e2 - x[r + 2] - attach[0, 2]
@@ -117,8 +112,8 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
     drag0, drag1, drag2 = payload_force_per_mass(x[p], x[p + 1], x[p + 2], x[nq + p],
                                                  x[nq + p + 1], x[nq + p + 2], gusts, formation)
     # alpha_0 = J^-1 (-omega x J omega), principal axes (Euler's equations without the cables)
-    h0, h1, h2 = _cross(omega[0], omega[1], omega[2], inertia[0] * omega[0],
-                        inertia[1] * omega[1], inertia[2] * omega[2])
+    h0, h1, h2 = cross(omega, (inertia[0] * omega[0], inertia[1] * omega[1],
+                               inertia[2] * omega[2]))
     alpha0 = np.array([-h0 / inertia[0], -h1 / inertia[1], -h2 / inertia[2]])
     two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
     d = np.zeros((n, 3))
@@ -134,23 +129,24 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         if not taut[i]:
             continue
         attach[:, :] = 0.0
-        uav_rotation_i = np.eye(3)
-        if attached_off_centre(uavs, i):
+        held_off_centre = attached_off_centre(uavs, i)
+        if held_off_centre:
             uav_rotation_i = uav_attach_motion(x, i, wrenches, uavs, attach)
         d0, d1, d2, v0, v1, v2, e0, e1, e2 = cable_geometry(x, uavs, i, rotation, w, base,
                                                             attach)
-        moment[i, 0], moment[i, 1], moment[i, 2] = cable_moment_arm(uavs, i, uav_rotation_i,
-                                                                    d0, d1, d2)
+        if held_off_centre:
+            moment[i, 0], moment[i, 1], moment[i, 2] = cable_moment_arm(uavs, i, uav_rotation_i,
+                                                                        d0, d1, d2)
         d[i, 0], d[i, 1], d[i, 2] = d0, d1, d2
         # f_i = R_p^T d_i, c_i = b_i x f_i (payload frame)
         f0 = rotation[0, 0] * d0 + rotation[1, 0] * d1 + rotation[2, 0] * d2
         f1 = rotation[0, 1] * d0 + rotation[1, 1] * d1 + rotation[2, 1] * d2
         f2 = rotation[0, 2] * d0 + rotation[1, 2] * d1 + rotation[2, 2] * d2
-        c[i, 0], c[i, 1], c[i, 2] = _cross(uavs[i, UAV_PAYLOAD_ATTACH],
+        c[i, 0], c[i, 1], c[i, 2] = cross((uavs[i, UAV_PAYLOAD_ATTACH],
                                            uavs[i, UAV_PAYLOAD_ATTACH + 1],
-                                           uavs[i, UAV_PAYLOAD_ATTACH + 2], f0, f1, f2)
-        s0, s1, s2 = _cross(w[0], w[1], w[2], e0, e1, e2)
-        cp0, cp1, cp2 = _cross(w[0], w[1], w[2], s0, s1, s2)  # w x (w x e_i)
+                                           uavs[i, UAV_PAYLOAD_ATTACH + 2]), (f0, f1, f2))
+        s0, s1, s2 = cross(w, (e0, e1, e2))
+        cp0, cp1, cp2 = cross(w, (s0, s1, s2))  # w x (w x e_i)
         offset_sq = d0 * d0 + d1 * d1 + d2 * d2
         rhs[i] = (2.0 * (v0 * v0 + v1 * v1 + v2 * v2)
                   + 2.0 * (d0 * (drag0 - thrust[i, 0] - attach[2, 0])

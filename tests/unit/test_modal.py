@@ -24,12 +24,7 @@ from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_tools.modal_cli import modal_main
 
 SCENARIO_NAMES = sorted(p.stem for p in SCENARIOS.glob('*.yaml')
-                        if 'rigid_body' not in p.read_text())  # point payloads (below)
-
-
-def test_a_rigid_payload_s_modes_are_refused_by_name():
-    with pytest.raises(ValueError, match='box_lift: the modes of a rigid_body payload are not'):
-        scenario_equilibrium(load('box_lift'))
+                        if 'rigid_body' not in p.read_text())  # point (bodies: test_modal_rigid)
 
 
 def load(name: str) -> scenario_io.Scenario:

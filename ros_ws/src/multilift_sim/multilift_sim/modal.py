@@ -1,6 +1,7 @@
 """Modal analysis of the formation about a static equilibrium (seed Sec. 2.8, Eq. 2.71-2.73).
 
-World frame (z up), SI units, coordinates ``q_f`` of docs/conventions.md (6n + 3 of them).
+World frame (z up), SI units, coordinates ``q_f`` of docs/conventions.md (6n + 3 of them); a
+rigid-body payload adds its attitude as a rotation vector (below: 6n + 6 coordinates).
 
 1. Equilibrium (Eq. 2.73 with q_dot = 0): ``f_g + G^T Lambda = B_f u_f``, ``g = 0``. Written in
    the world frame the rows are
@@ -30,14 +31,29 @@ World frame (z up), SI units, coordinates ``q_f`` of docs/conventions.md (6n + 3
 
    J_q, J_v the Jacobians of the DAE's accelerations (the G^T dLambda part drops out since
    T^T G^T = 0). ``basis='nullspace'`` uses an orthonormal null-space basis N_f of G instead of
-   T; the eigenvalues are the same (test_modal.py).
+   T; the eigenvalues are the same (test_modal.py). ``hold_uavs`` clamps the UAVs' 6n
+   coordinates (their rows of T zero: the cables' upper ends held still, as a bifilar
+   suspension's formula assumes); T^T G^T = 0 still removes the multipliers, and what the
+   cables' turning does at the equilibrium tension, -T^T (dG^T/dq) Lambda_e, stays in J_q.
 3. Eigenvalues of the first-order system ``A = [[0, I], [M_r^-1 K_r, M_r^-1 D_r]]``. A free
    formation under held rotor speeds has rigid-body modes (translation of the whole formation,
    and each UAV's attitude, which nothing restores in open loop) at zero: they are reported
-   apart. Purely imaginary pairs of pendulum size are the pendulum modes.
+   apart. Purely imaginary pairs of pendulum size are the pendulum modes. Each mode is named
+   by where its kinetic energy sits (`motion_shares`): the payload's swing x / y, heave, its
+   roll / pitch / yaw (a rigid body), the UAVs' translation or attitude.
+
+A rigid-body payload (docs/rigid_payload.md, "The equations"): cable i holds it at b_i
+(payload frame), d_i = r_p + R_p b_i - r_i. Its attitude enters as a rotation vector theta in
+the payload frame, R_p = R_e Exp(theta) (3 coordinates after q_f, not the quaternion's 4),
+with rates omega_p (= theta_dot to first order at rest, so theta_ddot linearises to the DAE's
+alpha_p). The equilibrium's payload rows gain the moment, ``sum_i 2 lambda_i c_i = 0`` with
+c_i = b_i x R_p^T d_i (n >= 7, or cables through one point: least-norm), G the columns
+``dg_i/dtheta = 2 c_i`` (U_i = 2 (d_i, c_i) of the docs), M the principal inertia J_p. The
+hanging rest is the simulator's start (simulation.formation_start: level, the identity).
 
 Payload drag and gusts do not enter: the quadratic drag has zero slope at zero air speed, and
-the analysis is of the formation in still air.
+the analysis is of the formation in still air. Cables held off a UAV's centre
+(uavs[i].attach_point) are not analysed yet (ValueError).
 """
 from __future__ import annotations
 
@@ -54,10 +70,13 @@ from multilift_sim.constraints import cable_residuals, cable_tension, constraint
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.multirotor import euler_mass_matrix
+from multilift_sim.physics.layout import PAYLOAD_BODY_RATES, UAV_COORDINATES
+from multilift_sim.physics.rigid_payload import payload_rotation
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import formation_start
 
 MODE_KINDS = ('pendulum', 'oscillatory', 'unstable', 'damped', 'rigid')
+ROTATION_NAMES = ('rx_p', 'ry_p', 'rz_p')  # a rigid payload's rotation vector, payload frame
 
 
 @dataclass(frozen=True)
@@ -71,31 +90,84 @@ class Equilibrium:
     tensions: np.ndarray                  # T_i = 2 l_i lambda_i (n,) [N], positive = taut
 
 
+def _quaternion_rotation(quaternion: ArrayLike) -> np.ndarray:
+    """R_p (3, 3), payload frame -> world, of a unit quaternion (w, x, y, z)."""
+    state = np.concatenate((np.zeros(1), np.asarray(quaternion, dtype=float)))
+    return payload_rotation(state, 1)
+
+
+def _cable_offsets(params: FormationParams, uavs: np.ndarray, payload: np.ndarray,
+                   rotation: np.ndarray | None) -> np.ndarray:
+    """d_i (n, 3) [m], world: from UAV i's centre to where cable i holds the payload, r_p - r_i
+    (a point payload) or r_p + R_p b_i - r_i (a rigid body of attitude `rotation`)."""
+    if not params.rigid_payload:
+        return payload - uavs
+    return payload + np.asarray(params.payload_attach_points) @ rotation.T - uavs
+
+
+def _cable_moments(params: FormationParams, offsets: np.ndarray,
+                   rotation: np.ndarray) -> np.ndarray:
+    """c_i = b_i x R_p^T d_i (n, 3) [m^2], payload frame (docs/rigid_payload.md)."""
+    return np.cross(np.asarray(params.payload_attach_points), offsets @ rotation)
+
+
+def _state_rotation(layout: StateLayout, x: np.ndarray) -> np.ndarray | None:
+    """A rigid payload's R_p (3, 3) at state x; None for a point payload."""
+    return _quaternion_rotation(layout.payload_quaternion(x)) if layout.rigid_payload else None
+
+
 def static_equilibrium(params: FormationParams, uav_positions: ArrayLike,
                        payload_position: ArrayLike, yaws: ArrayLike | None = None,
-                       tolerance: float = 1e-9) -> Equilibrium:
+                       tolerance: float = 1e-9,
+                       payload_quaternion: ArrayLike | None = None) -> Equilibrium:
     """Rotor speeds, attitudes and multipliers that hold the given configuration at rest.
 
     uav_positions (n, 3) and payload_position (3,) [m] in the world frame, on the constraint
-    manifold (every cable at its length); yaws (n,) [rad], default 0. Solves Eq. 2.73 as the
-    module docstring says. Raises ValueError naming the cable or UAV when the payload cannot
-    hang at rest there, a cable would be slack, or a rotor would leave its speed limits.
+    manifold (every cable at its length); yaws (n,) [rad], default 0; a rigid payload's
+    attitude payload_quaternion (w, x, y, z), payload frame -> world, default the identity.
+    Solves Eq. 2.73 as the module docstring says (a rigid body: its force and moment rows).
+    Raises ValueError naming the cable or UAV when the payload cannot hang at rest there, a
+    cable would be slack, or a rotor would leave its speed limits.
     """
     n = params.n_uavs
+    if params.uav_attach_points is not None:
+        raise ValueError('cables held off the UAVs\' centres (uavs[i].attach_point): their '
+                         'equilibrium and modes are not analysed yet (multilift_sim.modal)')
     uavs = np.asarray(uav_positions, dtype=float).reshape(n, 3)
     payload = np.asarray(payload_position, dtype=float).reshape(3)
     yaws = np.zeros(n) if yaws is None else np.asarray(yaws, dtype=float).reshape(n)
+    quaternion = np.array([1.0, 0.0, 0.0, 0.0] if payload_quaternion is None
+                          else payload_quaternion, dtype=float)
+    rotation = _quaternion_rotation(quaternion) if params.rigid_payload else None
     lengths = np.asarray(params.cable_lengths)
-    residual = cable_residuals(uavs, payload, lengths) / lengths ** 2
+    if params.rigid_payload:
+        offsets = _cable_offsets(params, uavs, payload, rotation)
+        residual = (np.einsum('ij,ij->i', offsets, offsets) - lengths ** 2) / lengths ** 2
+    else:
+        residual = cable_residuals(uavs, payload, lengths) / lengths ** 2
     worst = int(np.argmax(np.abs(residual)))
     if abs(residual[worst]) > tolerance:
-        raise ValueError(f'cable {worst + 1}: |r_p - r_i|^2 differs from l_i^2 by a fraction '
+        raise ValueError(f'cable {worst + 1}: |d_i|^2 differs from l_i^2 by a fraction '
                          f'{residual[worst]:.3g}: not on the constraint manifold (Eq. 2.42)')
-    offsets = payload - uavs                                       # d_i, (n, 3)
+    offsets = _cable_offsets(params, uavs, payload, rotation)          # d_i, (n, 3)
     weight = np.array([0.0, 0.0, params.payload_mass * params.gravity])
-    # payload rows: (2 D^T) Lambda = -m_p g e_z, least-norm when indeterminate (n >= 4)
-    multipliers, *_ = np.linalg.lstsq(2.0 * offsets.T, -weight, rcond=None)
-    miss = float(np.linalg.norm(2.0 * offsets.T @ multipliers + weight))
+    if params.rigid_payload:
+        # payload rows, force and moment: 2 [D^T; C^T] Lambda = (-m_p g e_z, 0), least-norm
+        moments = _cable_moments(params, offsets, rotation)
+        rows = 2.0 * np.vstack((offsets.T, moments.T))
+        multipliers, *_ = np.linalg.lstsq(rows, np.concatenate((-weight, np.zeros(3))),
+                                          rcond=None)
+        miss = rows @ multipliers + np.concatenate((weight, np.zeros(3)))
+        arm = max(1e-3, float(np.abs(params.payload_attach_points).max()))
+        if float(np.linalg.norm(miss[3:])) > tolerance * weight[2] * arm:
+            raise ValueError(f'the body cannot hang at rest in this attitude: its cables leave '
+                             f'{np.linalg.norm(miss[3:]):.3g} N m of moment unbalanced '
+                             '(docs/rigid_payload.md)')
+        miss = float(np.linalg.norm(miss[:3]))
+    else:
+        # payload rows: (2 D^T) Lambda = -m_p g e_z, least-norm when indeterminate (n >= 4)
+        multipliers, *_ = np.linalg.lstsq(2.0 * offsets.T, -weight, rcond=None)
+        miss = float(np.linalg.norm(2.0 * offsets.T @ multipliers + weight))
     if miss > tolerance * weight[2]:
         raise ValueError(f'the payload cannot hang at rest at {payload.tolist()} m: its cables '
                          f'leave {miss:.3g} N of its weight unbalanced (Eq. 2.73)')
@@ -126,7 +198,10 @@ def static_equilibrium(params: FormationParams, uav_positions: ArrayLike,
                              f'{uav.rotor_speed_max:g}] rad/s')
         rotor_speeds.append(speeds)
         wrenches[i] = allocator.wrench(speeds)
-    state = StateLayout(n).pack(uavs, euler, payload)
+    if params.rigid_payload:
+        state = StateLayout(n, True).pack(uavs, euler, payload, payload_quaternion=quaternion)
+    else:
+        state = StateLayout(n).pack(uavs, euler, payload)
     return Equilibrium(state=state, rotor_speeds=tuple(rotor_speeds), wrenches=wrenches,
                        multipliers=multipliers, tensions=cable_tension(multipliers, lengths))
 
@@ -137,7 +212,8 @@ def scenario_configuration(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     n = 1: the scenario's UAV position with the payload straight below (alpha = beta = 0; the
     release angles of payload.alpha_deg/beta_deg are an initial condition, not the
     equilibrium). n >= 2: simulation.formation_start (the payload under the UAVs' horizontal
-    centroid, where equal multipliers balance it), without the payload.swing_deg release.
+    centroid, where equal multipliers balance it; a rigid body level, its centre under the
+    centroid of r_i - b_i), without the payload.swing_deg release.
     """
     if scenario.n_uavs == 1:
         uav = np.array([scenario.uavs[0].position], dtype=float)
@@ -147,62 +223,118 @@ def scenario_configuration(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
 
 def scenario_equilibrium(scenario: Scenario) -> Equilibrium:
     """The static equilibrium (Eq. 2.73) of the scenario's formation at its hanging rest,
-    UAVs at the scenario's yaw angles. ValueError for a rigid-body payload (its modes: not
-    yet, docs/rigid_payload.md)."""
-    if scenario.payload.type != 'point':
-        raise ValueError(f'{scenario.name}: the modes of a {scenario.payload.type} payload are '
-                         'not analysed yet (multilift modal: point payloads; '
-                         'docs/rigid_payload.md)')
+    UAVs at the scenario's yaw angles, a rigid payload level (the simulator's start)."""
     uavs, payload = scenario_configuration(scenario)
     return static_equilibrium(scenario.formation_params(0.0, 0.0), uavs, payload,
                               [u.yaw for u in scenario.uavs])
 
 
-def coordinate_names(n_uavs: int) -> tuple[str, ...]:
-    """Names of the 6n + 3 coordinates q_f: x1 y1 z1 phi1 theta1 psi1 ... x_p y_p z_p."""
+def coordinate_names(n_uavs: int, rigid_payload: bool = False) -> tuple[str, ...]:
+    """Names of the 6n + 3 coordinates q_f: x1 y1 z1 phi1 theta1 psi1 ... x_p y_p z_p, and a
+    rigid payload's rotation vector rx_p ry_p rz_p [rad] (payload frame) after them."""
     names = [f'{c}{i + 1}' for i in range(n_uavs)
              for c in ('x', 'y', 'z', 'phi', 'theta', 'psi')]
-    return tuple(names + ['x_p', 'y_p', 'z_p'])
+    return tuple(names + ['x_p', 'y_p', 'z_p'] + (list(ROTATION_NAMES) if rigid_payload else []))
 
 
 def mass_matrix(params: FormationParams, uav_euler: ArrayLike) -> np.ndarray:
-    """Formation inertia M_f (Eq. 2.47): blocks m_i I, M_eta,i = W^T J W (Eq. 2.24), m_p I."""
+    """Formation inertia M_f (Eq. 2.47): blocks m_i I, M_eta,i = W^T J W (Eq. 2.24), m_p I;
+    a rigid payload's J_p = diag(J_xx, J_yy, J_zz) [kg m^2] (payload frame) after them."""
     n = params.n_uavs
     euler = np.asarray(uav_euler, dtype=float).reshape(n, 3)
-    mass = np.zeros((6 * n + 3, 6 * n + 3))
+    size = 6 * n + (6 if params.rigid_payload else 3)
+    mass = np.zeros((size, size))
     for i, uav in enumerate(params.uavs):
         mass[6 * i:6 * i + 3, 6 * i:6 * i + 3] = uav.mass * np.eye(3)
         mass[6 * i + 3:6 * i + 6, 6 * i + 3:6 * i + 6] = euler_mass_matrix(uav.inertia, euler[i])
-    mass[6 * n:, 6 * n:] = params.payload_mass * np.eye(3)
+    mass[6 * n:6 * n + 3, 6 * n:6 * n + 3] = params.payload_mass * np.eye(3)
+    if params.rigid_payload:
+        mass[6 * n + 3:, 6 * n + 3:] = np.diag(params.payload_inertia)
     return mass
 
 
-def default_dependent_coordinates(jacobian: np.ndarray) -> tuple[int, ...]:
+def formation_jacobian(params: FormationParams, x: np.ndarray) -> np.ndarray:
+    """G [m] (n, 6n + 3) at state x (Eq. 2.65-2.67, constraints.constraint_jacobian); a rigid
+    payload's (n, 6n + 6) with the columns dg_i/dtheta = 2 c_i [m^2] of its rotation vector
+    (R_p = R Exp(theta), c_i = b_i x R^T d_i at x's attitude R; docs/rigid_payload.md)."""
+    layout = StateLayout(params.n_uavs, params.rigid_payload)
+    uavs, payload = layout.uav_positions(x), layout.payload_position(x)
+    if not params.rigid_payload:
+        return constraint_jacobian(uavs, payload)
+    n = params.n_uavs
+    rotation = _state_rotation(layout, x)
+    offsets = _cable_offsets(params, uavs, payload, rotation)
+    jacobian = np.zeros((n, 6 * n + 6))
+    for i in range(n):
+        jacobian[i, 6 * i:6 * i + 3] = -2.0 * offsets[i]
+        jacobian[i, 6 * n:6 * n + 3] = 2.0 * offsets[i]
+    jacobian[:, 6 * n + 3:] = 2.0 * _cable_moments(params, offsets, rotation)
+    return jacobian
+
+
+def formation_residuals(params: FormationParams, x: np.ndarray) -> np.ndarray:
+    """g_i = |d_i|^2 - l_i^2 [m^2] (n,) at state x (Eq. 2.42; a rigid payload's d_i)."""
+    layout = StateLayout(params.n_uavs, params.rigid_payload)
+    uavs, payload = layout.uav_positions(x), layout.payload_position(x)
+    if not params.rigid_payload:
+        return cable_residuals(uavs, payload, params.cable_lengths)
+    offsets = _cable_offsets(params, uavs, payload, _state_rotation(layout, x))
+    return np.einsum('ij,ij->i', offsets, offsets) - np.asarray(params.cable_lengths) ** 2
+
+
+def displaced_state(layout: StateLayout, x: np.ndarray, dq: np.ndarray,
+                    dq_dot: np.ndarray) -> np.ndarray:
+    """The packed state x moved by dq (q_f [m, rad], a rigid payload's rotation vector theta
+    [rad], payload frame, after it) and dq_dot (q_f_dot [m/s, rad/s], then omega_p [rad/s]):
+    x + (dq, dq_dot) for a point payload; a rigid one's attitude q (x) Exp(theta) (a body-frame
+    rotation, the quaternion kept unit) and body rates omega_p + dq_dot's last three."""
+    if not layout.rigid_payload:
+        return x + np.concatenate((dq, dq_dot))
+    nq = layout.n_coordinates
+    out = np.array(x, dtype=float)
+    out[:nq] += dq[:nq]
+    out[nq:2 * nq] += dq_dot[:nq]
+    theta = np.asarray(dq[nq:nq + 3], dtype=float)
+    angle = float(np.linalg.norm(theta))
+    w, v = layout.payload_quaternion(x)[0], layout.payload_quaternion(x)[1:]
+    turn_w = math.cos(0.5 * angle)
+    turn_v = theta * (0.5 if angle == 0.0 else math.sin(0.5 * angle) / angle)
+    layout.payload_quaternion(out)[:] = np.concatenate((
+        [w * turn_w - v @ turn_v], w * turn_v + turn_w * v + np.cross(v, turn_v)))
+    layout.payload_body_rates(out)[:] += dq_dot[nq:nq + 3]
+    return out
+
+
+def default_dependent_coordinates(jacobian: np.ndarray,
+                                  held: tuple[int, ...] = ()) -> tuple[int, ...]:
     """n dependent coordinates where G restricted to them has full rank.
 
     The UAV altitudes z_i (the seed's choice for the twin-lift, Sec. 2.8.2), whose block of G
-    is diag(-2 (z_p - z_i)): fine unless a cable is (nearly) horizontal; then the first n
-    pivots of a column-pivoted QR of G.
+    is diag(-2 (z_p - z_i)): fine unless a cable is (nearly) horizontal; then, or when the
+    coordinates `held` (clamped, not free) include them, the first n pivots of a
+    column-pivoted QR of G over the free coordinates.
     """
     n = jacobian.shape[0]
-    altitudes = tuple(6 * i + 2 for i in range(n))
+    altitudes = tuple(UAV_COORDINATES * i + 2 for i in range(n))
     rows = np.linalg.norm(jacobian, axis=1)                     # 2 l_i on the manifold
-    if np.min(np.abs(jacobian[np.arange(n), altitudes]) / rows) > 1e-3:
+    if not held and np.min(np.abs(jacobian[np.arange(n), altitudes]) / rows) > 1e-3:
         return altitudes
-    _, _, pivots = scipy.linalg.qr(jacobian, pivoting=True)
-    return tuple(sorted(int(k) for k in pivots[:n]))
+    free = [k for k in range(jacobian.shape[1]) if k not in held]
+    _, _, pivots = scipy.linalg.qr(jacobian[:, free], pivoting=True)
+    return tuple(sorted(free[int(k)] for k in pivots[:n]))
 
 
-def elimination_basis(jacobian: np.ndarray,
-                      dependent: tuple[int, ...]) -> tuple[np.ndarray, tuple[int, ...]]:
-    """(T (6n+3, 5n+3), independent indices): ``dq = T dq_i`` solves ``G dq = 0`` to first
-    order with ``dq_d = -G_d^-1 G_i dq_i``. Raises ValueError when G_d is singular."""
+def elimination_basis(jacobian: np.ndarray, dependent: tuple[int, ...],
+                      held: tuple[int, ...] = ()) -> tuple[np.ndarray, tuple[int, ...]]:
+    """(T (size, size - n - len(held)), independent indices): ``dq = T dq_i`` solves
+    ``G dq = 0`` to first order with ``dq_d = -G_d^-1 G_i dq_i``, the coordinates `held`
+    clamped (their rows of T zero). Raises ValueError when G_d is singular."""
     n, size = jacobian.shape
     dependent = tuple(int(k) for k in dependent)
-    if len(set(dependent)) != n or not all(0 <= k < size for k in dependent):
-        raise ValueError(f'need {n} distinct dependent coordinates in 0..{size - 1}, got '
-                         f'{dependent}')
-    independent = tuple(k for k in range(size) if k not in dependent)
+    if len(set(dependent)) != n or not all(0 <= k < size and k not in held for k in dependent):
+        raise ValueError(f'need {n} distinct dependent coordinates in 0..{size - 1}, none held, '
+                         f'got {dependent}')
+    independent = tuple(k for k in range(size) if k not in dependent and k not in held)
     block = jacobian[:, dependent]
     if np.linalg.cond(block) > 1e10:
         raise ValueError(f'G restricted to the dependent coordinates {dependent} is singular')
@@ -218,15 +350,16 @@ class ModalAnalysis:
 
     Eigenvalues [1/s] are sorted: non-rigid modes by decreasing |Im| then |Re| (conjugates
     adjacent, positive imaginary part first), rigid-body (zero) modes last. ``shapes[k]`` is
-    mode k's shape in all 6n + 3 coordinates q_f ([m] and [rad], complex), scaled so that its
-    largest component is 1.
+    mode k's shape in all 6n + 3 coordinates q_f ([m] and [rad], complex; a rigid payload's
+    rotation vector [rad], payload frame, after them: 6n + 6), scaled so that its largest
+    component is 1.
     """
 
     params: FormationParams
     equilibrium: Equilibrium
     basis_kind: str                   # 'elimination' or 'nullspace'
     dependent: tuple[int, ...]        # indices into q_f ('elimination'); () for 'nullspace'
-    basis: np.ndarray                 # T (or N_f), (6n+3, 5n+3)
+    basis: np.ndarray                 # T (or N_f), (6n+3, 5n+3); rigid (6n+6, 5n+6)
     mass: np.ndarray                  # M_r = T^T M T
     stiffness: np.ndarray             # K_r = T^T M J_q T: M_r dq_i_ddot = K_r dq_i + D_r dq_i_dot
     damping: np.ndarray               # D_r = T^T M J_v T (zero: nothing damps at rest)
@@ -235,6 +368,8 @@ class ModalAnalysis:
     shapes: np.ndarray                # (2(5n+3), 6n+3) complex
     kinds: tuple[str, ...]            # one of MODE_KINDS per eigenvalue
     zero_tolerance: float             # |lambda| below this is a rigid-body mode [1/s]
+    inertia: np.ndarray               # M at the equilibrium (6n+3 or 6n+6 square) [kg, kg m^2]
+    held_uavs: bool                   # the UAVs' coordinates clamped (modal_analysis hold_uavs)
 
     def indices(self, kind: str) -> np.ndarray:
         """Indices of the eigenvalues of one kind (MODE_KINDS)."""
@@ -256,21 +391,59 @@ class ModalAnalysis:
         """Number of zero (rigid-body) eigenvalues."""
         return len(self.indices('rigid'))
 
+    def motion(self, mode: int, least: float = 0.05, most: int = 3) -> str:
+        """Mode `mode` named by where its kinetic energy sits (motion_shares): the `most`
+        largest shares of at least `least`, e.g. 'yaw 0.99' or 'UAVs 0.57, swing y 0.30,
+        roll 0.13'."""
+        shares = sorted(motion_shares(self, mode).items(), key=lambda item: -item[1])
+        kept = [item for item in shares[:most] if item[1] >= least] or shares[:1]
+        return ', '.join(f'{name} {share:.2f}' for name, share in kept)
+
+
+def motion_groups(n_uavs: int, rigid_payload: bool) -> dict[str, list[int]]:
+    """The coordinates (indices into q_f, a rigid payload's rotation after it) of each motion
+    a mode is named by: the payload's swing x, swing y (world), heave (z); a rigid payload's
+    roll, pitch, yaw (its rotation about its own x, y, z axes); the UAVs' translation and
+    attitude (all UAVs together)."""
+    p = UAV_COORDINATES * n_uavs
+    groups = {'swing x': [p], 'swing y': [p + 1], 'heave': [p + 2]}
+    if rigid_payload:
+        groups.update({'roll': [p + 3], 'pitch': [p + 4], 'yaw': [p + 5]})
+    groups['UAVs'] = [UAV_COORDINATES * i + k for i in range(n_uavs) for k in range(3)]
+    groups['UAV attitudes'] = [UAV_COORDINATES * i + k for i in range(n_uavs) for k in (3, 4, 5)]
+    return groups
+
+
+def motion_shares(analysis: ModalAnalysis, mode: int) -> dict[str, float]:
+    """Each motion's share (motion_groups) of mode `mode`'s kinetic energy, sum 1:
+    Re(v_g^H M_gg v_g) / Re(v^H M v) with v the shape and M the formation's inertia at the
+    equilibrium (block-diagonal over the groups, so the shares add up; unit-free, unlike the
+    shape's components in m and rad)."""
+    shape = analysis.shapes[mode]
+    inertia = analysis.inertia
+    groups = motion_groups(analysis.params.n_uavs, analysis.params.rigid_payload)
+    energy = {name: float(np.real(np.conj(shape[k]) @ inertia[np.ix_(k, k)] @ shape[k]))
+              for name, k in groups.items()}
+    total = sum(energy.values())
+    return {name: value / total for name, value in energy.items()}
+
 
 def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
                    dependent: tuple[int, ...] | None = None, basis: str = 'elimination',
                    zero_tolerance: float = 1e-4, imaginary_tolerance: float = 1e-6,
-                   position_step: float = 1e-5, rate_step: float = 1e-3) -> ModalAnalysis:
+                   position_step: float = 1e-5, rate_step: float = 1e-3,
+                   hold_uavs: bool = False) -> ModalAnalysis:
     """Linearise the open-loop formation about `equilibrium` and find its modes.
 
-    dependent: indices into q_f of the n eliminated coordinates (default: the UAV altitudes,
-    see default_dependent_coordinates); basis: 'elimination' (T of the module docstring) or
-    'nullspace' (orthonormal N_f, Eq. 2.71). zero_tolerance [1/s]: smaller |lambda| are
-    rigid-body modes; a pair is purely imaginary when |Re| <= imaginary_tolerance |lambda|,
-    and a pendulum mode when also 0.1 sqrt(g / l_max) <= |omega| <= 10 sqrt(g / l_min)
-    (pendulum size; 'oscillatory' otherwise).
-    position_step [m or rad] and rate_step [m/s or rad/s]: central-difference steps (the
-    accelerations are even in the rates at rest, so rate_step only meets rounding).
+    dependent: indices into q_f (a rigid payload: and its rotation vector) of the n eliminated
+    coordinates (default: the UAV altitudes, see default_dependent_coordinates); basis:
+    'elimination' (T of the module docstring) or 'nullspace' (orthonormal N_f, Eq. 2.71).
+    hold_uavs: the UAVs' 6n coordinates clamped (the cables' upper ends held still; only the
+    payload moves). zero_tolerance [1/s]: smaller |lambda| are rigid-body modes; a pair is
+    purely imaginary when |Re| <= imaginary_tolerance |lambda|, and a pendulum mode when also
+    0.1 sqrt(g / l_max) <= |omega| <= 10 sqrt(g / l_min) (pendulum size; 'oscillatory'
+    otherwise). position_step [m or rad] and rate_step [m/s or rad/s]: central-difference steps
+    (the accelerations are even in the rates at rest, so rate_step only meets rounding).
     """
     if basis not in ('elimination', 'nullspace'):
         raise ValueError(f"basis must be 'elimination' or 'nullspace', got {basis!r}")
@@ -279,33 +452,42 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
                                 baumgarte_alpha=0.0, baumgarte_beta=0.0)
     model = FormationModel(still)
     layout = model.layout
+    nq = layout.n_coordinates
     x_e = np.asarray(equilibrium.state, dtype=float)
-    size = layout.n_coordinates
-    jacobian = constraint_jacobian(layout.uav_positions(x_e), layout.payload_position(x_e))
+    jacobian = formation_jacobian(still, x_e)
+    size = jacobian.shape[1]                     # 6n + 3, a rigid payload's 6n + 6
+    held = tuple(range(UAV_COORDINATES * params.n_uavs)) if hold_uavs else ()
     if basis == 'elimination':
-        dependent = (default_dependent_coordinates(jacobian) if dependent is None
+        dependent = (default_dependent_coordinates(jacobian, held) if dependent is None
                      else tuple(dependent))
-        transform, _ = elimination_basis(jacobian, dependent)
+        transform, _ = elimination_basis(jacobian, dependent, held)
     else:
         dependent = ()
-        transform = scipy.linalg.null_space(jacobian)
+        free = [k for k in range(size) if k not in held]
+        transform = np.zeros((size, len(free) - params.n_uavs))
+        transform[free] = scipy.linalg.null_space(jacobian[:, free] if held else jacobian)
     n_free = transform.shape[1]
 
-    def acceleration(x: np.ndarray) -> np.ndarray:
-        return model.accelerations_from_wrenches(x, equilibrium.wrenches)[0]
+    def acceleration(dq: np.ndarray, dq_dot: np.ndarray) -> np.ndarray:
+        """q_ddot (and a rigid payload's alpha_p [rad/s^2], = theta_ddot at rest) at x_e
+        moved by (dq, dq_dot) (displaced_state)."""
+        acc = model.accelerations_from_wrenches(displaced_state(layout, x_e, dq, dq_dot),
+                                                equilibrium.wrenches)[0]
+        if not layout.rigid_payload:
+            return acc
+        return np.concatenate((acc[:nq], acc[nq + PAYLOAD_BODY_RATES:nq + PAYLOAD_BODY_RATES + 3]))
 
+    still_rates = np.zeros(size)
     j_q = np.empty((size, n_free))
     j_v = np.empty((size, n_free))
     for k in range(n_free):
         direction = transform[:, k]
         h = position_step / max(1.0, float(np.linalg.norm(direction)))
-        step = np.zeros(2 * size)
-        step[:size] = h * direction
-        j_q[:, k] = (acceleration(x_e + step) - acceleration(x_e - step)) / (2.0 * h)
+        j_q[:, k] = (acceleration(h * direction, still_rates)
+                     - acceleration(-(h * direction), still_rates)) / (2.0 * h)
         h = rate_step / max(1.0, float(np.linalg.norm(direction)))
-        step = np.zeros(2 * size)
-        step[size:] = h * direction
-        j_v[:, k] = (acceleration(x_e + step) - acceleration(x_e - step)) / (2.0 * h)
+        j_v[:, k] = (acceleration(still_rates, h * direction)
+                     - acceleration(still_rates, -(h * direction))) / (2.0 * h)
     inertia = mass_matrix(still, layout.uav_euler(x_e))
     mass = transform.T @ inertia @ transform                         # Eq. 2.72, left side
     stiffness = transform.T @ inertia @ j_q
@@ -332,7 +514,7 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
                          dependent=tuple(dependent), basis=transform, mass=mass,
                          stiffness=stiffness, damping=damping, state_matrix=state_matrix,
                          eigenvalues=eigenvalues, shapes=shapes, kinds=tuple(kinds),
-                         zero_tolerance=zero_tolerance)
+                         zero_tolerance=zero_tolerance, inertia=inertia, held_uavs=hold_uavs)
 
 
 def _real_shapes(eigenvalues: np.ndarray, kinds: list[str], shapes: np.ndarray,
@@ -387,18 +569,26 @@ def mode_state(analysis: ModalAnalysis, mode: int, amplitude: float,
     """A state at rest displaced along mode `mode`'s (real) shape, back on the manifold.
 
     The coordinates move by ``amplitude * Re(shape)`` (largest component = amplitude [m or
-    rad]); then least-norm Newton steps ``dq = -G^+ g`` put every cable at its length (a
-    second-order correction). Velocities are zero. Returns the packed state.
+    rad]; a rigid payload's rotation vector turns its attitude, displaced_state); then
+    least-norm Newton steps ``dq = -G^+ g`` (over the free coordinates when the UAVs are held)
+    put every cable at its length (a second-order correction). Velocities are zero. Returns
+    the packed state.
     """
-    layout = StateLayout(analysis.params.n_uavs)
+    params = analysis.params
+    layout = StateLayout(params.n_uavs, params.rigid_payload)
     x = np.array(analysis.equilibrium.state, dtype=float)
-    size = layout.n_coordinates
-    x[:size] += amplitude * analysis.shapes[mode].real
-    lengths = np.asarray(analysis.params.cable_lengths)
+    size = analysis.shapes.shape[1]
+    still = np.zeros(size)
+    x = displaced_state(layout, x, amplitude * analysis.shapes[mode].real, still)
+    lengths = np.asarray(params.cable_lengths)
+    free = np.ones(size, dtype=bool)
+    free[:UAV_COORDINATES * params.n_uavs] = not analysis.held_uavs
     for _ in range(iterations):
-        residual = cable_residuals(layout.uav_positions(x), layout.payload_position(x), lengths)
+        residual = formation_residuals(params, x)
         if np.max(np.abs(residual) / lengths ** 2) < 1e-15:
             break
-        jacobian = constraint_jacobian(layout.uav_positions(x), layout.payload_position(x))
-        x[:size] -= np.linalg.pinv(jacobian) @ residual
+        jacobian = formation_jacobian(params, x)
+        step = np.zeros(size)
+        step[free] = np.linalg.pinv(jacobian[:, free]) @ residual
+        x = displaced_state(layout, x, -step, still)
     return x

@@ -1,5 +1,7 @@
-"""`multilift modal SCENARIO [--out DIR]`: the modal analysis of multilift_sim.modal (seed
-Sec. 2.8) printed as a table, plotted in the complex plane (the analogue of seed Fig. 2.12) and
+"""`multilift modal SCENARIO [--out DIR] [--hold-uavs]`: the modal analysis of
+multilift_sim.modal (seed Sec. 2.8; a rigid-body payload's too, docs/rigid_payload.md) printed
+as a table, each mode named by where its kinetic energy sits (the payload's swing, heave, roll,
+pitch, yaw; the UAVs), plotted in the complex plane (the analogue of seed Fig. 2.12) and
 written as JSON. World frame (z up), SI units; eigenvalues [1/s], periods [s].
 Exit codes: 0 done, 2 bad scenario or argument (one `error:` line).
 """
@@ -14,13 +16,15 @@ from pathlib import Path
 import numpy as np
 
 from multilift_sim.formation_params import StateLayout
-from multilift_sim.modal import MODE_KINDS, ModalAnalysis, coordinate_names, scenario_modal_analysis
+from multilift_sim.modal import (MODE_KINDS, ModalAnalysis, coordinate_names, motion_shares,
+                                 scenario_modal_analysis)
 from multilift_sim.scenario import ScenarioError, load
 
 
 def _shape_text(analysis: ModalAnalysis, mode: int, count: int = 3) -> str:
-    """The `count` largest components of mode `mode`'s shape, named by coordinate."""
-    names = coordinate_names(analysis.params.n_uavs)
+    """The `count` largest components of mode `mode`'s shape ([m], [rad]), named by
+    coordinate."""
+    names = coordinate_names(analysis.params.n_uavs, analysis.params.rigid_payload)
     shape = analysis.shapes[mode]
     top = [k for k in np.argsort(-np.abs(shape))[:count] if abs(shape[k]) >= 0.01]
     parts = []
@@ -33,25 +37,36 @@ def _shape_text(analysis: ModalAnalysis, mode: int, count: int = 3) -> str:
 
 
 def modal_report(analysis: ModalAnalysis, name: str) -> str:
-    """The eigenvalue table, pendulum periods and rigid-body count as text."""
+    """The eigenvalue table (each mode's motion by kinetic energy share, its largest shape
+    components), pendulum periods and rigid-body count as text."""
     eq = analysis.equilibrium
-    n = analysis.params.n_uavs
+    params = analysis.params
+    n = params.n_uavs
     layout = StateLayout(n)
     tilts = np.degrees(np.arccos(np.cos(layout.uav_euler(eq.state)[:, 0])
                                  * np.cos(layout.uav_euler(eq.state)[:, 1])))
-    names = coordinate_names(n)
+    names = coordinate_names(n, params.rigid_payload)
     lines = [f'modal analysis of {name} (n = {n}): open loop, rotor speeds held at the static '
              'equilibrium of Eq. 2.73',
              '  cable tensions  ' + ', '.join(f'{t:.3f}' for t in eq.tensions) + ' N',
              '  rotor speeds    ' + ', '.join(f'{np.mean(s):.1f}' for s in eq.rotor_speeds)
              + ' rad/s (per UAV)',
              '  UAV tilt        ' + ', '.join(f'{t:.2f}' for t in tilts) + ' deg',
-             f'  coordinates     {layout.n_coordinates}, of them {analysis.basis.shape[1]} '
+             f'  coordinates     {analysis.basis.shape[0]}, of them {analysis.basis.shape[1]} '
              'independent' + (' (dependent: ' + ', '.join(names[k] for k in analysis.dependent)
-                              + ')' if analysis.dependent else ' (null-space basis)'),
-             '',
-             f'  {"#":>2}  {"Re [1/s]":>10}  {"Im [1/s]":>12}  {"period [s]":>10}  '
-             f'{"kind":<11}  shape (largest components of q_f)']
+                              if analysis.dependent else ' (null-space basis')
+             + (f'; the UAVs\' {6 * n} held)' if analysis.held_uavs else ')')]
+    if params.rigid_payload:
+        lines.append(f'  payload         a rigid body of {params.payload_mass:g} kg, J_p '
+                     + ', '.join(f'{j:.4g}' for j in params.payload_inertia) + ' kg m^2, level; '
+                     'its rotation vector rx_p, ry_p, rz_p [rad] (payload frame) in the '
+                     'coordinates')
+    if analysis.held_uavs:
+        lines.append('  UAVs            held still (--hold-uavs): their coordinates clamped, '
+                     'only the payload moves')
+    lines += ['',
+              f'  {"#":>2}  {"Re [1/s]":>10}  {"Im [1/s]":>12}  {"period [s]":>10}  '
+              f'{"kind":<11}  {"motion (kinetic energy share)":<36}  shape (largest components)']
     row = 0
     for k, value in enumerate(analysis.eigenvalues):
         kind = analysis.kinds[k]
@@ -61,14 +76,17 @@ def modal_report(analysis: ModalAnalysis, name: str) -> str:
         imag = f'+/-{value.imag:.5f}' if value.imag > 0 else f'{0.0:.5f}'
         period = f'{2 * math.pi / value.imag:.4f}' if value.imag > 0 else '-'
         lines.append(f'  {row:>2}  {value.real:>+10.2e}  {imag:>12}  {period:>10}  '
-                     f'{kind:<11}  {_shape_text(analysis, k)}')
+                     f'{kind:<11}  {analysis.motion(k):<36}  {_shape_text(analysis, k)}')
     rigid = analysis.rigid_count
     largest = max((abs(v) for v, c in zip(analysis.eigenvalues, analysis.kinds) if c == 'rigid'),
                   default=0.0)
+    held = ('motions of the payload its cables do not hold' if analysis.held_uavs else
+            'translation of the free formation and the UAV attitudes, which nothing holds in '
+            'open loop' + (', and any rotation of the body its cables do not hold'
+                           if params.rigid_payload else ''))
     lines += ['',
               f'  rigid-body modes: {rigid} eigenvalues with |lambda| < '
-              f'{analysis.zero_tolerance:g} 1/s (largest {largest:.1e}): translation of the '
-              'free formation and the UAV attitudes, which nothing holds in open loop',
+              f'{analysis.zero_tolerance:g} 1/s (largest {largest:.1e}): {held}',
               '  pendulum periods: ' + (', '.join(f'{p:.4f}' for p in analysis.pendulum_periods)
                                         or 'none') + ' s']
     unstable = analysis.indices('unstable')
@@ -76,6 +94,27 @@ def modal_report(analysis: ModalAnalysis, name: str) -> str:
         lines.append('  unstable: ' + ', '.join(f'{analysis.eigenvalues[k]:.4g}'
                                                 for k in unstable) + ' 1/s')
     return '\n'.join(lines)
+
+
+def _label_groups(analysis: ModalAnalysis, gap: float = 0.03) -> list[list[int]]:
+    """The pendulum modes (positive imaginary part, fastest first) as the plot labels them:
+    one label each, but a run of three or more whose imaginary parts lie within `gap` of the
+    largest |lambda| [1/s] of the run's first (labels that would overlap, e.g. box_lift's
+    formation modes near 8.7 s) shares one label."""
+    modes = list(analysis.pendulum_modes)
+    span = max(1e-3, float(np.max(np.abs(analysis.eigenvalues))))
+    groups: list[list[int]] = []
+    for k in modes:
+        first = groups[-1][0] if groups else None
+        if first is not None and (analysis.eigenvalues[first].imag
+                                  - analysis.eigenvalues[k].imag) <= gap * span:
+            groups[-1].append(k)
+        else:
+            groups.append([k])
+    out: list[list[int]] = []
+    for group in groups:          # a pair keeps its two labels (on alternating sides)
+        out += [group] if len(group) >= 3 else [[k] for k in group]
+    return out
 
 
 def plot_eigenvalues(analysis: ModalAnalysis, path: Path, title: str) -> None:
@@ -96,10 +135,13 @@ def plot_eigenvalues(analysis: ModalAnalysis, path: Path, title: str) -> None:
         label = f'{kind} ({k.size})' if kind != 'rigid' else f'rigid body ({k.size}, at 0)'
         axes.plot(values.real, values.imag, marker, color=colour, linestyle='none',
                   markersize=8, fillstyle='none' if kind == 'rigid' else 'full', label=label)
-    for count, k in enumerate(analysis.pendulum_modes):      # sides alternate: close pairs
-        value = analysis.eigenvalues[k]
+    for count, group in enumerate(_label_groups(analysis)):   # sides alternate: close pairs
+        value = analysis.eigenvalues[group[0]]
+        periods = [2 * math.pi / analysis.eigenvalues[k].imag for k in group]
+        text = (f'{periods[0]:.2f} s' if len(group) == 1 else
+                f'{min(periods):.2f}-{max(periods):.2f} s ({len(group)})')
         right = count % 2 == 0
-        axes.annotate(f'{2 * math.pi / value.imag:.2f} s', (value.real, value.imag),
+        axes.annotate(text, (value.real, value.imag),
                       textcoords='offset points', xytext=(8 if right else -8, -3),
                       ha='left' if right else 'right', fontsize=8)
     axes.axhline(0.0, color='black', linewidth=0.5)
@@ -116,15 +158,23 @@ def plot_eigenvalues(analysis: ModalAnalysis, path: Path, title: str) -> None:
 
 
 def modal_summary(analysis: ModalAnalysis, name: str) -> dict:
-    """JSON-ready eigenvalues [1/s], kinds, pendulum periods [s] and equilibrium."""
+    """JSON-ready eigenvalues [1/s], kinds, each mode's motion (kinetic energy shares, for
+    the non-rigid modes), pendulum periods [s] and equilibrium."""
     eq = analysis.equilibrium
+    params = analysis.params
+    names = coordinate_names(params.n_uavs, params.rigid_payload)
     return {'scenario': name,
+            'payload': 'rigid_body' if params.rigid_payload else 'point',
+            'held_uavs': analysis.held_uavs,
             'eigenvalues': [[float(v.real), float(v.imag)] for v in analysis.eigenvalues],
             'kinds': list(analysis.kinds),
+            'motions': [None if kind == 'rigid' else
+                        {m: round(s, 6) for m, s in motion_shares(analysis, k).items()}
+                        for k, kind in enumerate(analysis.kinds)],
             'pendulum_periods': [float(p) for p in analysis.pendulum_periods],
             'rigid_count': analysis.rigid_count,
-            'dependent_coordinates': [coordinate_names(analysis.params.n_uavs)[k]
-                                      for k in analysis.dependent],
+            'coordinates': list(names),
+            'dependent_coordinates': [names[k] for k in analysis.dependent],
             'equilibrium': {'state': eq.state.tolist(),
                             'rotor_speeds': [s.tolist() for s in eq.rotor_speeds],
                             'tensions': eq.tensions.tolist()}}
@@ -142,20 +192,23 @@ class _Parser(argparse.ArgumentParser):
 
 
 def modal_main(argv: list[str] | None = None) -> int:
-    """`multilift modal SCENARIO [--out DIR]` (argv without the word 'modal').
+    """`multilift modal SCENARIO [--out DIR] [--hold-uavs]` (argv without the word 'modal').
 
     Prints the eigenvalue table and the pendulum periods, writes DIR/<name>_eigenvalues.png
-    and DIR/<name>_modal.json (DIR default runs/modal). Exit 0, or 2 with one line on stderr
-    for a bad scenario or argument.
+    and DIR/<name>_modal.json (DIR default runs/modal; with --hold-uavs <name>_held_...).
+    --hold-uavs clamps the UAVs (the cables' upper ends held still: a suspension's own modes).
+    Exit 0, or 2 with one line on stderr for a bad scenario or argument.
     """
     parser = _Parser(prog='multilift modal', description='modal analysis of a formation at '
                      'its static equilibrium (seed Sec. 2.8)')
     parser.add_argument('scenario', help='a name in scenarios/ or a YAML path')
     parser.add_argument('--out', default='runs/modal', help='directory for the plot and JSON')
+    parser.add_argument('--hold-uavs', action='store_true', help='clamp the UAVs: the cables\' '
+                        'upper ends held still, only the payload moves')
     try:
         args = parser.parse_args(argv)
         scenario = load(args.scenario)
-        analysis = scenario_modal_analysis(scenario)
+        analysis = scenario_modal_analysis(scenario, hold_uavs=args.hold_uavs)
     except (_UsageError, ScenarioError, ValueError) as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2
@@ -164,10 +217,11 @@ def modal_main(argv: list[str] | None = None) -> int:
     print(modal_report(analysis, scenario.name))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    png = out / f'{scenario.name}_eigenvalues.png'
+    stem = scenario.name + ('_held' if args.hold_uavs else '')
+    png = out / f'{stem}_eigenvalues.png'
     plot_eigenvalues(analysis, png, f'{scenario.name}: eigenvalues of the linearised formation '
-                     '(open loop)')
-    summary = out / f'{scenario.name}_modal.json'
+                     '(open loop' + (', UAVs held)' if args.hold_uavs else ')'))
+    summary = out / f'{stem}_modal.json'
     summary.write_text(json.dumps(modal_summary(analysis, scenario.name), indent=1))
     print(f'  wrote {png} and {summary}')
     return 0

@@ -161,7 +161,8 @@ def test_runnable_follows_the_kernel_variable(monkeypatch):
     ('FORMATION_', 'FORMATION_SCALARS', {'FORMATION_WIND': 3, 'FORMATION_PAYLOAD_INERTIA': 3}),
     ('ACTUATOR_', 'ACTUATOR_COLUMNS', {}),
     ('EVENT_', 'EVENT_COLUMNS', {'EVENT_VELOCITY': 3}),
-    ('CABLE_', 'CABLE_COLUMNS', {'CABLE_OFFSET': 3, 'CABLE_THRUST': 3, 'CABLE_MOMENT': 3}),
+    ('CABLE_', 'CABLE_COLUMNS', {'CABLE_OFFSET': 3, 'CABLE_THRUST': 3, 'CABLE_MOMENT': 3,
+                                 'CABLE_PAYLOAD_MOMENT': 3}),
     ('WRENCH_', 'WRENCH_COLUMNS', {'WRENCH_TORQUE': 3}),
     ('WORK_', 'WORK_ROWS', {}),
 ])

@@ -7,7 +7,10 @@ hybrid model of RotorTM (Li et al., 2023): a taut cable is the seed's constraint
 tension); when |r_p - r_i| reaches l_i again while they separate, the cable snaps taut with an
 inelastic impulse: the velocities are projected, in the mass metric, onto those that keep every
 taut cable's length (g_dot = 0), which conserves momentum and does not increase the kinetic
-energy.
+energy. The same holds for a rigid-body payload and for cables held off the UAVs' centres
+(issue 20): the metric is then G M^-1 G^T with the bodies' rotations, the matrix A of
+docs/rigid_payload.md (which writes the snap out), and the impulse turns the bodies too; an
+impulse that leaves another slack cable at its length and separating snaps it at once.
 
 The snap is an event located within the RK4 step (`physics.slack_cables.slack_step`, compiled
 with the rest of the physics): when a slack cable would pass its
@@ -60,9 +63,11 @@ class SlackCableModel(FormationModel):
         return functions
 
     def snap_velocities(self, x: np.ndarray, taut: ArrayLike) -> np.ndarray:
-        """x with the translational velocities projected so that every `taut` cable has
-        g_dot = 0: v+ = v - M^-1 G^T (G M^-1 G^T)^-1 G v (an inelastic impulse along the
-        cables; total momentum kept, kinetic energy not increased). Returns a new array."""
+        """x with the velocities projected so that every `taut` cable has g_dot = 0:
+        u+ = u - M^-1 G^T (G M^-1 G^T)^-1 G u (an inelastic impulse along the cables; linear
+        and angular momentum kept, kinetic energy not increased; a rigid payload's body rates
+        and, with cables off the UAVs' centres, their Euler rates jump too). Returns a new
+        array."""
         x = np.array(self._state_array(x))
         n = self._n
         self._physics()['snap_velocities'](

@@ -85,6 +85,17 @@ def cable_multipliers(cables, payload_mass, taut, out):
 
 
 @jit
+def inverse_delta(uavs, i, offset_sq, k0, k1, k2):
+    """1 / delta_i [kg/m^2] of cable i's diagonal of G M^-1 G^T (point payload), |d_i|^2 =
+    offset_sq [m^2]: delta_i = 4 |d_i|^2 / m_i, plus 4 k_i . J_i^-1 k_i when the cable holds
+    UAV i off its centre (k_i [m^2], `free_motion.cable_moment_arm`; all 0 at its centre)."""
+    if k0 == 0.0 and k1 == 0.0 and k2 == 0.0:
+        return 0.25 * uavs[i, UAV_MASS] / offset_sq
+    return 1.0 / (4.0 * offset_sq / uavs[i, UAV_MASS]
+                  + 4.0 * rotational_compliance(uavs, i, k0, k1, k2))
+
+
+@jit
 def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     """q_ddot into acc (6n + 3,) [m/s^2, rad/s^2] and the cable multipliers Lambda into
     multipliers (n,) [N/m] at state x (seed Eq. 2.60, 2.70), only the `taut` cables
@@ -94,7 +105,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
         return
     if x.shape[0] > 2 * (UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES):
         # a rigid-body payload (its attitude after q_f_dot: physics.rigid_payload)
-        rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers)
+        rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
         return
     n = uavs.shape[0]
     p = UAV_COORDINATES * n
@@ -106,7 +117,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
     gravity = formation[FORMATION_GRAVITY]
     for i in range(n):
-        mass, length_sq = uavs[i, UAV_MASS], uavs[i, UAV_LENGTH_SQ]
+        length_sq = uavs[i, UAV_LENGTH_SQ]
         r = UAV_COORDINATES * i + POSITION
         rx, ry, rz = x[r], x[r + 1], x[r + 2]
         vx, vy, vz = x[nq + r], x[nq + r + 1], x[nq + r + 2]
@@ -134,11 +145,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
             + beta_sq * (offset_sq - length_sq))                       # beta_f^2 g
         # G M^-1 G^T = diag(4 |d_i|^2 / m_i) + 4 D D^T / m_p: 1 / delta_i of the diagonal
         # (held off its centre, the UAV's rotation adds 4 k_i . J_i^-1 k_i to delta_i)
-        if k0 == 0.0 and k1 == 0.0 and k2 == 0.0:
-            cables[i, CABLE_INV_DELTA] = 0.25 * mass / offset_sq
-        else:
-            cables[i, CABLE_INV_DELTA] = 1.0 / (
-                4.0 * offset_sq / mass + 4.0 * rotational_compliance(uavs, i, k0, k1, k2))
+        cables[i, CABLE_INV_DELTA] = inverse_delta(uavs, i, offset_sq, k0, k1, k2)
         cables[i, CABLE_MOMENT], cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2] = \
             k0, k1, k2
         cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], cables[i, CABLE_OFFSET + 2] = \

@@ -103,12 +103,14 @@ FORMATION_PAYLOAD_INERTIA = 10  # a rigid payload's principal moments J_p [kg m^
 FORMATION_SCALARS = 13
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
-CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots)
+CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots; from the attach points)
 CABLE_RHS = 3               # row i of the right-hand side of the multiplier equation
-CABLE_INV_DELTA = 4         # 1 / delta_i = m_i / (4 |d_i|^2) [kg/m^2]
+CABLE_INV_DELTA = 4         # 1 / delta_i = m_i / (4 |d_i|^2) [kg/m^2] (+ the UAV's rotation)
 CABLE_THRUST = 5            # UAV i's thrust (and drag) acceleration u_T R e_z / m_i [m/s^2] (3)
 CABLE_MOMENT = 8            # k_i = a_i x R_i^T d_i [m^2], body FLU: the pull's moment arm (3)
-CABLE_COLUMNS = 11
+CABLE_PAYLOAD_MOMENT = 11   # c_i = b_i x R_p^T d_i [m^2], a rigid payload's frame: its moment
+#                             arm there (3; physics.rigid_payload)
+CABLE_COLUMNS = 14
 
 # -- an RK4 step's scratch (rows of a (WORK_ROWS, 2 (6n + 3)) array) ---------------------------
 WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives (consecutive rows)

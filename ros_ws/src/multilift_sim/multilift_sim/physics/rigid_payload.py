@@ -32,12 +32,11 @@ from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_ce
                                               cable_moment_arm, cross, payload_force_per_mass,
                                               rotational_compliance, uav_attach_motion,
                                               uav_free_motion)
-from multilift_sim.physics.layout import (FORMATION_BETA_SQ, FORMATION_GRAVITY,
-                                          FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
-                                          FORMATION_TWO_ALPHA, PAYLOAD_BODY_RATES,
-                                          PAYLOAD_COORDINATES, PAYLOAD_QUATERNION, POSITION,
-                                          UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS,
-                                          UAV_PAYLOAD_ATTACH)
+from multilift_sim.physics.layout import (
+    CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT, CABLE_RHS,
+    CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_GRAVITY, FORMATION_PAYLOAD_INERTIA,
+    FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, PAYLOAD_BODY_RATES, PAYLOAD_COORDINATES,
+    PAYLOAD_QUATERNION, POSITION, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS, UAV_PAYLOAD_ATTACH)
 from multilift_sim.physics.nullspace import dense_solve
 
 
@@ -95,10 +94,94 @@ def world_rates(x, base, rotation):
 
 
 @jit
-def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
+def quaternion_rate(x, base, o0, o1, o2):
+    """q (x) (0, omega) / 2 [1/s] of the payload's quaternion q at x[base:] and a rate omega
+    = (o0, o1, o2) [rad/s], payload frame: q_dot, as 4 floats (w, x, y, z)."""
+    qw, qx = x[base + PAYLOAD_QUATERNION], x[base + PAYLOAD_QUATERNION + 1]
+    qy, qz = x[base + PAYLOAD_QUATERNION + 2], x[base + PAYLOAD_QUATERNION + 3]
+    return (0.5 * (-qx * o0 - qy * o1 - qz * o2), 0.5 * (qw * o0 + qy * o2 - qz * o1),
+            0.5 * (qw * o1 + qz * o0 - qx * o2), 0.5 * (qw * o2 + qx * o1 - qy * o0))
+
+
+@jit
+def rigid_cable_row(x, uavs, i, wrenches, rotation, w, base, attach, cables):
+    """Cable i's row of G M^-1 G^T at x into cables[i]: d_i [m] (CABLE_OFFSET, world), c_i =
+    b_i x R_p^T d_i [m^2] (CABLE_PAYLOAD_MOMENT, payload frame), k_i = a_i x R_i^T d_i [m^2]
+    (CABLE_MOMENT, UAV i's body; 0 at its centre) and 1 / delta_i, delta_i = 4 |d_i|^2 / m_i
+    + 4 k_i . J_i^-1 k_i (CABLE_INV_DELTA). `attach` (3, 3) gets UAV i's attach point's motion
+    (`free_motion.uav_attach_motion` under `wrenches`; zeros at its centre). Returns d_i_dot
+    [m/s], e_i = R_p b_i [m] (world) and |d_i|^2 [m^2] as 7 floats."""
+    attach[:, :] = 0.0
+    k0 = k1 = k2 = 0.0
+    held_off_centre = attached_off_centre(uavs, i)
+    if held_off_centre:
+        uav_rotation_i = uav_attach_motion(x, i, wrenches, uavs, attach)
+    d0, d1, d2, v0, v1, v2, e0, e1, e2 = cable_geometry(x, uavs, i, rotation, w, base, attach)
+    if held_off_centre:
+        k0, k1, k2 = cable_moment_arm(uavs, i, uav_rotation_i, d0, d1, d2)
+    # f_i = R_p^T d_i, c_i = b_i x f_i (payload frame)
+    f0 = rotation[0, 0] * d0 + rotation[1, 0] * d1 + rotation[2, 0] * d2
+    f1 = rotation[0, 1] * d0 + rotation[1, 1] * d1 + rotation[2, 1] * d2
+    f2 = rotation[0, 2] * d0 + rotation[1, 2] * d1 + rotation[2, 2] * d2
+    c0, c1, c2 = cross((uavs[i, UAV_PAYLOAD_ATTACH], uavs[i, UAV_PAYLOAD_ATTACH + 1],
+                        uavs[i, UAV_PAYLOAD_ATTACH + 2]), (f0, f1, f2))
+    offset_sq = d0 * d0 + d1 * d1 + d2 * d2
+    cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], cables[i, CABLE_OFFSET + 2] = \
+        d0, d1, d2
+    cables[i, CABLE_PAYLOAD_MOMENT], cables[i, CABLE_PAYLOAD_MOMENT + 1] = c0, c1
+    cables[i, CABLE_PAYLOAD_MOMENT + 2] = c2
+    cables[i, CABLE_MOMENT], cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2] = \
+        k0, k1, k2
+    cables[i, CABLE_INV_DELTA] = 1.0 / (4.0 * offset_sq / uavs[i, UAV_MASS]
+                                        + 4.0 * rotational_compliance(uavs, i, k0, k1, k2))
+    return v0, v1, v2, e0, e1, e2, offset_sq
+
+
+@jit
+def rigid_multipliers(cables, formation, taut, out):
+    """Solve ``A_TT z = b_T`` over the taut cables T, z = 0 on the others, into out (n,): A =
+    G M^-1 G^T of a rigid payload (the module docstring) from each cable's row of `cables`
+    (CABLE_OFFSET d_i, CABLE_PAYLOAD_MOMENT c_i, CABLE_INV_DELTA, CABLE_RHS b_i;
+    `rigid_cable_row`). Woodbury: A = Delta + U W U^T, U_i = 2 (d_i, c_i), W = diag(I / m_p,
+    J_p^-1), A^-1 b = Delta^-1 (b - U y) with S y = U^T Delta^-1 b, S = W^-1 + sum_i U_i U_i^T
+    / delta_i (6 x 6: the point payload's `formation_dae.cable_multipliers` with the
+    rotation's three rows added)."""
+    n = cables.shape[0]
+    s = np.zeros((6, 6))
+    for k in range(3):
+        s[k, k] = formation[FORMATION_PAYLOAD_MASS]
+        s[3 + k, 3 + k] = formation[FORMATION_PAYLOAD_INERTIA + k]
+    sb = np.zeros(6)
+    u = np.empty(6)
+    for i in range(n):
+        if not taut[i]:
+            continue
+        inv_delta = cables[i, CABLE_INV_DELTA]
+        for k in range(3):
+            u[k] = 2.0 * cables[i, CABLE_OFFSET + k]
+            u[3 + k] = 2.0 * cables[i, CABLE_PAYLOAD_MOMENT + k]
+        for a in range(6):
+            sb[a] += u[a] * inv_delta * cables[i, CABLE_RHS]
+            for b in range(6):
+                s[a, b] += u[a] * u[b] * inv_delta
+    y = dense_solve(s, sb)
+    for i in range(n):
+        if not taut[i]:
+            out[i] = 0.0
+            continue
+        projection = 0.0
+        for k in range(3):
+            projection += (2.0 * cables[i, CABLE_OFFSET + k] * y[k]
+                           + 2.0 * cables[i, CABLE_PAYLOAD_MOMENT + k] * y[3 + k])
+        out[i] = (cables[i, CABLE_RHS] - projection) * cables[i, CABLE_INV_DELTA]
+
+
+@jit
+def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     """q_ddot into acc[:6n + 3] [m/s^2, rad/s^2], the attitude block's rate (quaternion rate,
     then alpha_p [rad/s^2], payload frame) into acc[6n + 3:6n + 10], and Lambda into
-    multipliers (n,) [N/m] at state x (see the module docstring); only `taut` cables pull."""
+    multipliers (n,) [N/m] at state x (see the module docstring); only `taut` cables pull.
+    cables (n, CABLE_COLUMNS) scratch: each cable's row (`rigid_cable_row`; zeros when slack)."""
     n = uavs.shape[0]
     p = UAV_COORDINATES * n
     nq = p + PAYLOAD_COORDINATES
@@ -116,103 +199,62 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                                inertia[2] * omega[2]))
     alpha0 = np.array([-h0 / inertia[0], -h1 / inertia[1], -h2 / inertia[2]])
     two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
-    d = np.zeros((n, 3))
-    c = np.zeros((n, 3))
-    rhs = np.zeros(n)
-    inv_delta = np.zeros(n)
-    thrust = np.empty((n, 3))
-    moment = np.zeros((n, 3))  # k_i of a UAV held off its centre (free_motion)
     attach = np.zeros((3, 3))
     for i in range(n):
-        thrust[i, 0], thrust[i, 1], thrust[i, 2] = uav_free_motion(x, i, wrenches, uavs,
-                                                                   formation, acc)
-        if not taut[i]:
+        thrust0, thrust1, thrust2 = uav_free_motion(x, i, wrenches, uavs, formation, acc)
+        cables[i, CABLE_THRUST], cables[i, CABLE_THRUST + 1] = thrust0, thrust1
+        cables[i, CABLE_THRUST + 2] = thrust2
+        if not taut[i]:  # a slack cable holds nothing: a zero row
+            cables[i, CABLE_RHS] = cables[i, CABLE_INV_DELTA] = 0.0
+            for k in range(3):
+                cables[i, CABLE_OFFSET + k] = cables[i, CABLE_PAYLOAD_MOMENT + k] = 0.0
+                cables[i, CABLE_MOMENT + k] = 0.0
             continue
-        attach[:, :] = 0.0
-        held_off_centre = attached_off_centre(uavs, i)
-        if held_off_centre:
-            uav_rotation_i = uav_attach_motion(x, i, wrenches, uavs, attach)
-        d0, d1, d2, v0, v1, v2, e0, e1, e2 = cable_geometry(x, uavs, i, rotation, w, base,
-                                                            attach)
-        if held_off_centre:
-            moment[i, 0], moment[i, 1], moment[i, 2] = cable_moment_arm(uavs, i, uav_rotation_i,
-                                                                        d0, d1, d2)
-        d[i, 0], d[i, 1], d[i, 2] = d0, d1, d2
-        # f_i = R_p^T d_i, c_i = b_i x f_i (payload frame)
-        f0 = rotation[0, 0] * d0 + rotation[1, 0] * d1 + rotation[2, 0] * d2
-        f1 = rotation[0, 1] * d0 + rotation[1, 1] * d1 + rotation[2, 1] * d2
-        f2 = rotation[0, 2] * d0 + rotation[1, 2] * d1 + rotation[2, 2] * d2
-        c[i, 0], c[i, 1], c[i, 2] = cross((uavs[i, UAV_PAYLOAD_ATTACH],
-                                           uavs[i, UAV_PAYLOAD_ATTACH + 1],
-                                           uavs[i, UAV_PAYLOAD_ATTACH + 2]), (f0, f1, f2))
+        v0, v1, v2, e0, e1, e2, offset_sq = rigid_cable_row(x, uavs, i, wrenches, rotation, w,
+                                                            base, attach, cables)
+        d0, d1, d2 = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
+            cables[i, CABLE_OFFSET + 2]
+        c0, c1, c2 = cables[i, CABLE_PAYLOAD_MOMENT], cables[i, CABLE_PAYLOAD_MOMENT + 1], \
+            cables[i, CABLE_PAYLOAD_MOMENT + 2]
         s0, s1, s2 = cross(w, (e0, e1, e2))
         cp0, cp1, cp2 = cross(w, (s0, s1, s2))  # w x (w x e_i)
-        offset_sq = d0 * d0 + d1 * d1 + d2 * d2
-        rhs[i] = (2.0 * (v0 * v0 + v1 * v1 + v2 * v2)
-                  + 2.0 * (d0 * (drag0 - thrust[i, 0] - attach[2, 0])
-                           + d1 * (drag1 - thrust[i, 1] - attach[2, 1])
-                           + d2 * (drag2 - thrust[i, 2] - attach[2, 2]))
-                  + 2.0 * (c[i, 0] * alpha0[0] + c[i, 1] * alpha0[1] + c[i, 2] * alpha0[2])
-                  + 2.0 * (d0 * cp0 + d1 * cp1 + d2 * cp2)
-                  + two_alpha * 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
-                  + beta_sq * (offset_sq - uavs[i, UAV_LENGTH_SQ]))
-        inv_delta[i] = 1.0 / (4.0 * offset_sq / uavs[i, UAV_MASS] + 4.0 * rotational_compliance(
-            uavs, i, moment[i, 0], moment[i, 1], moment[i, 2]))
-    # Woodbury: S = diag(m_p I, J) + sum_i U_i U_i^T / delta_i, U_i = 2 (d_i, c_i)
-    s = np.zeros((6, 6))
-    for k in range(3):
-        s[k, k] = payload_mass
-        s[3 + k, 3 + k] = inertia[k]
-    sb = np.zeros(6)
-    u = np.empty(6)
-    for i in range(n):
-        if not taut[i]:
-            continue
-        for k in range(3):
-            u[k] = 2.0 * d[i, k]
-            u[3 + k] = 2.0 * c[i, k]
-        for a in range(6):
-            sb[a] += u[a] * inv_delta[i] * rhs[i]
-            for b in range(6):
-                s[a, b] += u[a] * u[b] * inv_delta[i]
-    y = dense_solve(s, sb)
+        cables[i, CABLE_RHS] = (2.0 * (v0 * v0 + v1 * v1 + v2 * v2)
+                                + 2.0 * (d0 * (drag0 - thrust0 - attach[2, 0])
+                                         + d1 * (drag1 - thrust1 - attach[2, 1])
+                                         + d2 * (drag2 - thrust2 - attach[2, 2]))
+                                + 2.0 * (c0 * alpha0[0] + c1 * alpha0[1] + c2 * alpha0[2])
+                                + 2.0 * (d0 * cp0 + d1 * cp1 + d2 * cp2)
+                                + two_alpha * 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
+                                + beta_sq * (offset_sq - uavs[i, UAV_LENGTH_SQ]))
+    rigid_multipliers(cables, formation, taut, multipliers)
     pull0 = pull1 = pull2 = 0.0     # sum_j lambda_j d_j (world)
     turn0 = turn1 = turn2 = 0.0     # sum_j lambda_j c_j (payload frame)
     for i in range(n):
-        if not taut[i]:
-            multipliers[i] = 0.0
-        else:
-            projection = 0.0
-            for k in range(3):
-                projection += 2.0 * d[i, k] * y[k] + 2.0 * c[i, k] * y[3 + k]
-            multipliers[i] = (rhs[i] - projection) * inv_delta[i]
         lam = multipliers[i]
+        d0, d1, d2 = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
+            cables[i, CABLE_OFFSET + 2]
         r = UAV_COORDINATES * i + POSITION
         pull = 2.0 * lam / uavs[i, UAV_MASS]
-        acc[r] = thrust[i, 0] + pull * d[i, 0]
-        acc[r + 1] = thrust[i, 1] + pull * d[i, 1]
-        acc[r + 2] = thrust[i, 2] + pull * d[i, 2] - gravity
+        acc[r] = cables[i, CABLE_THRUST] + pull * d0
+        acc[r + 1] = cables[i, CABLE_THRUST + 1] + pull * d1
+        acc[r + 2] = cables[i, CABLE_THRUST + 2] + pull * d2 - gravity
         if lam != 0.0 and attached_off_centre(uavs, i):  # the pull's moment on the UAV
-            add_cable_torque(x, i, uavs, acc, 2.0 * lam, moment[i, 0],
-                             moment[i, 1], moment[i, 2])
-        pull0 += lam * d[i, 0]
-        pull1 += lam * d[i, 1]
-        pull2 += lam * d[i, 2]
-        turn0 += lam * c[i, 0]
-        turn1 += lam * c[i, 1]
-        turn2 += lam * c[i, 2]
+            add_cable_torque(x, i, uavs, acc, 2.0 * lam, cables[i, CABLE_MOMENT],
+                             cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
+        pull0 += lam * d0
+        pull1 += lam * d1
+        pull2 += lam * d2
+        turn0 += lam * cables[i, CABLE_PAYLOAD_MOMENT]
+        turn1 += lam * cables[i, CABLE_PAYLOAD_MOMENT + 1]
+        turn2 += lam * cables[i, CABLE_PAYLOAD_MOMENT + 2]
     scale = 2.0 / payload_mass
     acc[p] = drag0 - scale * pull0
     acc[p + 1] = drag1 - scale * pull1
     acc[p + 2] = drag2 - scale * pull2 - gravity
     # the attitude block: q_dot = q (x) (0, omega) / 2, alpha = alpha_0 - 2 J^-1 sum lambda c
-    qw, qx = x[base + PAYLOAD_QUATERNION], x[base + PAYLOAD_QUATERNION + 1]
-    qy, qz = x[base + PAYLOAD_QUATERNION + 2], x[base + PAYLOAD_QUATERNION + 3]
-    o0, o1, o2 = omega[0], omega[1], omega[2]
-    acc[nq + PAYLOAD_QUATERNION] = 0.5 * (-qx * o0 - qy * o1 - qz * o2)
-    acc[nq + PAYLOAD_QUATERNION + 1] = 0.5 * (qw * o0 + qy * o2 - qz * o1)
-    acc[nq + PAYLOAD_QUATERNION + 2] = 0.5 * (qw * o1 + qz * o0 - qx * o2)
-    acc[nq + PAYLOAD_QUATERNION + 3] = 0.5 * (qw * o2 + qx * o1 - qy * o0)
+    (acc[nq + PAYLOAD_QUATERNION], acc[nq + PAYLOAD_QUATERNION + 1],
+     acc[nq + PAYLOAD_QUATERNION + 2], acc[nq + PAYLOAD_QUATERNION + 3]) = quaternion_rate(
+        x, base, omega[0], omega[1], omega[2])
     acc[nq + PAYLOAD_BODY_RATES] = alpha0[0] - 2.0 * turn0 / inertia[0]
     acc[nq + PAYLOAD_BODY_RATES + 1] = alpha0[1] - 2.0 * turn1 / inertia[1]
     acc[nq + PAYLOAD_BODY_RATES + 2] = alpha0[2] - 2.0 * turn2 / inertia[2]

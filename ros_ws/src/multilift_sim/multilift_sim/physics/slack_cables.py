@@ -1,6 +1,7 @@
 """Cables that pull but never push (`cable_model: slack`, slack.SlackCableModel) on one
 formation's arrays: the taut set, the snap (positions projected onto the cable's length, an
-inelastic impulse in the mass metric) and the taut event located within the RK4 step.
+inelastic impulse in the mass metric; a rigid payload's and the UAVs' rotations included,
+docs/rigid_payload.md) and the taut event located within the RK4 step.
 Not in the seed (slack.py's docstring has the model and its references). World frame, SI;
 arguments as in formation_dae, the slots `physics.layout`'s.
 
@@ -12,14 +13,21 @@ import math
 import numpy as np
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.formation_dae import cable_multipliers, residuals, rk4_step, solve
+from multilift_sim.physics.formation_dae import (cable_multipliers, inverse_delta, residuals,
+                                                 rk4_step, solve)
+from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_centre,
+                                              cable_moment_arm, uav_attach_motion)
 from multilift_sim.physics.layout import (
-    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_OFFSET, CABLE_RHS, FORMATION_INV_PAYLOAD_MASS,
-    FORMATION_PAYLOAD_MASS, PAYLOAD_COORDINATES, POSITION, SLACK_BRACKET, SLACK_CABLE_ROWS,
-    SLACK_CROSSING, SLACK_END, SLACK_EVENT, SLACK_FLAGS, SLACK_G_DOT_END, SLACK_G_END,
-    SLACK_MULTIPLIERS, SLACK_SNAPPING, SLACK_SOLUTION, SLACK_STATES, SLACK_TARGET, SLACK_VALUE,
-    SLACK_VALUE_BRACKET, SLACK_WATCHED, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS, WORK_ACC,
-    WORK_ROWS)
+    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT, CABLE_RHS,
+    FORMATION_INV_PAYLOAD_MASS, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
+    PAYLOAD_BODY_RATES, PAYLOAD_COORDINATES, PAYLOAD_QUATERNION, POSITION, SLACK_BRACKET,
+    SLACK_CABLE_ROWS, SLACK_CROSSING, SLACK_END, SLACK_EVENT, SLACK_FLAGS, SLACK_G_DOT_END,
+    SLACK_G_END, SLACK_MULTIPLIERS, SLACK_SNAPPING, SLACK_SOLUTION, SLACK_STATES, SLACK_TARGET,
+    SLACK_VALUE, SLACK_VALUE_BRACKET, SLACK_WATCHED, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS,
+    WORK_ACC, WORK_ROWS, WRENCH_COLUMNS)
+from multilift_sim.physics.rigid_payload import (normalize_quaternion, payload_rotation,
+                                                 quaternion_rate, rigid_cable_row,
+                                                 rigid_multipliers, world_rates)
 
 # The taut event is located to |g_i| <= EVENT_TOLERANCE l_i^2 (|r_p - r_i| within 5e-13 l_i of
 # l_i), in at most EVENT_ITERATIONS RK4 sub-steps (one or two in practice).
@@ -28,28 +36,59 @@ EVENT_ITERATIONS = 40
 
 
 # ---------------------------------------------------------------- solves in the mass metric
+# G M^-1 G^T is the matrix of the multiplier equation without its Baumgarte terms (the DAE's
+# solve builds it the same way): each cable's row from d_i and, where they exist, the moment
+# arms k_i (a UAV held off its centre) and c_i (a rigid payload); docs/rigid_payload.md.
 @jit
 def mass_metric_solve(x, uavs, formation, taut, rhs, out, cables):
     """z = (G M^-1 G^T)_TT^-1 rhs_T over the taut cables T (0 on the others) into out (n,),
-    at the positions of x; leaves each cable's d_i = r_p - r_i [m] in `cables`."""
+    at the positions of x; leaves each cable's row in `cables`: d_i [m] from its attach
+    points, k_i (CABLE_MOMENT, 0 at a UAV's centre) and with a rigid payload c_i
+    (CABLE_PAYLOAD_MOMENT)."""
     n = uavs.shape[0]
     p = UAV_COORDINATES * n
+    nq = p + PAYLOAD_COORDINATES
+    if x.shape[0] > 2 * nq:  # a rigid payload: the 6 x 6 Woodbury solve (physics.rigid_payload)
+        rotation = payload_rotation(x, 2 * nq)
+        w = world_rates(x, 2 * nq, rotation)
+        attach = np.zeros((3, 3))
+        still = np.zeros((n, WRENCH_COLUMNS))  # (the attach points' accelerations: unused)
+        for i in range(n):
+            rigid_cable_row(x, uavs, i, still, rotation, w, 2 * nq, attach, cables)
+            cables[i, CABLE_RHS] = rhs[i]
+        rigid_multipliers(cables, formation, taut, out)
+        return
     for i in range(n):
         r = UAV_COORDINATES * i + POSITION
         dx, dy, dz = x[p] - x[r], x[p + 1] - x[r + 1], x[p + 2] - x[r + 2]
+        k0 = k1 = k2 = 0.0
+        if attached_off_centre(uavs, i):  # from the attach point r_i + R_i a_i
+            attach = np.empty((3, 3))
+            uav_rotation_i = uav_attach_motion(x, i, np.zeros((n, WRENCH_COLUMNS)), uavs,
+                                               attach)
+            dx, dy, dz = dx - attach[0, 0], dy - attach[0, 1], dz - attach[0, 2]
+            k0, k1, k2 = cable_moment_arm(uavs, i, uav_rotation_i, dx, dy, dz)
         cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], cables[i, CABLE_OFFSET + 2] = \
             dx, dy, dz
-        cables[i, CABLE_INV_DELTA] = 0.25 * uavs[i, UAV_MASS] / (dx * dx + dy * dy + dz * dz)
+        cables[i, CABLE_MOMENT], cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2] = \
+            k0, k1, k2
+        cables[i, CABLE_INV_DELTA] = inverse_delta(uavs, i, dx * dx + dy * dy + dz * dz,
+                                                   k0, k1, k2)
         cables[i, CABLE_RHS] = rhs[i]
     cable_multipliers(cables, formation[FORMATION_PAYLOAD_MASS], taut, out)
 
 
 @jit
 def move_along_cables(x, uavs, formation, z, start, cables):
-    """x[start:] moved by -M^-1 G^T z on the translations: UAV i by +2 z_i d_i / m_i, the
-    payload by -2 sum_i z_i d_i / m_p (d_i from `cables`). start = 0 moves the positions
-    [m], start = 6n + 3 the velocities [m/s]."""
+    """x[start:] moved by -M^-1 G^T z (the rows of `cables`, `mass_metric_solve`'s): UAV i by
+    +2 z_i d_i / m_i and, held off its centre, its attitude by W^-1 J_i^-1 (2 z_i k_i) (Eq.
+    2.8's map of a body rotation to eta); the payload by -2 sum_i z_i d_i / m_p and, a rigid
+    one, turned by -2 J_p^-1 sum_i z_i c_i (payload frame). start = 0 moves the positions
+    [m] and angles [rad] (a rigid payload's quaternion q -> q (x) (1, turn / 2), back to unit
+    length: to first order, as the projection's Newton steps are), start = 6n + 3 the
+    velocities [m/s] and rates [rad/s]."""
     n = uavs.shape[0]
+    nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
     p = start + UAV_COORDINATES * n
     inv_payload_mass = formation[FORMATION_INV_PAYLOAD_MASS]
     for i in range(n):
@@ -58,13 +97,36 @@ def move_along_cables(x, uavs, formation, z, start, cables):
             pull = 2.0 * z[i] * cables[i, CABLE_OFFSET + k]  # G^T z of this body
             x[r + k] += pull / uavs[i, UAV_MASS]
             x[p + k] -= pull * inv_payload_mass
+        if attached_off_centre(uavs, i):  # the impulse's moment about UAV i's centre
+            add_cable_torque(x, i, uavs, x[start:], 2.0 * z[i], cables[i, CABLE_MOMENT],
+                             cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
+    if x.shape[0] > 2 * nq:  # a rigid payload's rotation
+        base = 2 * nq
+        turn0 = turn1 = turn2 = 0.0
+        for i in range(n):
+            turn0 += z[i] * cables[i, CABLE_PAYLOAD_MOMENT]
+            turn1 += z[i] * cables[i, CABLE_PAYLOAD_MOMENT + 1]
+            turn2 += z[i] * cables[i, CABLE_PAYLOAD_MOMENT + 2]
+        turn0 *= -2.0 / formation[FORMATION_PAYLOAD_INERTIA]
+        turn1 *= -2.0 / formation[FORMATION_PAYLOAD_INERTIA + 1]
+        turn2 *= -2.0 / formation[FORMATION_PAYLOAD_INERTIA + 2]
+        if start == 0:
+            rate = quaternion_rate(x, base, turn0, turn1, turn2)
+            for k in range(4):
+                x[base + PAYLOAD_QUATERNION + k] += rate[k]
+            normalize_quaternion(x, base)
+        else:
+            x[base + PAYLOAD_BODY_RATES] += turn0
+            x[base + PAYLOAD_BODY_RATES + 1] += turn1
+            x[base + PAYLOAD_BODY_RATES + 2] += turn2
 
 
 @jit
 def snap_velocities(x, uavs, formation, taut, g, g_dot, impulses, cables):
-    """x's translational velocities projected so that every `taut` cable has g_dot = 0:
-    v+ = v - M^-1 G^T (G M^-1 G^T)^-1 G v, an inelastic impulse along the cables (total
-    momentum kept, kinetic energy not increased). Writes x; g, g_dot, impulses (n,) scratch."""
+    """x's velocities projected so that every `taut` cable has g_dot = 0: u+ = u - M^-1 G^T
+    (G M^-1 G^T)^-1 G u, an inelastic impulse along the cables (the bodies' rotations in M
+    and G: docs/rigid_payload.md; linear and angular momentum kept, kinetic energy not
+    increased). Writes x; g, g_dot, impulses (n,) scratch."""
     residuals(x, uavs, g, g_dot)
     mass_metric_solve(x, uavs, formation, taut, g_dot, impulses, cables)
     nq = UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES
@@ -309,6 +371,31 @@ def taut_event(x, wrenches, uavs, gusts, formation, taut, released, h, g, g_dot,
 
 
 @jit
+def snap_separating(state, wrenches, uavs, gusts, formation, taut, released, g, g_dot, values,
+                    flags, work, cables):
+    """After a snap: a slack cable (not `released`) that its impulse leaves at its length
+    (|g_i| within EVENT_TOLERANCE l_i^2) and separating (g_dot_i > 0) snaps at once with the
+    taut ones, the taut set updated again (at most n rounds). Without it two cables that both
+    reach their lengths would take turns, each one's impulse pulling the other taut within
+    the next microseconds, and the last would snap only at the step's end, past its length.
+    state, taut, g [m^2], g_dot [m^2/s] updated."""
+    n = uavs.shape[0]
+    snapping = flags[SLACK_SNAPPING]
+    for _ in range(n):
+        any_snapping = False
+        for i in range(n):
+            snapping[i] = (not taut[i] and not released[i] and g_dot[i] > 0.0
+                           and g[i] >= -EVENT_TOLERANCE * uavs[i, UAV_LENGTH_SQ])
+            any_snapping = any_snapping or snapping[i]
+        if not any_snapping:
+            return
+        snap(state, uavs, formation, taut, snapping, values, cables)
+        update_taut_set(state, wrenches, uavs, gusts, formation, taut,
+                        values[SLACK_MULTIPLIERS], work[WORK_ACC], cables)
+        residuals(state, uavs, g, g_dot)
+
+
+@jit
 def slack_step(state, wrenches, uavs, gusts, formation, taut, released, dt, g, g_dot, states,
                values, flags, work, cables):
     """One RK4 step of dt [s] from state (whose residuals are g, g_dot), cut at each taut
@@ -340,6 +427,8 @@ def slack_step(state, wrenches, uavs, gusts, formation, taut, released, dt, g, g
         update_taut_set(state, wrenches, uavs, gusts, formation, taut,
                         values[SLACK_MULTIPLIERS], work[WORK_ACC], cables)
         residuals(state, uavs, g, g_dot)
+        snap_separating(state, wrenches, uavs, gusts, formation, taut, released, g, g_dot,
+                        values, flags, work, cables)
         left -= tau
         if left <= 0.0:
             return
@@ -366,7 +455,7 @@ def integrate_period(x, wrenches, uavs, gusts, formation, taut, released, dt, st
     (the state at the end, the multipliers [N/m] at x after the taut set's update there,
     g [m^2] and g_dot [m^2/s] at the end). taut (n,) bool is updated; x is not written."""
     n = uavs.shape[0]
-    size = 2 * (UAV_COORDINATES * n + PAYLOAD_COORDINATES)
+    size = x.shape[0]  # 2 (6n + 3), and a rigid payload's attitude
     work = np.empty((WORK_ROWS, size))
     states = np.empty((SLACK_STATES, size))
     values = np.empty((SLACK_CABLE_ROWS, n))

@@ -205,9 +205,6 @@ def scenario_of(data: Any, where: str) -> Scenario:
                                                        for u in scenario.uavs)
     rigid = payload.type == 'rigid_body'
     off_centre = [i + 1 for i, u in enumerate(scenario.uavs) if any(u.attach_point)]
-    if off_centre and cable_model != 'rigid':
-        raise ScenarioError(f'{where}: uavs[{off_centre[0] - 1}].attach_point needs '
-                            f'cable_model: rigid (slack cables off a UAV\'s centre: not yet)')
     for used, what in ((windy, 'wind and vehicle.drag_coefficient'), (events, 'events'),
                        (lagging, f'vehicle.motor_time_constant / motor_rate_limit '
                                  f'(uav{lagging[0] if lagging else 0})'),
@@ -217,9 +214,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
         if used and sim.integrator != 'baumgarte':
             raise ScenarioError(f'{where}: {what} need simulation.integrator: baumgarte, got '
                                 f'{sim.integrator!r}')
-    if rigid and (cable_model != 'rigid' or len(uavs) < 2):
-        raise ScenarioError(f'{where}: payload.type: rigid_body needs n >= 2 UAVs and '
-                            f'cable_model: rigid (slack cables on a rigid body: not yet)')
+    if rigid and len(uavs) < 2:
+        raise ScenarioError(f'{where}: payload.type: rigid_body needs n >= 2 UAVs')
     if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')

@@ -18,9 +18,12 @@ from multilift_control.controllers import MissionLeader
 from multilift_control.formation import FormationFollower
 from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_control.headless import run_headless
-from multilift_control.laws import cascade, constraints, follower, linalg, mixer, reference
+from multilift_control.laws import (cascade, constraints, follower, linalg, mixer, reference,
+                                    swing)
 from multilift_control.laws.layout import (CASCADE_GRAVITY, CASCADE_MAX_TILT,
                                            CASCADE_SQUARE_MAX, CASCADE_SQUARE_MIN,
+                                           CASCADE_SWING_DAMPING, CASCADE_SWING_REST,
+                                           CASCADE_SWING_STIFFNESS,
                                            CASCADE_THRUST_COEFFICIENT, FOLLOWER_FREE_MODE_GAIN,
                                            FOLLOWER_MEMORY_SIZE, REFERENCE_SIZE,
                                            UAV_STATE_SIZE)
@@ -114,6 +117,9 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
     twin = scenario_io.load('twin_lift')
     leader = MissionLeader(twin, 0)
     c, m = leader.cascade.constants, leader.cascade.mixer.rows
+    damped = c.copy()  # with the swing feedback (control.payload_feedback) on
+    damped[CASCADE_SWING_STIFFNESS], damped[CASCADE_SWING_DAMPING] = 0.8, 0.3
+    damped[CASCADE_SWING_REST:CASCADE_SWING_REST + 2] = 0.2, -0.1
     raw = MissionPath(dataclasses.replace(twin.mission, reference_filter_time=0.0))
     paths = (leader.path, raw)
     followers = _followers()
@@ -153,9 +159,16 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
                                                 t, state, ref, yaw)
         saturated += bool(out[1].any())
         clamped += np.abs(cascade_memory[:3]).max() == 0.5 * c[CASCADE_GRAVITY]
-        _, (*_, leader_memory, _, _, _, _, _) = check(
-            cascade.leader_update, c, m, leader_memory, leader.path.mission,
-            leader.path.segments, leader.path.steps, t, state)
+        # the leader of a twin-lift, its swing feedback (control.payload_feedback) on every
+        # other tick
+        formation = _states(rng, np.array([[0.0, 0.0, 0.0], [-3.5, -2.0, 0.0]]), spread)
+        payload_position = [-1.7, -1.0, -10.0] + spread * rng.normal(size=3)
+        payload_velocity = rng.normal(size=3)
+        check(swing.swing_feedback, damped, formation, payload_position, payload_velocity)
+        _, (*_, leader_memory, _, _, _, _, _, _, _) = check(
+            cascade.leader_update, damped if tick % 2 else c, m, leader_memory,
+            leader.path.mission, leader.path.segments, leader.path.steps, t, formation,
+            payload_position, payload_velocity)
         # the linear algebra: full rank, rank deficient, wide, square singular
         matrix = rng.normal(size=(int(rng.integers(1, 5)), int(rng.integers(1, 6))))
         if tick % 3 == 0:

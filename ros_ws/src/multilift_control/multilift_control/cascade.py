@@ -26,7 +26,10 @@ from multilift_control.laws.layout import (CASCADE_ATT_KD, CASCADE_ATT_KP, CASCA
                                            CASCADE_KI, CASCADE_KP, CASCADE_LAST_T,
                                            CASCADE_MAX_TILT, CASCADE_MEMORY_SIZE, CASCADE_SIZE,
                                            CASCADE_SQUARE_MAX, CASCADE_SQUARE_MIN,
-                                           CASCADE_THRUST_COEFFICIENT, MIXER_COLLECTIVE,
+                                           CASCADE_SWING_DAMPING, CASCADE_SWING_LIMIT,
+                                           CASCADE_SWING_REST,
+                                           CASCADE_SWING_STIFFNESS, CASCADE_THRUST_COEFFICIENT,
+                                           MIXER_COLLECTIVE,
                                            MIXER_SIZE, MIXER_WRENCH, REFERENCE_ACCELERATION,
                                            REFERENCE_POSITION, REFERENCE_SIZE,
                                            REFERENCE_VELOCITY, UAV_BODY_RATES, UAV_EULER,
@@ -58,7 +61,20 @@ class UavState:
 class FormationStates(tuple):
     """Every UAV's UavState at one tick, from the leader on, stacked once into the laws' (n,
     UAV_STATE_SIZE) array (`array`, read-only): the followers of one process share it instead
-    of each stacking n states (O(n^2) a tick)."""
+    of each stacking n states (O(n^2) a tick). `payload_velocity`: the payload's v_p [m/s],
+    world, at the same tick as the snapshot carries it, and `payload_position` r_p [m] (None
+    where not given: a leader with `control.payload_feedback` refuses to answer without them).
+    """
+
+    payload_position: np.ndarray | None
+    payload_velocity: np.ndarray | None
+
+    def __new__(cls, states=(), payload_position=None, payload_velocity=None):
+        self = super().__new__(cls, states)
+        self.payload_position, self.payload_velocity = (
+            None if value is None else np.asarray(value, dtype=float).reshape(3)
+            for value in (payload_position, payload_velocity))
+        return self
 
     @classmethod
     def of(cls, states) -> FormationStates:
@@ -135,7 +151,9 @@ class CascadeController:
     """
 
     def __init__(self, vehicle: MultirotorParams, gains: ControlConfig, hover_mass: float,
-                 gravity: float):
+                 gravity: float, swing_rest: tuple[float, float] = (0.0, 0.0)):
+        """swing_rest: s_0 of the swing feedback (`laws.swing`), the payload's x, y from the
+        UAVs' mean position at the formation's hanging rest [m] (a leader's; else unused)."""
         self.vehicle = vehicle
         self.gains = gains
         self.hover_mass = hover_mass
@@ -157,6 +175,11 @@ class CascadeController:
         self.constants[CASCADE_SQUARE_MIN] = self.mixer.square_min
         self.constants[CASCADE_SQUARE_MAX] = self.mixer.square_max
         self.constants[CASCADE_THRUST_COEFFICIENT] = vehicle.thrust_coefficient
+        # a leader's swing feedback (laws.swing); s_0 given by the leader that knows the formation
+        self.constants[CASCADE_SWING_STIFFNESS] = gains.swing_stiffness
+        self.constants[CASCADE_SWING_DAMPING] = gains.swing_damping
+        self.constants[CASCADE_SWING_REST:CASCADE_SWING_REST + 2] = swing_rest
+        self.constants[CASCADE_SWING_LIMIT] = gains.swing_limit
         self.constants.flags.writeable = False
         # what the loop remembers (CASCADE_INTEGRAL, CASCADE_LAST_T: NaN before a tick)
         self.memory = np.zeros(CASCADE_MEMORY_SIZE)

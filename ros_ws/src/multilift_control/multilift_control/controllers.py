@@ -1,7 +1,8 @@
-"""The controllers a scenario can pick (`control.mode`), behind one `update(t, state)` call.
+"""The controllers a scenario can pick (`control.mode`), behind one `update(t, states)` call.
 
-A controller answers a UAV state at simulated time t [s] with a `ControlOutput` and the
-reference it tracked (or None).
+A controller answers the formation's states at simulated time t [s] (`FormationStates`: every
+UAV's, its own first, and the payload's velocity) with a `ControlOutput` and the reference it
+tracked (or None).
 """
 from __future__ import annotations
 
@@ -10,15 +11,17 @@ from typing import Protocol
 import numpy as np
 
 from multilift_control import laws
-from multilift_control.cascade import (CascadeController, ControlOutput, UavState,
+from multilift_control.cascade import (CascadeController, ControlOutput, FormationStates,
                                        balancing_rotor_speed)
 from multilift_control.laws.cascade import leader_update
 from multilift_control.mission import MissionPath, Reference
 from multilift_sim.scenario import CONTROL_MODES, Scenario
+from multilift_sim.simulation import formation_start
 
 
 class Controller(Protocol):
-    def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
+    def update(self, t: float, states: FormationStates
+               ) -> tuple[ControlOutput, Reference | None]:
         ...
 
 
@@ -39,7 +42,8 @@ class ConstantRotorSpeed:
                                     attitude_setpoint=np.zeros(3),
                                     thrust=vehicle.collective_thrust(speeds))
 
-    def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
+    def update(self, t: float, states: FormationStates
+               ) -> tuple[ControlOutput, Reference | None]:
         return self.output, None
 
 
@@ -51,15 +55,36 @@ class MissionLeader:
         uav = scenario.uavs[index]
         hover_mass = uav.vehicle.mass + scenario.payload.mass / scenario.n_uavs
         self.cascade = CascadeController(uav.vehicle, scenario.control, hover_mass,
-                                         scenario.simulation.gravity)
+                                         scenario.simulation.gravity, swing_rest(scenario))
         self.path = MissionPath(scenario.mission)
+        control = scenario.control
+        self.swing_feedback = bool(control.swing_stiffness or control.swing_damping)
         self._law = laws.runnable(leader_update)
 
-    def update(self, t: float, state: UavState) -> tuple[ControlOutput, Reference | None]:
+    def update(self, t: float, states: FormationStates
+               ) -> tuple[ControlOutput, Reference | None]:
         c, p = self.cascade, self.path
+        states = FormationStates.of(states)
+        payload = states.payload_position, states.payload_velocity
+        if payload[0] is None or payload[1] is None:
+            if self.swing_feedback:
+                raise ValueError('control.payload_feedback needs the payload\'s position and '
+                                 'velocity (FormationStates.payload_position, _velocity)')
+            payload = np.zeros(3), np.zeros(3)  # not read without the feedback
         *out, reference = self._law(c.constants, c.mixer.rows, c.memory, p.mission, p.segments,
-                                    p.steps, float(t), state.row())
+                                    p.steps, float(t), states.array, *payload)
         return ControlOutput(*out), Reference.of(reference)
+
+
+def swing_rest(scenario: Scenario) -> tuple[float, float]:
+    """s_0 of the swing feedback (`laws.swing`): the payload's (x, y) from the UAVs' mean
+    position at the formation's hanging rest [m] (`simulation.formation_start`, without the
+    payload.swing_deg release); 0 for one UAV, whose payload hangs straight below."""
+    if scenario.n_uavs == 1:
+        return 0.0, 0.0
+    uavs, payload = formation_start(scenario)
+    offset = payload - uavs.mean(axis=0)
+    return float(offset[0]), float(offset[1])
 
 
 # the leader's controller by `control.mode`: the names are the scenario's registry

@@ -136,7 +136,7 @@ class ControllerRuntime:
         self._faults.at(t_ns // self._period_ns, None if cascade is None else cascade.mixer,
                         self.follower.constraints if self.is_follower else None)
         if not self.is_follower:
-            output, reference = self.leader.update(t, states[0])
+            output, reference = self.leader.update(t, states)
             if reference is not None:
                 self.statistics.add(reference.position, states[0].position)
             return ControllerAnswer(0, t_ns, output, reference=reference)
@@ -176,12 +176,14 @@ def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
 
 def uav_states(snapshot: Snapshot) -> FormationStates:
     """What the controllers measure of the formation at the snapshot's tick (its
-    `measured` rows: the state, or with `sensors:` the sensors' measurement)."""
-    return FormationStates(UavState(row[UAV_POSITION:UAV_POSITION + 3],
-                                    row[UAV_VELOCITY:UAV_VELOCITY + 3],
-                                    row[UAV_EULER:UAV_EULER + 3],
-                                    row[UAV_BODY_RATES:UAV_BODY_RATES + 3])
-                           for row in snapshot.measured)
+    `measured` rows: the state, or with `sensors:` the sensors' measurement) and the payload's
+    position and velocity (the state's)."""
+    return FormationStates((UavState(row[UAV_POSITION:UAV_POSITION + 3],
+                                     row[UAV_VELOCITY:UAV_VELOCITY + 3],
+                                     row[UAV_EULER:UAV_EULER + 3],
+                                     row[UAV_BODY_RATES:UAV_BODY_RATES + 3])
+                            for row in snapshot.measured), snapshot.payload_position,
+                           snapshot.payload_velocity)
 
 
 def prepare_node_laws(scenario: Scenario, index: int) -> None:

@@ -23,7 +23,8 @@ from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals
 from multilift_sim.physics.layout import (EVENT_KIND, EVENT_UAV, FORMATION_WIND,
                                           KIND_ROTOR_EFFECTIVENESS)
-from multilift_sim.physics.measurement import measured_states
+from multilift_sim.physics.measurement import (measured_states, payload_position,
+                                               payload_velocity)
 from multilift_sim.physics.sensors import sensed_states
 from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
                                                    run_add_gust_speed, run_add_slack,
@@ -44,7 +45,8 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
     if a.leader_mode[b] == MODE_CASCADE:
         s, sat, setpoint, lift, ref = leader_update(
             a.cascade[b, 0], m.mixers[b, 0], m.cascade_memory[b, 0], a.mission[b],
-            a.segments[b], a.mission_steps[b], t, states[0])
+            a.segments[b], a.mission_steps[b], t, states, payload_position(m.state[b], n),
+            payload_velocity(m.state[b], n))
         for k in range(REFERENCE_SIZE):
             reference[k] = ref[k]
         tracking_add(m.tracking[b], ref[REFERENCE_POSITION:REFERENCE_POSITION + 3],

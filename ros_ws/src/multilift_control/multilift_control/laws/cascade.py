@@ -14,12 +14,14 @@ from multilift_control.laws.layout import (CASCADE_ATT_KD, CASCADE_ATT_KP, CASCA
                                            CASCADE_INTEGRAL, CASCADE_INTEGRAL_LIMIT, CASCADE_KD,
                                            CASCADE_KI, CASCADE_KP, CASCADE_LAST_T,
                                            CASCADE_MAX_TILT, CASCADE_SQUARE_MAX,
-                                           CASCADE_SQUARE_MIN, REFERENCE_ACCELERATION,
+                                           CASCADE_SQUARE_MIN, CASCADE_SWING_DAMPING,
+                                           CASCADE_SWING_STIFFNESS, REFERENCE_ACCELERATION,
                                            REFERENCE_POSITION, REFERENCE_VELOCITY,
                                            UAV_BODY_RATES, UAV_EULER, UAV_POSITION,
                                            UAV_VELOCITY)
 from multilift_control.laws.mixer import rotor_speeds
 from multilift_control.laws.reference import mission_reference
+from multilift_control.laws.swing import swing_feedback
 
 
 @jit
@@ -155,10 +157,21 @@ def cascade_update(constants, mixer, memory, t, state, reference, yaw):
 
 
 @jit
-def leader_update(constants, mixer, memory, mission, segments, steps, t, state):
+def leader_update(constants, mixer, memory, mission, segments, steps, t, states,
+                  payload_position, payload_velocity):
     """A leader's tick at t [s]: the mission reference (`reference.mission_reference`) tracked
-    by the cascade at heading 0. Returns (speeds, saturated, setpoint, thrust, reference)."""
+    by the cascade at heading 0, its acceleration with the swing feedback
+    (`swing.swing_feedback`) added when CASCADE_SWING_STIFFNESS or _DAMPING is not 0. states
+    (n, UAV_STATE_SIZE): every UAV's, the leader's first; payload_position [m],
+    payload_velocity [m/s] (3,), world (read only with the feedback on).
+    Returns (speeds, saturated, setpoint, thrust, reference), the mission's reference."""
     reference = mission_reference(mission, segments, steps, t)
-    speeds, saturated, setpoint, thrust = cascade_update(constants, mixer, memory, t, state,
-                                                         reference, 0.0)
+    aimed = reference
+    if constants[CASCADE_SWING_STIFFNESS] != 0.0 or constants[CASCADE_SWING_DAMPING] != 0.0:
+        aimed = reference.copy()
+        feedback = swing_feedback(constants, states, payload_position, payload_velocity)
+        for axis in range(3):
+            aimed[REFERENCE_ACCELERATION + axis] += feedback[axis]
+    speeds, saturated, setpoint, thrust = cascade_update(constants, mixer, memory, t, states[0],
+                                                         aimed, 0.0)
     return speeds, saturated, setpoint, thrust, reference

@@ -52,7 +52,13 @@ CASCADE_ATT_KD = 19            # (3) [1/s]
 CASCADE_SQUARE_MIN = 22        # omega_min^2 [rad^2/s^2]
 CASCADE_SQUARE_MAX = 23        # omega_max^2 [rad^2/s^2]
 CASCADE_THRUST_COEFFICIENT = 24  # k_T [N s^2/rad^2]
-CASCADE_SIZE = 25
+# a leader's swing feedback (`swing.swing_feedback`, control.payload_feedback); both gains 0:
+# the seed's law (off)
+CASCADE_SWING_STIFFNESS = 25   # k_s [1/s^2]
+CASCADE_SWING_DAMPING = 26     # k_d [1/s]
+CASCADE_SWING_REST = 27        # (2) s_0: the payload's x, y from the UAVs' mean at rest [m]
+CASCADE_SWING_LIMIT = 29       # a_max: the largest |a_s| [m/s^2]
+CASCADE_SIZE = 30
 # its memory
 CASCADE_INTEGRAL = 0   # (3) position loop integral [m/s^2]
 CASCADE_LAST_T = 3     # time of the last tick [s] (NaN: none yet)

@@ -40,6 +40,22 @@ def measured_states(x, n, out):
 
 
 @jit
+def payload_position(x, n):
+    """The payload's position r_p [m] (3,), world, in the formation state x of n UAVs (a view:
+    what the snapshot carries and a leader's swing feedback reads, multilift_control.laws.swing)."""
+    start = UAV_COORDINATES * n
+    return x[start:start + 3]
+
+
+@jit
+def payload_velocity(x, n):
+    """The payload's velocity v_p [m/s] (3,), world, in the formation state x of n UAVs (a view:
+    what the snapshot carries and a leader's swing damping reads, multilift_control.laws.swing)."""
+    start = 2 * UAV_COORDINATES * n + PAYLOAD_COORDINATES
+    return x[start:start + 3]
+
+
+@jit
 def odometry_states(states, n, out):
     """Every UAV's odometry row into out (K, n, ODOMETRY_COLUMNS) for K formation states
     (K, 2 (6n + 3)) (FormationSimulator.snapshot: K = 1; the headless bag: a chunk's ticks):

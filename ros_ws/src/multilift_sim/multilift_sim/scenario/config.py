@@ -96,6 +96,11 @@ class ControlConfig:
     attitude_kp: tuple[float, float, float]  # [1/s^2]
     attitude_kd: tuple[float, float, float]  # [1/s]
     max_tilt: float                  # [rad]
+    # control.payload_feedback (not in the seed: the leader's swing feedback,
+    # multilift_control.laws.swing); both 0 = the seed's law
+    swing_stiffness: float = 0.0     # k_s [1/s^2]
+    swing_damping: float = 0.0       # k_d [1/s]
+    swing_limit: float = math.inf    # a_max: the largest |a_s| [m/s^2]
 
 
 @dataclass(frozen=True)

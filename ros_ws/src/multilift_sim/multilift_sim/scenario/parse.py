@@ -165,7 +165,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
         position_ki=gains_pos.vector('ki', **nonneg),
         attitude_kp=gains_att.vector('kp', **nonneg), attitude_kd=gains_att.vector('kd', **nonneg),
         max_tilt=math.radians(c.number('max_tilt_deg', 30.0, lambda a: 0 < a < 90,
-                                       'must be within (0, 90) degrees')))
+                                       'must be within (0, 90) degrees')),
+        **_payload_feedback(c, mode))
     gains_pos.done()
     gains_att.done()
     c.done()
@@ -220,6 +221,22 @@ def scenario_of(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario
+
+
+def _payload_feedback(c: Section, mode: str) -> dict[str, float]:
+    """`control.payload_feedback` (issue 20; not in the seed): the leader's swing feedback
+    gains swing_stiffness k_s [1/s^2] and swing_damping k_d [1/s]
+    (multilift_control.laws.swing), both 0 (the default) the seed's law."""
+    feedback = c.section('payload_feedback', {})
+    gains = {name: feedback.number(name, 0.0) for name in ('swing_stiffness', 'swing_damping')}
+    for name, gain in gains.items():
+        if gain != 0 and mode != 'cascade':
+            raise feedback.fail(name, gain, f'needs control.mode: cascade (a leader that '
+                                f'tracks the mission), not {mode!r}')
+    gains['swing_limit'] = (feedback.positive('acceleration_limit')
+                            if feedback.has('acceleration_limit') else math.inf)
+    feedback.done()
+    return gains
 
 
 def _rigid_body(p: Section, payload: PayloadConfig, n: int) -> PayloadConfig:

@@ -236,3 +236,28 @@ def test_a_rigid_payload_flies_alike_through_ros_and_headless(tmp_path):
                 for c, _, raw in reader.messages(odom)]
     assert len(tilt) == 301 and min(tilt) < 1.0 - 1e-6
     assert np.abs(ros_run.payload_position() - headless_run.payload_position()).max() < 1e-9
+
+
+def test_the_payload_feedback_flies_alike_through_ros_and_headless(tmp_path):
+    """`twin_lift` with `control.payload_feedback` (the corners shaped, the leader's swing
+    feedback on the payload's state from /formation/snapshot): the leader node flies what the
+    headless run flies, through the released swing and the first corner."""
+    import yaml
+
+    from conftest import SCENARIOS
+    data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
+    data['control']['payload_feedback'] = {'input_shaping': 'zvdd', 'swing_stiffness': 0.25,
+                                           'swing_damping': -0.2, 'acceleration_limit': 0.15}
+    path = tmp_path / 'twin_lift_feedback.yaml'
+    path.write_text(yaml.safe_dump(data))
+    _, headless = _ros_and_headless(tmp_path, str(path), '12.0',
+                                    'payload feedback zvdd shaping of the corners')
+    seed = tmp_path / 'seed'
+    env = dict(os.environ, ROS_DOMAIN_ID=str(next_domain()),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    out = subprocess.run([MULTILIFT, 'run', 'twin_lift', '--duration', '12.0', '--headless',
+                          '--bag', str(seed)], capture_output=True, text=True, timeout=600,
+                         env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    moved = np.abs(load_run(seed).uav_positions() - headless.uav_positions()).max()
+    assert moved > 1e-2  # the feedback acted

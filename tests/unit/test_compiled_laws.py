@@ -30,6 +30,7 @@ from multilift_control.laws.layout import (CASCADE_GRAVITY, CASCADE_MAX_TILT,
 from multilift_control.mission import MissionPath
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
+from multilift_sim.scenario import INPUT_SHAPERS
 from multilift_sim.simulation import FormationSimulator
 
 pytest.importorskip('numba')
@@ -120,8 +121,11 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
     damped = c.copy()  # with the swing feedback (control.payload_feedback) on
     damped[CASCADE_SWING_STIFFNESS], damped[CASCADE_SWING_DAMPING] = 0.8, 0.3
     damped[CASCADE_SWING_REST:CASCADE_SWING_REST + 2] = 0.2, -0.1
-    raw = MissionPath(dataclasses.replace(twin.mission, reference_filter_time=0.0))
-    paths = (leader.path, raw)
+    raw_mission = dataclasses.replace(twin.mission, reference_filter_time=0.0)
+    raw = MissionPath(raw_mission)
+    shaped = [MissionPath(mission, INPUT_SHAPERS['zvd'], 6.4)  # control.payload_feedback
+              for mission in (twin.mission, raw_mission)]
+    paths = (leader.path, raw, *shaped)
     followers = _followers()
     memories = {id(f): f.memory.copy() for f, _ in followers}
     cascade_memory = leader.cascade.memory.copy()

@@ -82,6 +82,8 @@ def test_every_figure_of_the_report_is_committed_and_modest(report_lines):
     links = re.findall(r'!\[[^\]]*\]\((figures/[^)]+\.png)\)', text)
     numbers = re.findall(r'^### Fig\. ([0-9.]+)$', text, flags=re.MULTILINE)
     assert numbers == ['2.12'] + [f'4.{k}' for k in range(1, 18)]
-    assert len(links) == len(numbers)
+    beyond = re.findall(r'\(figures/(swing_feedback_[a-z_]+\.png)\)', text)  # issue 20
+    assert beyond == ['swing_feedback_single_lift.png', 'swing_feedback_twin_lift.png']
+    assert len(links) == len(numbers) + len(beyond)
     sizes = [(REPORT.parent / link).stat().st_size for link in links]
     assert sum(sizes) < 8e6

@@ -11,15 +11,18 @@ import numpy as np
 import pytest
 
 from multilift_control import laws
-from multilift_control.controllers import MissionLeader, swing_rest
+from multilift_control.controllers import MissionLeader, swing_period, swing_rest
 from multilift_control.engine import Engine
 from multilift_control.headless import run_headless
 from multilift_control.laws.layout import (CASCADE_SWING_DAMPING, CASCADE_SWING_LIMIT,
                                            CASCADE_SWING_REST, CASCADE_SWING_STIFFNESS,
                                            UAV_STATE_SIZE)
+from multilift_control.laws import cascade as cascade_law
 from multilift_control.laws.swing import swing_feedback
+from multilift_control.mission import MissionPath
 from multilift_control.runtime import uav_states
 from multilift_sim import scenario as scenario_io
+from multilift_sim.scenario import INPUT_SHAPERS
 from multilift_sim.simulation import FormationSimulator, formation_start
 from multilift_sim.statistics import payload_swing
 
@@ -160,3 +163,98 @@ def test_a_released_swing_dies_faster_than_under_the_seed_s_law():
         swings.append(float(np.sqrt(np.mean(swing ** 2))))
     assert swings[0] > 5e-3  # the seed's law leaves a swing to damp
     assert swings[1] < 0.7 * swings[0], swings
+
+
+def _one_leg(tau: float) -> scenario_io.MissionConfig:
+    """0.5 m/s along x for 20 s, then 0.5 m/s along y for 20 s, then the stop."""
+    return scenario_io.MissionConfig(
+        start=(0.0, 0.0, 0.0), reference_filter_time=tau,
+        segments=(scenario_io.MissionSegment(velocity=(0.5, 0.0, 0.0), end_time=20.0),
+                  scenario_io.MissionSegment(velocity=(0.0, 0.5, 0.0), end_time=40.0)))
+
+
+def _residual_swing(path: MissionPath, omega: float, t_end: float) -> float:
+    """The amplitude [m] a pendulum of frequency omega [rad/s] hung from the reference's x keeps
+    after t_end [s]: x_p_ddot = -omega^2 (x_p - x_ref(t)), from rest under the start,
+    integrated independently of the shaper (scipy, 1 ms steps at most)."""
+    from scipy.integrate import solve_ivp
+
+    def rates(t, y):
+        return [y[1], -omega ** 2 * (y[0] - path(t).position[0])]
+
+    solution = solve_ivp(rates, (0.0, t_end), [0.0, 0.0], max_step=1e-3, rtol=1e-10,
+                         atol=1e-12)
+    x_p, v_p = solution.y[:, -1]
+    reference = path(t_end)
+    swing, rate = x_p - reference.position[0], v_p - reference.velocity[0]
+    return float(math.hypot(swing, rate / omega))
+
+
+@pytest.mark.parametrize('tau', [0.0, 0.5])
+def test_a_shaped_corner_leaves_the_pendulum_it_is_shaped_for_at_rest(tau):
+    """Each shaper of INPUT_SHAPERS at period T: a pendulum of that period hung from the
+    reference keeps (almost) no swing after the corners, where the unshaped corners leave
+    one; raw steps and the filtered path alike."""
+    period = 3.0
+    omega = 2.0 * math.pi / period
+    mission = _one_leg(tau)
+    unshaped = _residual_swing(MissionPath(mission), omega, 38.0)
+    assert unshaped > 1e-3
+    for name, shaper in INPUT_SHAPERS.items():
+        if name == 'none':
+            continue
+        shaped = _residual_swing(MissionPath(mission, shaper, period), omega, 38.0)
+        assert shaped < 1e-3 * unshaped, (name, shaped, unshaped)
+
+
+def test_a_shaped_mission_ends_where_the_mission_ends():
+    mission = _one_leg(2.0)
+    for name, shaper in INPUT_SHAPERS.items():
+        path = MissionPath(mission, shaper, 6.4)
+        final = path(200.0)
+        assert final.position == pytest.approx([10.0, 10.0, 0.0], abs=1e-9), name
+        assert final.velocity == pytest.approx([0.0, 0.0, 0.0], abs=1e-9)
+        assert path(19.0).velocity[:2] == pytest.approx([0.5, 0.0], abs=1e-2)  # settled
+    # the shaper's impulses: the steps at 0, T/2, T, 3T/2 of the velocity, sorted in time
+    steps = MissionPath(mission, INPUT_SHAPERS['zvdd'], 4.0).steps
+    assert list(steps[:4, 0]) == [0.0, 2.0, 4.0, 6.0]
+    assert list(steps[:4, 1]) == [0.0625, 0.1875, 0.1875, 0.0625]
+
+
+def test_the_shaping_period_is_the_hanging_payload_s_pendulum():
+    single = scenario_io.load('single_lift')
+    assert swing_period(single) == pytest.approx(
+        2 * math.pi * math.sqrt(single.uavs[0].cable_length / 9.81), rel=1e-12)
+    twin = scenario_io.load('twin_lift')
+    half = 0.5 * math.hypot(*twin.formation.offsets[0])  # the UAVs 4 m apart, level
+    depth = math.sqrt(twin.uavs[0].cable_length ** 2 - half ** 2)
+    assert swing_period(twin) == pytest.approx(2 * math.pi * math.sqrt(depth / 9.81), rel=1e-9)
+
+
+def test_the_feedback_yields_to_the_rotor_limits():
+    """A share 1, 1/2, 1/4 of m a_s that saturates no rotor is flown; where all three would,
+    the leader flies the seed's command (its integral advanced once either way)."""
+    scenario = _with_feedback('twin_lift', 0.75, 0.25)
+    leader = MissionLeader(scenario, 0)
+    seed = MissionLeader(scenario_io.load('twin_lift'), 0)
+    states = uav_states(FormationSimulator(scenario).snapshot()).array.copy()
+    rest = np.array(formation_start(scenario)[1])
+    law = laws.runnable(cascade_law.leader_update)
+    c, p = leader.cascade, leader.path
+
+    def answer(constants, payload_offset):
+        memory = c.memory.copy()
+        out = law(constants, c.mixer.rows, memory, p.mission, p.segments, p.steps, 0.5, states,
+                  rest + payload_offset, np.zeros(3))
+        return out, memory
+
+    (seed_speeds, seed_saturated, *_), seed_memory = answer(seed.cascade.constants,
+                                                             np.zeros(3))
+    (speeds, saturated, *_), memory = answer(c.constants, np.array([0.02, 0.0, 0.0]))
+    assert not saturated.any() and not np.array_equal(speeds, seed_speeds)
+    assert np.array_equal(memory, seed_memory)
+    wild = c.constants.copy()
+    wild[CASCADE_SWING_STIFFNESS] = 1e4  # every share tilts the UAV past its rotors
+    (speeds, saturated, *_), memory = answer(wild, np.array([3.0, 0.0, 0.0]))
+    assert np.array_equal(speeds, seed_speeds) and np.array_equal(saturated, seed_saturated)
+    assert np.array_equal(memory, seed_memory)

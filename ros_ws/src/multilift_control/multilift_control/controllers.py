@@ -6,6 +6,7 @@ tracked (or None).
 """
 from __future__ import annotations
 
+import math
 from typing import Protocol
 
 import numpy as np
@@ -15,7 +16,7 @@ from multilift_control.cascade import (CascadeController, ControlOutput, Formati
                                        balancing_rotor_speed)
 from multilift_control.laws.cascade import leader_update
 from multilift_control.mission import MissionPath, Reference
-from multilift_sim.scenario import CONTROL_MODES, Scenario
+from multilift_sim.scenario import CONTROL_MODES, INPUT_SHAPERS, Scenario
 from multilift_sim.simulation import formation_start
 
 
@@ -56,8 +57,9 @@ class MissionLeader:
         hover_mass = uav.vehicle.mass + scenario.payload.mass / scenario.n_uavs
         self.cascade = CascadeController(uav.vehicle, scenario.control, hover_mass,
                                          scenario.simulation.gravity, swing_rest(scenario))
-        self.path = MissionPath(scenario.mission)
         control = scenario.control
+        self.path = MissionPath(scenario.mission, INPUT_SHAPERS[control.input_shaping],
+                                swing_period(scenario))
         self.swing_feedback = bool(control.swing_stiffness or control.swing_damping)
         self._law = laws.runnable(leader_update)
 
@@ -85,6 +87,19 @@ def swing_rest(scenario: Scenario) -> tuple[float, float]:
     uavs, payload = formation_start(scenario)
     offset = payload - uavs.mean(axis=0)
     return float(offset[0]), float(offset[1])
+
+
+def swing_period(scenario: Scenario) -> float:
+    """The hanging payload's pendulum period 2 pi sqrt(h / g) [s], h its depth below the UAVs'
+    mean position at the formation's hanging rest (one UAV: its cable's length): what
+    `control.payload_feedback.input_shaping` shapes the mission's corners for. For two UAVs it
+    is the swing across their line (along it the cables hold the payload to the UAVs)."""
+    if scenario.n_uavs == 1:
+        depth = scenario.uavs[0].cable_length
+    else:
+        uavs, payload = formation_start(scenario)
+        depth = float(uavs.mean(axis=0)[2] - payload[2])
+    return 2.0 * math.pi * math.sqrt(depth / scenario.simulation.gravity)
 
 
 # the leader's controller by `control.mode`: the names are the scenario's registry

@@ -6,7 +6,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from multilift_control import laws
-from multilift_control.laws.layout import (MISSION_FINAL, MISSION_OMEGA, MISSION_SIZE,
+from multilift_control.laws.layout import (MISSION_FINAL, MISSION_OMEGA, MISSION_SHAPED,
+                                           MISSION_SIZE,
                                            MISSION_START, REFERENCE_ACCELERATION,
                                            REFERENCE_POSITION, REFERENCE_VELOCITY,
                                            SEGMENT_END_TIME, SEGMENT_ORIGIN, SEGMENT_SIZE,
@@ -45,10 +46,17 @@ class MissionPath:
     omega^2 x e^(-omega x) peaks at omega dv / e and is continuous, and the position (the
     integral) rounds the corners and ends where the raw path ends. tau = 0: the raw path.
 
+    With a `shaper` ((time [periods], share), ...) of multilift_sim.scenario.INPUT_SHAPERS
+    (`control.payload_feedback.input_shaping`, issue 20; not in the seed) and the pendulum's
+    `period` T [s], each step dv_k becomes share_j dv_k at t_k + time_j T (an input shaper,
+    Singer & Seering 1990): an undamped pendulum of period T driven by the reference's
+    acceleration is left at rest after the last impulse, whatever the filter after it.
+
     `mission`, `segments`, `steps`: the law's arrays (MISSION_*, SEGMENT_*, STEP_* slots).
     """
 
-    def __init__(self, mission: MissionConfig):
+    def __init__(self, mission: MissionConfig,
+                 shaper: tuple[tuple[float, float], ...] = ((0.0, 1.0),), period: float = 0.0):
         tau = float(mission.reference_filter_time)
         start = np.asarray(mission.start, dtype=float)
         ends = np.array([s.end_time for s in mission.segments], dtype=float)
@@ -63,6 +71,7 @@ class MissionPath:
         self.mission[MISSION_FINAL:MISSION_FINAL + 3] = (start + steps.sum(axis=0)
                                                          if len(steps) else start)
         self.mission[MISSION_OMEGA] = 1.0 / tau if tau > 0.0 else 0.0
+        self.mission[MISSION_SHAPED] = 1.0 if len(shaper) > 1 else 0.0
         self.segments = np.empty((len(ends), SEGMENT_SIZE))
         self.segments[:, SEGMENT_START_TIME] = starts
         self.segments[:, SEGMENT_END_TIME] = ends
@@ -75,6 +84,15 @@ class MissionPath:
             self.steps[:, STEP_TIME] = np.append(starts, ends[-1])
             self.steps[:, STEP_DV:STEP_DV + 3] = np.vstack((
                 np.diff(np.vstack((np.zeros((1, 3)), velocities)), axis=0), -velocities[-1]))
+        if len(shaper) > 1 and len(self.steps):  # each step as the shaper's impulses
+            shaped = []
+            for delay, share in shaper:
+                part = self.steps.copy()
+                part[:, STEP_TIME] += delay * period
+                part[:, STEP_DV:STEP_DV + 3] *= share
+                shaped.append(part)
+            shaped = np.vstack(shaped)
+            self.steps = shaped[np.argsort(shaped[:, STEP_TIME], kind='stable')]
         for array in (self.mission, self.segments, self.steps):
             array.flags.writeable = False
         self._law = laws.runnable(mission_reference)

@@ -128,6 +128,11 @@ def _summary(name: str, data: dict, bag: Path | None, scenario) -> None:
                 f'{what} {seed}' for what, seed in sim['seeds'].items()))
         for event in sim.get('events', []):
             lines.append(f'  event at {event["time"]:g} s   {event["description"]}')
+    control = scenario.control
+    if control.input_shaping != 'none' or control.swing_stiffness or control.swing_damping:
+        lines.append(f'  payload feedback {control.input_shaping} shaping of the corners, swing '
+                     f'k_s {control.swing_stiffness:g}, k_d {control.swing_damping:g}, a_max '
+                     f'{control.swing_limit:g} m/s^2 (control.payload_feedback)')
     leader = data.get('leader')
     if leader and leader.get('answered_states'):
         lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} m, '

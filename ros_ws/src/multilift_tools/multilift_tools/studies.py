@@ -1,5 +1,7 @@
 """Numerical studies behind `multilift study NAME`: pure numpy/scipy/matplotlib, no ROS.
 
+swing_feedback (beyond the seed, issue 20): multilift_tools.swing_study.
+
 baumgarte: the seed's Sec. 4.1 study (Fig. 4.2 and 4.3) on the open-loop single-lift swing.
 The formation DAE is integrated with Baumgarte gains alpha_f = beta_f = 0, 20, 100 (Eq. 2.59,
 dynamics.FormationModel) and with the null-space formulation (Eq. 2.71-2.72,
@@ -28,7 +30,7 @@ from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.scenario import Scenario, ScenarioError, load
 from multilift_sim.simulation import initial_state
 
-STUDIES = ('baumgarte',)
+STUDIES = ('baumgarte', 'swing_feedback')  # the second: multilift_tools.swing_study
 DEFAULT_DURATION = 60.0   # [s] the drift of alpha_f = 0 needs time to show (Fig. 4.2)
 DEFAULT_STEP = 0.01       # [s] RK4 step; see baumgarte_study
 RESIDUAL_FLOOR = 1e-18    # [m^2] |g| below this is drawn at this value on the log axis
@@ -225,8 +227,9 @@ class _Parser(argparse.ArgumentParser):
 
 def study_main(argv: list[str] | None = None) -> int:
     """`multilift study NAME [--out DIR] [--duration S] [--dt S] [--scenario S]` (argv without
-    the word 'study'). NAME: baumgarte. Prints the table and writes the files to DIR (default
-    runs/study). Exit 0, or 2 with one line on stderr for bad input."""
+    the word 'study'). NAME: baumgarte, or swing_feedback (multilift_tools.swing_study; it
+    takes --out only). Prints the table and writes the files to DIR (default runs/study).
+    Exit 0, or 2 with one line on stderr for bad input."""
     parser = _Parser(prog='multilift study', description='numerical studies (seed Ch. 4)')
     parser.add_argument('study', choices=STUDIES)
     parser.add_argument('--out', default='runs/study', help='output directory')
@@ -238,8 +241,12 @@ def study_main(argv: list[str] | None = None) -> int:
                         help='a single-lift scenario without drag (default single_lift_swing)')
     try:
         args = parser.parse_args(argv)
-        result = baumgarte_study(args.out, duration=args.duration, dt=args.dt,
-                                 scenario=args.scenario)
+        if args.study == 'swing_feedback':
+            from multilift_tools.swing_study import swing_feedback_study
+            result = swing_feedback_study(args.out)
+        else:
+            result = baumgarte_study(args.out, duration=args.duration, dt=args.dt,
+                                     scenario=args.scenario)
     except (_UsageError, ScenarioError, ValueError) as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2

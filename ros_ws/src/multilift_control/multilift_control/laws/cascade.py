@@ -24,6 +24,10 @@ from multilift_control.laws.reference import mission_reference
 from multilift_control.laws.swing import swing_feedback
 
 
+# the swing feedback's tries at a share 1, 1/2, 1/4 of itself before it yields (leader_update)
+YIELD_STEPS = 3
+
+
 @jit
 def clipped(value, limit):
     """value within [-limit, limit] (NaN stays NaN): np.minimum(np.maximum(value, -limit),
@@ -160,18 +164,25 @@ def cascade_update(constants, mixer, memory, t, state, reference, yaw):
 def leader_update(constants, mixer, memory, mission, segments, steps, t, states,
                   payload_position, payload_velocity):
     """A leader's tick at t [s]: the mission reference (`reference.mission_reference`) tracked
-    by the cascade at heading 0, its acceleration with the swing feedback
-    (`swing.swing_feedback`) added when CASCADE_SWING_STIFFNESS or _DAMPING is not 0. states
-    (n, UAV_STATE_SIZE): every UAV's, the leader's first; payload_position [m],
-    payload_velocity [m/s] (3,), world (read only with the feedback on).
-    Returns (speeds, saturated, setpoint, thrust, reference), the mission's reference."""
+    by the cascade at heading 0. With CASCADE_SWING_STIFFNESS or _DAMPING not 0 the swing
+    feedback (`swing.swing_feedback`) adds m a_s to the position loop's force (as a_s added to
+    the reference's acceleration) unless that asks a rotor beyond its limits: then the force
+    without it goes (the feedback yields to the mission). states (n, UAV_STATE_SIZE): every
+    UAV's, the leader's first; payload_position [m], payload_velocity [m/s] (3,), world (read
+    only with the feedback on). Returns (speeds, saturated, setpoint, thrust, reference)."""
     reference = mission_reference(mission, segments, steps, t)
-    aimed = reference
+    state = states[0]
+    force = position_force(constants, memory, t, state, reference)
     if constants[CASCADE_SWING_STIFFNESS] != 0.0 or constants[CASCADE_SWING_DAMPING] != 0.0:
-        aimed = reference.copy()
         feedback = swing_feedback(constants, states, payload_position, payload_velocity)
-        for axis in range(3):
-            aimed[REFERENCE_ACCELERATION + axis] += feedback[axis]
-    speeds, saturated, setpoint, thrust = cascade_update(constants, mixer, memory, t, states[0],
-                                                         aimed, 0.0)
+        share = 1.0
+        for _ in range(YIELD_STEPS):
+            pushed = force.copy()
+            for axis in range(2):
+                pushed[axis] += share * constants[CASCADE_HOVER_MASS] * feedback[axis]
+            speeds, saturated, setpoint, thrust = command(constants, mixer, state, pushed, 0.0)
+            if not saturated.any():
+                return speeds, saturated, setpoint, thrust, reference
+            share *= 0.5
+    speeds, saturated, setpoint, thrust = command(constants, mixer, state, force, 0.0)
     return speeds, saturated, setpoint, thrust, reference

@@ -26,7 +26,8 @@ REFERENCE_SIZE = 9
 MISSION_START = 0   # (3) position at t = 0 [m]
 MISSION_FINAL = 3   # (3) position after the last segment [m]
 MISSION_OMEGA = 6   # 1 / tau of the reference prefilter [1/s]; 0: the raw path
-MISSION_SIZE = 7
+MISSION_SHAPED = 7  # 1: the steps are an input shaper's (control.payload_feedback); 0: not
+MISSION_SIZE = 8
 # the mission's segments, a row each (segments, SEGMENT_SIZE)
 SEGMENT_START_TIME = 0  # [s]
 SEGMENT_END_TIME = 1    # [s]

@@ -5,7 +5,8 @@ import math
 import numpy as np
 
 from multilift_control.laws import jit
-from multilift_control.laws.layout import (MISSION_FINAL, MISSION_OMEGA, MISSION_START,
+from multilift_control.laws.layout import (MISSION_FINAL, MISSION_OMEGA, MISSION_SHAPED,
+                                           MISSION_START,
                                            REFERENCE_ACCELERATION, REFERENCE_POSITION,
                                            REFERENCE_SIZE, REFERENCE_VELOCITY,
                                            SEGMENT_END_TIME, SEGMENT_ORIGIN, SEGMENT_START_TIME,
@@ -46,10 +47,12 @@ def mission_reference(mission, segments, steps, t):
     [m/s^2], world. With MISSION_OMEGA = omega = 1/tau > 0 each horizontal velocity step dv_k
     at t_k (`steps`, (k, STEP_SIZE)) passes a critically damped second-order filter, in closed
     form: v(t) = sum_k dv_k s(t - t_k), s(x) = 1 - (1 + omega x) e^(-omega x); the position is
-    its integral, the acceleration omega^2 x e^(-omega x) dv_k. omega = 0: `raw_reference`."""
+    its integral, the acceleration omega^2 x e^(-omega x) dv_k. omega = 0: `raw_reference`, or
+    with MISSION_SHAPED the shaped steps unfiltered, s(x) = 1 (the acceleration their
+    impulses, 0 between them)."""
     out = raw_reference(mission, segments, t, np.empty(REFERENCE_SIZE))
     omega = mission[MISSION_OMEGA]
-    if omega == 0.0:
+    if omega == 0.0 and mission[MISSION_SHAPED] == 0.0:
         return out
     # horizontal only: the vertical steps (the climb of §4.2) need collective thrust, not
     # tilt, and stay raw, so the follower's climb lag of Fig. 4.7 stays the seed's
@@ -61,10 +64,13 @@ def mission_reference(mission, segments, steps, t):
         x = t - steps[k, STEP_TIME]
         if x <= 0.0:
             break
-        decay = math.exp(-omega * x)
-        moved = x - (2.0 - (2.0 + omega * x) * decay) / omega
-        gained = 1.0 - (1.0 + omega * x) * decay
-        pushed = omega * omega * x * decay
+        if omega == 0.0:  # shaped raw steps
+            moved, gained, pushed = x, 1.0, 0.0
+        else:
+            decay = math.exp(-omega * x)
+            moved = x - (2.0 - (2.0 + omega * x) * decay) / omega
+            gained = 1.0 - (1.0 + omega * x) * decay
+            pushed = omega * omega * x * decay
         for axis in range(2):
             dv = steps[k, STEP_DV + axis]
             out[REFERENCE_POSITION + axis] += dv * moved

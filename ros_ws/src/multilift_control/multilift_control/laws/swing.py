@@ -1,20 +1,25 @@
-"""Swing damping (`control.payload_feedback`, issue 20 item 5; not in the seed, which names a
-payload-based controller that reduces the pendulum oscillations as what comes next, §5.2).
+"""The leader's swing feedback (`control.payload_feedback`, issue 20 item 5; not in the seed,
+which names a payload-based controller that reduces the pendulum oscillations as what comes
+next, §5.2). Its other half, the mission's corners shaped at the payload's pendulum period, is
+the reference's (`multilift_control.mission.MissionPath`, multilift_sim.scenario.INPUT_SHAPERS):
+the shaping leaves no swing after a corner, this feedback damps what else swings the payload
+(a release, a gust, a turn the shaper did not foresee).
 
-The payload hangs from the formation as a pendulum of length l: its horizontal offset s from
-its rest place under the UAVs obeys, for small swings and a formation that moves as one with
-acceleration a_c, s_ddot = -(g / l) s - a_c (cf. the reduced model of seed §2.8.2). The leader
-adds
+The payload hangs from the formation as a pendulum: for small swings its horizontal offset s
+from its rest place under the UAVs obeys s_ddot = -(g / h) s - a_c (h its depth below them, a_c
+the formation's acceleration; cf. the reduced model of seed §2.8.2). The leader adds
 
-    a_s = k_s (v_p - v_f)_xy,      v_f = (1/n) sum_i v_i       (the formation's velocity),
+    a_s = k_s (s - s_0) + k_d s_dot,   s = (r_p - r_f)_xy,  s_dot = (v_p - v_f)_xy,
 
-to its reference's acceleration; the followers keep their virtual constraints (Eq. 3.8-3.12)
-and so accelerate with it, and s_dot = (v_p - v_f)_xy gives s_ddot + k_s s_dot + (g / l) s = 0:
-the suspension point chases the swing, as a crane's trolley does, and the swing loses the
-energy k_s |s_dot|^2 per unit mass. The leader's position loop pulls it back to its reference
-meanwhile (the two share the corner's transient); k_s 2 sqrt(g / l) would be critical damping
-of the pendulum alone. The payload's velocity is what the simulator's snapshot carries (its
-state, not a sensor's). Vertical: nothing (the cables hold the payload's height).
+r_f, v_f the UAVs' mean position and velocity and s_0 the value of s at the hanging rest, its
+size limited to a_max with its direction kept, to the position loop's acceleration
+(`cascade.leader_update`); the followers keep their virtual constraints (Eq. 3.8-3.12) and so
+move with it. Against the leader's position loop (a PID whose bandwidth is near the pendulum's
+on the twin-lift) the damping comes from the two together, not from k_d alone: the gains the
+study flies (k_s > 0, k_d < 0, multilift_tools.swing_study) were found by sweeping flights;
+the textbook law, k_d > 0 alone, swings the twin-lift's payload more than the seed's law
+(docs/reproduction.md, the study's rows). The payload's state is
+what the simulator's snapshot carries (its state, not a sensor's). Vertical: nothing.
 
 World frame z up, SI units; states (n, UAV_STATE_SIZE) as the laws' layout names them.
 """
@@ -24,8 +29,8 @@ import numpy as np
 
 from multilift_control.laws import jit
 from multilift_control.laws.layout import (CASCADE_SWING_DAMPING, CASCADE_SWING_LIMIT,
-                                           CASCADE_SWING_REST, CASCADE_SWING_STIFFNESS, UAV_POSITION,
-                                           UAV_VELOCITY)
+                                           CASCADE_SWING_REST, CASCADE_SWING_STIFFNESS,
+                                           UAV_POSITION, UAV_VELOCITY)
 
 
 @jit
@@ -52,4 +57,3 @@ def swing_feedback(constants, states, payload_position, payload_velocity):
         out[0] *= constants[CASCADE_SWING_LIMIT] / size
         out[1] *= constants[CASCADE_SWING_LIMIT] / size
     return out
-

@@ -16,8 +16,8 @@ from multilift_sim.topics import FORMATION_SNAPSHOT as SNAPSHOT_TOPIC  # noqa: F
 class SnapshotReader:
     """`/formation/snapshot` as it arrives (CDR bytes: the nodes subscribe with raw=True, which
     spares rclpy's message objects) -> (t [ns], every UAV's state at t from the leader on with
-    the payload's position and velocity, the rotor speeds applied up to t per UAV (empty at t = 0)), for the
-    formation of `scenario`."""
+    the payload's position and velocity, the rotor speeds applied up to t per UAV (empty at
+    t = 0)), for the formation of `scenario`."""
 
     def __init__(self, scenario: Scenario) -> None:
         counts = [u.vehicle.n_rotors for u in scenario.uavs]

@@ -9,7 +9,8 @@ The package: `config` (the dataclasses), `reading` (a mapping read with checks),
 imported from here: `from multilift_sim import scenario as scenario_io; scenario_io.load(...)`.
 """
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES,  # noqa: F401
-                                           FORMATION_GEOMETRIES, ControlConfig, EventConfig,
+                                           FORMATION_GEOMETRIES, INPUT_SHAPERS,
+                                           ControlConfig, EventConfig,
                                            FormationConfig, MissionConfig, MissionSegment,
                                            PayloadConfig, Scenario, ScenarioError, SensorConfig,
                                            SimulationConfig, TurbulenceConfig, UavConfig)

@@ -19,6 +19,14 @@ class ScenarioError(ValueError):
 
 CONTROL_MODES = ('cascade', 'constant_rotor_speed')
 CABLE_MODELS = ('rigid', 'slack')  # the seed's two-way rod; pulls only (multilift_sim.slack)
+# `control.payload_feedback.input_shaping` (issue 20, not in the seed): each velocity step of the
+# mission split into impulses (time in periods T of the payload's pendulum, share of the step);
+# zero residual swing of an undamped pendulum of period T: zv (Singer & Seering 1990), zvd
+# (also robust to a misjudged T; twice as long, half the acceleration)
+INPUT_SHAPERS = {'none': ((0.0, 1.0),),
+                 'zv': ((0.0, 0.5), (0.5, 0.5)),
+                 'zvd': ((0.0, 0.25), (0.5, 0.5), (1.0, 0.25)),
+                 'zvdd': ((0.0, 0.125), (0.5, 0.375), (1.0, 0.375), (1.5, 0.125))}
 
 
 @dataclass(frozen=True)
@@ -101,6 +109,9 @@ class ControlConfig:
     swing_stiffness: float = 0.0     # k_s [1/s^2]
     swing_damping: float = 0.0       # k_d [1/s]
     swing_limit: float = math.inf    # a_max: the largest |a_s| [m/s^2]
+    # the mission's corners passed through one of INPUT_SHAPERS at the hanging payload's
+    # pendulum period (multilift_control.mission.MissionPath); 'none' = the seed's corners
+    input_shaping: str = 'none'
 
 
 @dataclass(frozen=True)

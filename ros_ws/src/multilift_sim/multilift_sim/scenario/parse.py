@@ -15,6 +15,7 @@ from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_
                                          solid_inertia)
 from multilift_sim.physics.layout import EVENT_KINDS, SENSED_QUANTITIES
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
+                                           INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
                                            MissionConfig, MissionSegment, PayloadConfig,
                                            Scenario, ScenarioError, SensorConfig,
@@ -225,8 +226,10 @@ def scenario_of(data: Any, where: str) -> Scenario:
 
 def _payload_feedback(c: Section, mode: str) -> dict[str, float]:
     """`control.payload_feedback` (issue 20; not in the seed): the leader's swing feedback
-    gains swing_stiffness k_s [1/s^2] and swing_damping k_d [1/s]
-    (multilift_control.laws.swing), both 0 (the default) the seed's law."""
+    gains swing_stiffness k_s [1/s^2] and swing_damping k_d [1/s] with its acceleration_limit
+    [m/s^2] (multilift_control.laws.swing), and input_shaping (the mission's corners shaped at
+    the payload's pendulum period, multilift_control.mission); all off (the default) the seed's
+    law."""
     feedback = c.section('payload_feedback', {})
     gains = {name: feedback.number(name, 0.0) for name in ('swing_stiffness', 'swing_damping')}
     for name, gain in gains.items():
@@ -235,8 +238,12 @@ def _payload_feedback(c: Section, mode: str) -> dict[str, float]:
                                 f'tracks the mission), not {mode!r}')
     gains['swing_limit'] = (feedback.positive('acceleration_limit')
                             if feedback.has('acceleration_limit') else math.inf)
+    shaping = feedback.text('input_shaping', 'none', choices=tuple(INPUT_SHAPERS))
+    if shaping != 'none' and mode != 'cascade':
+        raise feedback.fail('input_shaping', shaping, f'needs control.mode: cascade, not '
+                            f'{mode!r}')
     feedback.done()
-    return gains
+    return {**gains, 'input_shaping': shaping}
 
 
 def _rigid_body(p: Section, payload: PayloadConfig, n: int) -> PayloadConfig:

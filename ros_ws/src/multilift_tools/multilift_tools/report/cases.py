@@ -24,7 +24,7 @@ from multilift_tools.report.seed import MULTI, SWING, TWIN
 from multilift_tools.report.single_lift import single_lift_table
 
 CASES = ('twin_lift', 'multi_lift', 'multi_lift_still_air', 'single_lift_table',
-         'single_lift_swing', 'modal')
+         'single_lift_swing', 'modal', 'swing_feedback')
 
 
 class _ProgressFile:
@@ -114,6 +114,26 @@ def _table_case(study_dir: Path, progress: _ProgressFile) -> dict:
     return {'rows': rows}
 
 
+def _swing_feedback_case(study_dir: Path, figure_dir: Path, progress: _ProgressFile) -> dict:
+    """Beyond the seed (issue 20): `multilift study swing_feedback` written to `study_dir`, its
+    figures copied to `figure_dir` as swing_feedback_<mission>.png."""
+    from multilift_control.controllers import swing_period
+    from multilift_tools.swing_study import swing_feedback_study
+
+    progress(0, 1)
+    study = swing_feedback_study(study_dir)
+    figure_dir.mkdir(parents=True, exist_ok=True)
+    figures = []
+    for mission in study['rows']:
+        source = Path(study['files'][mission])
+        shutil.copyfile(source, figure_dir / source.name)
+        figures.append(source.name)
+    progress(1, 1)
+    periods = {mission: swing_period(load(mission)) for mission in study['rows']}
+    return {'table': study['table'], 'rows': study['rows'], 'figures': figures,
+            'periods': periods}
+
+
 def run_case(case: str, work: str, figures: str) -> dict:
     """Run one case of CASES in this process; `work` holds bags and progress files. Returns
     what the report needs (picklable), with 'wall_time' [s]."""
@@ -128,6 +148,8 @@ def run_case(case: str, work: str, figures: str) -> dict:
         result = _table_case(work_dir / 'baumgarte', progress)
     elif case == 'modal':
         result = _modal_case(figure_dir, progress)
+    elif case == 'swing_feedback':
+        result = _swing_feedback_case(work_dir / 'swing_feedback', figure_dir, progress)
     else:
         raise ValueError(f'unknown case {case!r}')
     result['wall_time'] = time.monotonic() - start

@@ -203,4 +203,5 @@ def measure(results: dict[str, dict], work: Path, runs: dict[str, Any],
             'twin_modal': ModalNumbers.from_case(results['modal'][TWIN]),
             'multi_modal': ModalNumbers.from_case(results['modal'][MULTI]),
             'gust_effect': gust_effect(runs[MULTI], results['multi_lift_still_air'],
-                                       multi.gusts)}
+                                       multi.gusts),
+            'swing_feedback': results['swing_feedback']}

@@ -75,12 +75,15 @@ def test_the_equilibrium_of_eq_2_73_is_one(name):
         assert eq.tensions[0] == pytest.approx(params.payload_mass * params.gravity, rel=1e-12)
 
 
-def test_the_twin_lift_rests_at_its_equilibrium_for_seconds():
-    scenario = load('twin_lift')
+@pytest.mark.parametrize('name,steps', [('twin_lift', 400), ('box_lift', 200)])
+def test_the_formation_rests_at_its_equilibrium_for_seconds(name, steps):
+    """Held at its equilibrium's rotor speeds (2 s, or 1 s for the box, at 5 ms), nothing
+    moves: the point payload's and the rigid body's (docs/rigid_payload.md) alike."""
+    scenario = load(name)
     eq = scenario_equilibrium(scenario)
     model = FormationModel(scenario.formation_params())
     x = eq.state
-    for k in range(400):                                         # 2 s at 5 ms
+    for k in range(steps):
         x = model.step(k * 0.005, x, list(eq.rotor_speeds), 0.005)
     assert np.abs(x - eq.state).max() < 1e-9
 

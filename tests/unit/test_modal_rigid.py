@@ -201,16 +201,6 @@ def test_the_rigid_scenarios_equilibrium_is_their_statics(name):
     assert eq.tensions == pytest.approx(expected, rel=1e-12)
 
 
-def test_box_lift_rests_at_its_equilibrium_for_seconds():
-    scenario = load('box_lift')
-    eq = scenario_equilibrium(scenario)
-    model = FormationModel(scenario.formation_params())
-    x = eq.state
-    for k in range(200):                                         # 1 s at 5 ms
-        x = model.step(k * 0.005, x, list(eq.rotor_speeds), 0.005)
-    assert np.abs(x - eq.state).max() < 1e-9
-
-
 @pytest.fixture(scope='module')
 def box_lift():
     return scenario_modal_analysis(load('box_lift'))

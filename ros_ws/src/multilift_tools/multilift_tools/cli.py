@@ -5,7 +5,8 @@
     multilift node PKG EXECUTABLE [args...]
     multilift topic list | echo TOPIC [--once] | info TOPIC
     multilift plot BAG [--out DIR] | animate BAG [--out FILE.gif] | compare BAG_A BAG_B
-    multilift modal SCENARIO [--out DIR] | study baumgarte [--out DIR]
+    multilift modal SCENARIO [--out DIR] [--hold-uavs]
+    multilift study baumgarte|swing_feedback [--out DIR]
     multilift bag info|play|reindex DIR | foxglove [--port P] | sweep | reproduce
 
 Exit codes: 0 done, 1 the run failed, 2 bad input, 130 interrupted.

@@ -123,6 +123,20 @@ def test_a_leader_without_the_payload_state_refuses_to_guess():
     seed.update(0.0, bare)  # the seed's law does not read it
 
 
+def test_a_leader_answers_its_own_state_alone_as_before_the_feedback():
+    """A user's node that reads only /uav1/odom (examples/multilift_example_leader) hands the
+    leader one UavState: answered as the formation of one, the same as the stacked call."""
+    scenario = scenario_io.load('single_lift')
+    states = uav_states(FormationSimulator(scenario).snapshot())
+    alone, stacked = MissionLeader(scenario, 0), MissionLeader(scenario, 0)
+    for t in (0.0, 0.01, 0.02):
+        output, reference = alone.update(t, states[0])
+        expected, expected_reference = stacked.update(t, type(states)(states[:1]))
+        assert np.array_equal(output.rotor_speeds, expected.rotor_speeds)
+        assert np.array_equal(reference.position, expected_reference.position)
+    assert output.rotor_speeds.min() > 0
+
+
 def test_the_leader_node_reads_the_payload_from_the_snapshot():
     pytest.importorskip('rclpy')
     from multilift_control.ros.common import SnapshotReader

@@ -18,7 +18,7 @@ from nav_msgs.msg import Odometry
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 
-from multilift_control.cascade import UavState
+from multilift_control.cascade import FormationStates, UavState
 from multilift_control.controllers import make_controller
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import odometry_arrays
@@ -35,7 +35,10 @@ class ExampleLeader(Node):
 
     def control(self, t: float, msg: Odometry) -> list[float]:
         """Rotor speeds [rad/s] for the state `msg` at simulated time t [s]: your law here."""
-        output, _reference = self.controller.update(t, UavState(*odometry_arrays(msg)))
+        # the formation as this node sees it: its own state alone (no payload state, so the
+        # scenario's control.payload_feedback must be off; /formation/snapshot carries it)
+        states = FormationStates((UavState(*odometry_arrays(msg)),))
+        output, _reference = self.controller.update(t, states)
         return [float(w) for w in output.rotor_speeds]
 
     def on_odometry(self, msg: Odometry) -> None:

@@ -78,8 +78,11 @@ class FormationStates(tuple):
 
     @classmethod
     def of(cls, states) -> FormationStates:
-        """`states` itself when it is one, else its UavStates as one."""
-        return states if isinstance(states, cls) else cls(states)
+        """`states` itself when it is one, a lone UavState as the formation of one (a leader's
+        node that reads only its own odometry), else its UavStates as one."""
+        if isinstance(states, cls):
+            return states
+        return cls((states,)) if isinstance(states, UavState) else cls(states)
 
     @functools.cached_property
     def array(self) -> np.ndarray:

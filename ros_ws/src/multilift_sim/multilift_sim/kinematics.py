@@ -7,8 +7,6 @@ unchanged, in the seed's z-down/FRD frame (see frames.py).
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -41,21 +39,6 @@ def rotation_matrix(eta: ArrayLike) -> np.ndarray:
     rot[..., 2, 1] = c_theta * s_phi
     rot[..., 2, 2] = c_theta * c_phi
     return rot
-
-
-def thrust_axis(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """R(eta) e_z [unit, world], the body z axis along which the rotors push: the third column
-    of `rotation_matrix` for one attitude [rad], in plain floats (the per-tick path)."""
-    return np.array(thrust_axis_floats(roll, pitch, yaw))
-
-
-def thrust_axis_floats(roll: float, pitch: float, yaw: float) -> tuple[float, float, float]:
-    """`thrust_axis` as three floats."""
-    s_phi, c_phi = math.sin(roll), math.cos(roll)
-    s_theta, c_theta = math.sin(pitch), math.cos(pitch)
-    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
-    return (c_psi * s_theta * c_phi + s_psi * s_phi, s_psi * s_theta * c_phi - c_psi * s_phi,
-            c_theta * c_phi)
 
 
 def euler_rate_matrix(eta: ArrayLike) -> np.ndarray:

@@ -100,17 +100,6 @@ def attitude_from_force(force, yaw, max_tilt):
 
 
 @jit
-def thrust_axis(roll, pitch, yaw):
-    """R(eta) e_z (x, y, z) [unit, world]: the body z axis along which the rotors push, the
-    third column of the ZYX rotation (seed Eq. 2.3; multilift_sim.kinematics.thrust_axis)."""
-    s_phi, c_phi = math.sin(roll), math.cos(roll)
-    s_theta, c_theta = math.sin(pitch), math.cos(pitch)
-    s_psi, c_psi = math.sin(yaw), math.cos(yaw)
-    return (c_psi * s_theta * c_phi + s_psi * s_phi, s_psi * s_theta * c_phi - c_psi * s_phi,
-            c_theta * c_phi)
-
-
-@jit
 def attitude_torque(constants, state, setpoint):
     """Body torque [N m] (3,) driving the Euler angles to `setpoint` (roll, pitch, yaw) [rad]:
     PD on each angle, J-scaled, plus the gyroscopic omega x J omega."""

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from multilift_control.laws import jit
-from multilift_control.laws.cascade import clipped, command, elapsed, thrust_axis
+from multilift_control.laws.cascade import clipped, command, elapsed
 from multilift_control.laws.constraints import (free_follower_motions, jacobian,
                                                 jacobian_rate_product, residual, row_rate,
                                                 rows_by_uav)
@@ -28,6 +28,7 @@ from multilift_control.laws.layout import (CASCADE_THRUST_COEFFICIENT,
                                            FOLLOWER_TWO_ALPHA, FOLLOWER_YAW, UAV_EULER,
                                            UAV_POSITION, UAV_VELOCITY)
 from multilift_control.laws.linalg import minimum_norm_solve
+from multilift_sim.physics.free_motion import thrust_axis
 from multilift_control.laws.mixer import collective_thrust
 
 _FREE_TOL = 1e-9  # singular values of the followers' columns that count as zero (relative)

@@ -121,10 +121,10 @@ def uav_free_motion(x, i, wrenches, uavs, formation, acc):
     # Unconstrained translational acceleration: thrust along R e_z (Eq. 2.6, 2.20).
     # Gravity is common to every body (in `solve` it cancels in a_p - a_i; added at the end).
     thrust_per_mass = thrust / mass
-    s_theta_c_phi = s_theta * c_phi
-    thrust_ax = (c_psi * s_theta_c_phi + s_psi * s_phi) * thrust_per_mass
-    thrust_ay = (s_psi * s_theta_c_phi - c_psi * s_phi) * thrust_per_mass
-    thrust_az = c_theta * c_phi * thrust_per_mass
+    axis_x, axis_y, axis_z = thrust_direction(s_phi, c_phi, s_theta, c_theta, s_psi, c_psi)
+    thrust_ax = axis_x * thrust_per_mass
+    thrust_ay = axis_y * thrust_per_mass
+    thrust_az = axis_z * thrust_per_mass
     drag = uavs[i, UAV_DRAG]
     if drag > 0.0:  # the UAV's own drag in the steady wind: -c_d |v_rel| v_rel / m_i
         rel_x = vx - formation[FORMATION_WIND]
@@ -138,21 +138,37 @@ def uav_free_motion(x, i, wrenches, uavs, formation, acc):
 
 
 @jit
+def thrust_direction(s_phi, c_phi, s_theta, c_theta, s_psi, c_psi):
+    """R e_z (x, y, z) [unit, world]: the body z axis along which the rotors push, the third
+    column of R = Rz(psi) Ry(theta) Rx(phi) (Eq. 2.6), from the angles' sines and cosines."""
+    s_theta_c_phi = s_theta * c_phi
+    return (c_psi * s_theta_c_phi + s_psi * s_phi, s_psi * s_theta_c_phi - c_psi * s_phi,
+            c_theta * c_phi)
+
+
+@jit
+def thrust_axis(roll, pitch, yaw):
+    """`thrust_direction` of the Euler angles (roll, pitch, yaw) [rad]."""
+    return thrust_direction(math.sin(roll), math.cos(roll), math.sin(pitch), math.cos(pitch),
+                            math.sin(yaw), math.cos(yaw))
+
+
+@jit
 def uav_rotation(phi, theta, psi):
-    """R_i = Rz(psi) Ry(theta) Rx(phi) (3, 3), body FLU -> world (Eq. 2.6)."""
+    """R_i = Rz(psi) Ry(theta) Rx(phi) (3, 3), body FLU -> world (Eq. 2.6); its third column
+    `thrust_direction`. (kinematics.rotation_matrix: the numpy form over stacks, the tests'
+    oracle.)"""
     s_phi, c_phi = math.sin(phi), math.cos(phi)
     s_theta, c_theta = math.sin(theta), math.cos(theta)
     s_psi, c_psi = math.sin(psi), math.cos(psi)
     r = np.empty((3, 3))
     r[0, 0] = c_psi * c_theta
     r[0, 1] = c_psi * s_theta * s_phi - s_psi * c_phi
-    r[0, 2] = c_psi * s_theta * c_phi + s_psi * s_phi
     r[1, 0] = s_psi * c_theta
     r[1, 1] = s_psi * s_theta * s_phi + c_psi * c_phi
-    r[1, 2] = s_psi * s_theta * c_phi - c_psi * s_phi
     r[2, 0] = -s_theta
     r[2, 1] = c_theta * s_phi
-    r[2, 2] = c_theta * c_phi
+    r[0, 2], r[1, 2], r[2, 2] = thrust_direction(s_phi, c_phi, s_theta, c_theta, s_psi, c_psi)
     return r
 
 

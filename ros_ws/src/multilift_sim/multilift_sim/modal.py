@@ -51,9 +51,22 @@ c_i = b_i x R_p^T d_i (n >= 7, or cables through one point: least-norm), G the c
 ``dg_i/dtheta = 2 c_i`` (U_i = 2 (d_i, c_i) of the docs), M the principal inertia J_p. The
 hanging rest is the simulator's start (simulation.formation_start: level, the identity).
 
+Cables held off the UAVs' centres (uavs[i].attach_point, a_i body FLU; docs/rigid_payload.md):
+cable i starts at s_i = r_i + R_i a_i, so d_i = r_p (+ R_p b_i) - r_i - R_i a_i. The given UAV
+positions place each s_i where it would be with the UAV level at its yaw, s_i = r_i +
+Rz(psi_i) a_i (simulation.formation_start's convention: the simulator starts the UAVs level
+there); the cables' geometry is then fixed, so the payload rows give Lambda as above. Each UAV
+tilts to point its thrust along m_i g e_z - F_c,i (F_c,i = 2 lambda_i d_i, the cable's pull on
+it), its centre then moves to r_i = s_i - R_i a_i at that attitude (s_i stays put), and its
+rotors also cancel the pull's moment about the centre: the attitude rows read
+0 = W^T (tau_i + a_i x R_i^T F_c,i), so tau_i = -a_i x R_i^T F_c,i (body FLU; the DAE's
+2 lambda_i k_i, physics/free_motion.py cable_moment_arm, with the sign reversed). G gains the
+columns of the UAVs' Euler angles, dg_i/deta_i = -2 d_i . d(R_i a_i)/deta_i (= -2 W_i^T k_i,
+k_i = a_i x R_i^T d_i), so that T^T G^T = 0 still removes the multipliers of the DAE (which
+turns the UAV by J_i^-1 2 lambda_i k_i). Attach points all zero are the seed's case exactly.
+
 Payload drag and gusts do not enter: the quadratic drag has zero slope at zero air speed, and
-the analysis is of the formation in still air. Cables held off a UAV's centre
-(uavs[i].attach_point) are not analysed yet (ValueError).
+the analysis is of the formation in still air.
 """
 from __future__ import annotations
 
@@ -69,11 +82,12 @@ from numpy.typing import ArrayLike
 from multilift_sim.constraints import cable_residuals, cable_tension, constraint_jacobian
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
+from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.multirotor import euler_mass_matrix
 from multilift_sim.physics.layout import PAYLOAD_BODY_RATES, UAV_COORDINATES
 from multilift_sim.physics.rigid_payload import payload_rotation
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import formation_start
+from multilift_sim.simulation import formation_start, uav_offsets
 
 MODE_KINDS = ('pendulum', 'oscillatory', 'unstable', 'damped', 'rigid')
 ROTATION_NAMES = ('rx_p', 'ry_p', 'rz_p')  # a rigid payload's rotation vector, payload frame
@@ -97,12 +111,38 @@ def _quaternion_rotation(quaternion: ArrayLike) -> np.ndarray:
 
 
 def _cable_offsets(params: FormationParams, uavs: np.ndarray, payload: np.ndarray,
-                   rotation: np.ndarray | None) -> np.ndarray:
+                   rotation: np.ndarray | None, uav_euler: np.ndarray | None = None
+                   ) -> np.ndarray:
     """d_i (n, 3) [m], world: from UAV i's centre to where cable i holds the payload, r_p - r_i
-    (a point payload) or r_p + R_p b_i - r_i (a rigid body of attitude `rotation`)."""
+    (a point payload) or r_p + R_p b_i - r_i (a rigid body of attitude `rotation`); with
+    attach points a_i (params.uav_attach_points) and the UAVs' Euler angles `uav_euler`
+    (n, 3), from r_i + R_i a_i instead."""
     if not params.rigid_payload:
-        return payload - uavs
-    return payload + np.asarray(params.payload_attach_points) @ rotation.T - uavs
+        offsets = payload - uavs
+    else:
+        offsets = payload + np.asarray(params.payload_attach_points) @ rotation.T - uavs
+    if params.uav_attach_points is not None and uav_euler is not None:
+        offsets = offsets - _attach_offsets(params, uav_euler)
+    return offsets
+
+
+def _attach_offsets(params: FormationParams, uav_euler: np.ndarray) -> np.ndarray:
+    """o_i = R_i a_i (n, 3) [m], world: each cable's upper end from its UAV's centre."""
+    attach = np.asarray(params.uav_attach_points, dtype=float)
+    return np.einsum('ijk,ik->ij', rotation_matrix(np.asarray(uav_euler, dtype=float)), attach)
+
+
+def _attach_derivatives(euler: np.ndarray, attach: np.ndarray) -> np.ndarray:
+    """d(R a)/d(phi, theta, psi) (3, 3) [m/rad], columns, of R = Rz(psi) Ry(theta) Rx(phi):
+    R (e_x x a), Rz Ry (e_y x Rx a), e_z x R a."""
+    phi, theta, psi = (float(v) for v in euler)
+    r_x = rotation_matrix([phi, 0.0, 0.0])
+    r_y = rotation_matrix([0.0, theta, 0.0])
+    r_z = rotation_matrix([0.0, 0.0, psi])
+    rotation = r_z @ r_y @ r_x
+    return np.column_stack((rotation @ np.cross([1.0, 0.0, 0.0], attach),
+                            r_z @ r_y @ np.cross([0.0, 1.0, 0.0], r_x @ attach),
+                            np.cross([0.0, 0.0, 1.0], rotation @ attach)))
 
 
 def _cable_moments(params: FormationParams, offsets: np.ndarray,
@@ -126,16 +166,21 @@ def static_equilibrium(params: FormationParams, uav_positions: ArrayLike,
     manifold (every cable at its length); yaws (n,) [rad], default 0; a rigid payload's
     attitude payload_quaternion (w, x, y, z), payload frame -> world, default the identity.
     Solves Eq. 2.73 as the module docstring says (a rigid body: its force and moment rows).
+    Cables held off the UAVs' centres (params.uav_attach_points a_i): uav_positions are where
+    the centres would be with the UAVs level at their yaws, the cables starting at
+    r_i + Rz(psi_i) a_i; the returned state has each UAV tilted about that point (centre
+    s_i - R_i a_i) and the rotors' torque cancelling the cable's moment (module docstring).
     Raises ValueError naming the cable or UAV when the payload cannot hang at rest there, a
     cable would be slack, or a rotor would leave its speed limits.
     """
     n = params.n_uavs
-    if params.uav_attach_points is not None:
-        raise ValueError('cables held off the UAVs\' centres (uavs[i].attach_point): their '
-                         'equilibrium and modes are not analysed yet (multilift_sim.modal)')
     uavs = np.asarray(uav_positions, dtype=float).reshape(n, 3)
     payload = np.asarray(payload_position, dtype=float).reshape(3)
     yaws = np.zeros(n) if yaws is None else np.asarray(yaws, dtype=float).reshape(n)
+    attach = (None if params.uav_attach_points is None
+              else np.asarray(params.uav_attach_points, dtype=float).reshape(n, 3))
+    if attach is not None:  # the cables' upper ends s_i, the UAVs level at their yaws
+        uavs = uavs + _attach_offsets(params, np.column_stack((np.zeros((n, 2)), yaws)))
     quaternion = np.array([1.0, 0.0, 0.0, 0.0] if payload_quaternion is None
                           else payload_quaternion, dtype=float)
     rotation = _quaternion_rotation(quaternion) if params.rigid_payload else None
@@ -189,15 +234,22 @@ def static_equilibrium(params: FormationParams, uav_positions: ArrayLike,
         a = (c_psi * force[0] + s_psi * force[1]) / thrust
         b = (-s_psi * force[0] + c_psi * force[1]) / thrust
         euler[i] = math.asin(-b), math.atan2(a, force[2] / thrust), yaws[i]
+        torque = np.zeros(3)
+        if attach is not None:  # the rotors cancel the pull's moment about the centre
+            pull = 2.0 * multipliers[i] * offsets[i]
+            torque = -np.cross(attach[i], rotation_matrix(euler[i]).T @ pull)
         allocator = uav.allocator()
-        speeds, saturated = allocator.rotor_speeds([thrust, 0.0, 0.0, 0.0],
+        speeds, saturated = allocator.rotor_speeds([thrust, *torque],
                                                    uav.rotor_speed_min, uav.rotor_speed_max)
         if np.any(saturated):
-            raise ValueError(f'uav{i + 1}: the equilibrium thrust {thrust:.2f} N needs rotor '
-                             f'speeds outside [{uav.rotor_speed_min:g}, '
+            moment = '' if attach is None else f' and torque {np.linalg.norm(torque):.3g} N m'
+            raise ValueError(f'uav{i + 1}: the equilibrium thrust {thrust:.2f} N{moment} needs '
+                             f'rotor speeds outside [{uav.rotor_speed_min:g}, '
                              f'{uav.rotor_speed_max:g}] rad/s')
         rotor_speeds.append(speeds)
         wrenches[i] = allocator.wrench(speeds)
+    if attach is not None:  # each centre where its tilted UAV holds s_i
+        uavs = uavs - _attach_offsets(params, euler)
     if params.rigid_payload:
         state = StateLayout(n, True).pack(uavs, euler, payload, payload_quaternion=quaternion)
     else:
@@ -213,11 +265,15 @@ def scenario_configuration(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     release angles of payload.alpha_deg/beta_deg are an initial condition, not the
     equilibrium). n >= 2: simulation.formation_start (the payload under the UAVs' horizontal
     centroid, where equal multipliers balance it; a rigid body level, its centre under the
-    centroid of r_i - b_i), without the payload.swing_deg release.
+    centroid of r_i - b_i), without the payload.swing_deg release. Cables held off the UAVs'
+    centres (uavs[i].attach_point): the UAVs level at their yaws, each cable from
+    r_i + Rz(psi_i) a_i (simulation.uav_offsets), as static_equilibrium reads them.
     """
     if scenario.n_uavs == 1:
         uav = np.array([scenario.uavs[0].position], dtype=float)
-        return uav, uav[0] - np.array([0.0, 0.0, scenario.uavs[0].cable_length])
+        offsets = uav_offsets(scenario)         # a cable held off the level UAV's centre
+        end = uav[0] if offsets is None else uav[0] + offsets[0]
+        return uav, end - np.array([0.0, 0.0, scenario.uavs[0].cable_length])
     return formation_start(scenario)
 
 
@@ -256,29 +312,39 @@ def mass_matrix(params: FormationParams, uav_euler: ArrayLike) -> np.ndarray:
 def formation_jacobian(params: FormationParams, x: np.ndarray) -> np.ndarray:
     """G [m] (n, 6n + 3) at state x (Eq. 2.65-2.67, constraints.constraint_jacobian); a rigid
     payload's (n, 6n + 6) with the columns dg_i/dtheta = 2 c_i [m^2] of its rotation vector
-    (R_p = R Exp(theta), c_i = b_i x R^T d_i at x's attitude R; docs/rigid_payload.md)."""
+    (R_p = R Exp(theta), c_i = b_i x R^T d_i at x's attitude R; docs/rigid_payload.md).
+    Cables held off the UAVs' centres: d_i from r_i + R_i a_i, and the UAVs' Euler columns
+    dg_i/deta_i = -2 d_i . d(R_i a_i)/deta_i [m^2/rad] (module docstring)."""
     layout = StateLayout(params.n_uavs, params.rigid_payload)
     uavs, payload = layout.uav_positions(x), layout.payload_position(x)
-    if not params.rigid_payload:
+    attached = params.uav_attach_points is not None
+    if not params.rigid_payload and not attached:
         return constraint_jacobian(uavs, payload)
     n = params.n_uavs
     rotation = _state_rotation(layout, x)
-    offsets = _cable_offsets(params, uavs, payload, rotation)
-    jacobian = np.zeros((n, 6 * n + 6))
+    euler = layout.uav_euler(x)
+    offsets = _cable_offsets(params, uavs, payload, rotation, euler)
+    jacobian = np.zeros((n, 6 * n + (6 if params.rigid_payload else 3)))
     for i in range(n):
         jacobian[i, 6 * i:6 * i + 3] = -2.0 * offsets[i]
         jacobian[i, 6 * n:6 * n + 3] = 2.0 * offsets[i]
-    jacobian[:, 6 * n + 3:] = 2.0 * _cable_moments(params, offsets, rotation)
+        if attached:
+            jacobian[i, 6 * i + 3:6 * i + 6] = -2.0 * offsets[i] @ _attach_derivatives(
+                euler[i], np.asarray(params.uav_attach_points[i], dtype=float))
+    if params.rigid_payload:
+        jacobian[:, 6 * n + 3:] = 2.0 * _cable_moments(params, offsets, rotation)
     return jacobian
 
 
 def formation_residuals(params: FormationParams, x: np.ndarray) -> np.ndarray:
-    """g_i = |d_i|^2 - l_i^2 [m^2] (n,) at state x (Eq. 2.42; a rigid payload's d_i)."""
+    """g_i = |d_i|^2 - l_i^2 [m^2] (n,) at state x (Eq. 2.42; a rigid payload's d_i, and from
+    the UAVs' attach points r_i + R_i a_i when params.uav_attach_points)."""
     layout = StateLayout(params.n_uavs, params.rigid_payload)
     uavs, payload = layout.uav_positions(x), layout.payload_position(x)
-    if not params.rigid_payload:
+    if not params.rigid_payload and params.uav_attach_points is None:
         return cable_residuals(uavs, payload, params.cable_lengths)
-    offsets = _cable_offsets(params, uavs, payload, _state_rotation(layout, x))
+    offsets = _cable_offsets(params, uavs, payload, _state_rotation(layout, x),
+                             layout.uav_euler(x))
     return np.einsum('ij,ij->i', offsets, offsets) - np.asarray(params.cable_lengths) ** 2
 
 

@@ -45,12 +45,12 @@ def test_loading_the_kernel_leaves_scipy_and_coverage_unimported_and_importable(
 
 def test_setup_filled_numba_s_cache_so_a_new_process_loads_and_does_not_compile():
     """scripts/setup compiled the kernels into numba's on-disk cache (the supported way that
-    replaced pycc: multilift_sim.kernels): a new process's tick and engine step load them."""
+    replaced pycc: multilift_sim.kernels): a new process's tick (the simulator's
+    physics.tick.advance) and engine step load them."""
     out = _a_tick_in_a_new_process(
         'auto', 'from multilift_control.engine import Engine\n'
                 'from multilift_control.engine.tick import run_ticks\n'
-                'law = kernels.compiled_module("multilift_sim.physics.actuators")'
-                '.actuated_period\n'
+                'law = kernels.compiled_module("multilift_sim.physics.tick").advance\n'
                 'engine = Engine(scenario.load("twin_lift"))\n'
                 'engine.step(3)\n'
                 'print(kernels.enabled(), sim.t > 0, engine.memory.tick[0],\n'

@@ -13,8 +13,9 @@ import pytest
 from multilift_sim import kernels
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                       TrackingStatistics, accumulators, figures, swing)
-from multilift_sim.statistics.layout import (CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK,
-                                             PEAK_SIZE, RUN_SWING, run_size)
+from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
+                                             CHECK_NON_FINITE, CHECK_OK, PEAK_SIZE,
+                                             PITCH_LIMIT, RUN_SWING, run_size)
 
 pytest.importorskip('numba')
 
@@ -148,23 +149,29 @@ def test_the_check_compiled_and_uncompiled_agree(n):
     uavs, lengths = _formation(rng, n)
     state = rng.normal(size=2 * (6 * n + 3))
     state[:6 * n].reshape(n, 6)[:, :3] = uavs
+    state[:6 * n].reshape(n, 6)[:, 3:] = rng.normal(0.0, 0.3, (n, 3))  # attitudes a UAV flies
     state[6 * n:6 * n + 3] = uavs.mean(axis=0) - [0.0, 0.0, 1.0]
     seen = set()
-    for tick in range(40):
+    for tick in range(80):
         run = _accumulators(rng, n)
         g = rng.normal(0.0, 2e-3 if tick % 2 else 1e-4, n)
         g_dot = rng.normal(0.0, 1e-2, n)
         taut = rng.random(n) < 0.8
         x = state.copy()
+        tumbling = int(rng.integers(n))
         if tick % 7 == 6:
             x[rng.integers(len(x))] = rng.choice([math.nan, math.inf])
+        elif tick % 11 == 10:  # a UAV pitched past the Euler angles' limit, either side
+            x[6 * tumbling + 4] = rng.choice([-1.0, 1.0]) * rng.uniform(PITCH_LIMIT + 1e-6, 3.1)
         status, cable = _same(accumulators.run_check, run, x, g, g_dot, taut, 2e-3, 2e-2,
                               tick * 0.01, tick, 1 if n <= 2 else 10, lengths)
         seen.add(status)
         if status in (CHECK_G, CHECK_G_DOT):
             values = np.abs(g if status == CHECK_G else g_dot) * taut
             assert cable == int(np.argmax(values))
-    assert seen == {CHECK_OK, CHECK_NON_FINITE, CHECK_G, CHECK_G_DOT}
+        if tick % 11 == 10 and tick % 7 != 6:
+            assert (status, cable) == (CHECK_ATTITUDE, tumbling)
+    assert seen == {CHECK_OK, CHECK_NON_FINITE, CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT}
 
 
 def test_the_classes_read_their_arrays():

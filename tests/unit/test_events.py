@@ -18,7 +18,7 @@ from multilift_control.headless import run_headless
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
 from multilift_sim.physics.events import apply_events
-from multilift_sim.simulation import initial_state
+from multilift_sim.start import initial_state
 from multilift_sim.schedules import event_array
 from multilift_sim.slack import SlackCableModel
 from multilift_sim.dynamics import FormationModel

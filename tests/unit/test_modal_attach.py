@@ -23,7 +23,7 @@ from multilift_sim.modal import (displaced_state, formation_jacobian, formation_
                                  modal_analysis, mode_state, motion_shares,
                                  scenario_equilibrium, scenario_modal_analysis,
                                  static_equilibrium)
-from multilift_sim.simulation import formation_start
+from multilift_sim.start import formation_start
 
 G = 9.81
 BELOW = (0.0, 0.0, -0.1)          # a_i [m], body FLU: 10 cm under the centre of mass

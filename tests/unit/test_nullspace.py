@@ -18,7 +18,7 @@ from multilift_sim.modal import scenario_equilibrium
 from multilift_sim.formulations import make_formulation
 from multilift_sim.nullspace import NullSpaceModel
 from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
-from multilift_sim.simulation import initial_state
+from multilift_sim.start import initial_state
 from multilift_tools.studies import study_main
 
 SWING = str(SCENARIOS / 'single_lift_swing.yaml')
@@ -240,3 +240,45 @@ def test_the_null_space_form_compiled_is_its_source_bit_for_bit(name):
     g, g_dot = model.constraint_residuals(projected[0])
     assert np.abs(g).max() <= 1e-14 * model.cable_lengths.max() ** 2
     assert np.abs(g_dot).max() < 1e-12
+
+
+@pytest.mark.parametrize('name', ['single_lift_swing', 'twin_lift'])
+def test_a_control_period_projects_after_every_step(name):
+    """The one compiled period (physics.formation_dae.integrate_period, through the actuators)
+    projects after each RK4 step in the null-space form: NullSpaceModel.integrate equals its
+    steps taken one by one (RK4, then physics.nullspace.project), to the bit."""
+    scenario = load(name)
+    model = NullSpaceModel(scenario.formation_params())
+    x = initial_state(scenario)
+    speeds = [np.full(u.vehicle.n_rotors, 1500.0) for u in scenario.uavs]
+    period = model.integrate(x, speeds, 0.005, 4)
+    state = x
+    for _ in range(4):
+        state = model.step(0.0, state, speeds, 0.005)
+    assert np.array_equal(period.state, state)
+    assert np.array_equal(period.cable_tension, model.cable_tension(0.0, x, speeds))
+    g, _ = model.constraint_residuals(period.state)
+    assert np.abs(g).max() <= 1e-14 * max(u.cable_length for u in scenario.uavs) ** 2
+    # without the projection the same steps drift off the manifold
+    free = NullSpaceModel(scenario.formation_params(), projection=False)
+    assert not np.array_equal(free.integrate(x, speeds, 0.005, 4).state, period.state)
+
+
+def test_the_engine_flies_the_null_space_form_as_the_simulator_does():
+    """No fallback: `simulation.integrator: nullspace` flies in the engine (sweeps, learning)
+    with the simulator node's bits, |g| held at rounding."""
+    from multilift_control.engine import Engine
+    from multilift_control.headless import run_headless
+    base = load('twin_lift').with_duration(3.0)
+    scenario = dataclasses.replace(base, simulation=dataclasses.replace(
+        base.simulation, integrator='nullspace'))
+    engine = Engine(scenario)
+    engine.step(10 ** 6)
+    run = run_headless(scenario)
+    assert engine.finished[0]
+    assert np.array_equal(engine.state[0], run.simulator.state)
+    assert engine.summary(0)['sim']['max_abs_constraint'] < 1e-10
+    baumgarte = Engine(base)
+    baumgarte.step(10 ** 6)
+    assert np.abs(baumgarte.state[0] - engine.state[0]).max() > 0.0  # another formulation
+    assert np.abs(baumgarte.state[0] - engine.state[0]).max() < 1e-3  # of the same DAE

@@ -18,7 +18,7 @@ from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams
 from multilift_sim.physics.formation_dae import integrate_period, rk4_step, solve
 from multilift_sim.physics.layout import CABLE_COLUMNS, WORK_ROWS
-from multilift_sim.simulation import initial_state
+from multilift_sim.start import initial_state
 
 
 def _vehicle(mass: float | None = None):

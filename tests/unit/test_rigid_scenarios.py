@@ -16,7 +16,7 @@ from multilift_control.headless import fly
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.payload_types import solid_inertia
-from multilift_sim.simulation import initial_state
+from multilift_sim.start import initial_state
 
 
 def _edited(name: str, **payload) -> str:

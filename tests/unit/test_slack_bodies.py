@@ -308,7 +308,7 @@ def test_a_hanging_body_on_taut_slack_cables_flies_as_on_rigid_cables():
     quarter of the box, for 5 s: every cable stays taut, and the slack model's states are
     the rigid model's to 1e-9 m (the same arithmetic: they are equal to the bit)."""
     from multilift_control.headless import hover_speeds
-    from multilift_sim.simulation import initial_state
+    from multilift_sim.start import initial_state
 
     scenario = scenario_io.load('box_lift')
     slack, rigid = SlackCableModel(scenario.formation_params()), FormationModel(

@@ -23,7 +23,8 @@ from multilift_control.mission import MissionPath
 from multilift_control.runtime import uav_states
 from multilift_sim import scenario as scenario_io
 from multilift_sim.scenario import INPUT_SHAPERS
-from multilift_sim.simulation import FormationSimulator, formation_start
+from multilift_sim.simulation import FormationSimulator
+from multilift_sim.start import formation_start
 from multilift_sim.statistics import payload_swing
 
 

@@ -16,7 +16,7 @@ from multilift_control.engine import Engine
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
-from multilift_sim.simulation import initial_state
+from multilift_sim.start import initial_state
 
 WIND = (3.0, -1.0, 0.5)  # [m/s], world
 

@@ -17,7 +17,7 @@ from multilift_control.cascade import (CascadeController, ControlOutput, Formati
 from multilift_control.laws.cascade import leader_update
 from multilift_control.mission import MissionPath, Reference
 from multilift_sim.scenario import CONTROL_MODES, INPUT_SHAPERS, Scenario
-from multilift_sim.simulation import formation_start
+from multilift_sim.start import formation_start
 
 
 class Controller(Protocol):

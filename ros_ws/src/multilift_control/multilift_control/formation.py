@@ -32,7 +32,7 @@ from multilift_control.virtual_constraints import FormationGeometry, VirtualCons
 from multilift_sim import formation_geometry  # the start places, world
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario import ControlConfig
-from multilift_sim.simulation import uav_offsets
+from multilift_sim.start import uav_offsets
 
 OWN_THRUST = ('commanded', 'measured')  # where a follower's u_i comes from (FormationFollower)
 _COND_LIMIT = 1e10  # cond(J M^-1 J^T) above which the linear law takes its pseudo-inverse

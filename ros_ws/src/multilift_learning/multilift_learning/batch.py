@@ -38,7 +38,7 @@ from multilift_control.laws.layout import (UAV_BODY_RATES, UAV_EULER, UAV_POSITI
                                            UAV_VELOCITY)
 from multilift_learning.tasks import Targets, task, task_scenario
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import cable_reach
+from multilift_sim.start import cable_reach
 from multilift_sim.statistics.swing import equilibrium_point
 
 OBSERVATION_PER_UAV = 16

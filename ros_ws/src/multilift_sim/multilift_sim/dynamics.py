@@ -118,6 +118,12 @@ class FormationModel:
         period's unsteady wind: simulation.wind_series)."""
         self._formation[FORMATION_WIND:FORMATION_WIND + 3] = velocity
 
+    def physics_constants(self) -> tuple[np.ndarray, ...]:
+        """(uavs (n, UAV_COLUMNS), gusts (k, GUST_COLUMNS), formation (FORMATION_SCALARS,),
+        allocation (n, 4, rotors), actuators (n, ACTUATOR_COLUMNS)): the constants the
+        compiled tick reads (physics.layout slots), the model's own arrays."""
+        return self._uavs, self._gusts, self._formation, self.allocation, self._actuators
+
     # ------------------------------------------------------------------------- physics
     def _physics_functions(self) -> dict[str, Callable]:
         """The physics functions this model calls, by name (numba dispatchers)."""

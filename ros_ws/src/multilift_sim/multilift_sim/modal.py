@@ -87,7 +87,7 @@ from multilift_sim.multirotor import euler_mass_matrix
 from multilift_sim.physics.layout import PAYLOAD_BODY_RATES, UAV_COORDINATES
 from multilift_sim.physics.rigid_payload import payload_rotation
 from multilift_sim.scenario import Scenario
-from multilift_sim.simulation import formation_start, uav_offsets
+from multilift_sim.start import formation_start, uav_offsets
 
 MODE_KINDS = ('pendulum', 'oscillatory', 'unstable', 'damped', 'rigid')
 ROTATION_NAMES = ('rx_p', 'ry_p', 'rz_p')  # a rigid payload's rotation vector, payload frame

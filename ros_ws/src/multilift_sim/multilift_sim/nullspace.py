@@ -27,6 +27,7 @@ from multilift_sim import kernels
 from multilift_sim.constraints import cable_tension
 from multilift_sim.dynamics import FormationModel, Integration
 from multilift_sim.formation_params import FormationParams
+from multilift_sim.physics.layout import FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE
 from multilift_sim.physics.nullspace import project, translational_masses
 
 
@@ -75,6 +76,10 @@ class NullSpaceModel:
         self.gravity = self.formation.gravity
         self._masses = translational_masses(self.formation._uavs, self.formation._formation)
         self._project = kernels.runnable(project)
+        # the compiled period projects after each RK4 step (physics.formation_dae)
+        if projection:
+            self.formation._formation[FORMATION_PROJECTION_STEPS] = max_newton_steps
+            self.formation._formation[FORMATION_PROJECTION_TOLERANCE] = projection_tolerance
 
     # --------------------------------------------------------------------------- dynamics
     def wrenches(self, rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
@@ -106,13 +111,15 @@ class NullSpaceModel:
 
     def integrate(self, x: np.ndarray, rotor_speeds: Sequence[ArrayLike], dt: float,
                   steps: int) -> Integration:
-        """`steps` projected RK4 steps of dt [s] with the rotor speeds [rad/s] held; the
-        tension is the one at x."""
-        tension = self.cable_tension(0.0, x, rotor_speeds)
-        for _ in range(steps):
-            x = self.step(0.0, x, rotor_speeds, dt)
-        g, g_dot = self.constraint_residuals(x)
-        return Integration(x, tension, g, g_dot)
+        """`steps` projected RK4 steps of dt [s] with the rotor speeds [rad/s] commanded, in
+        the one compiled period (`physics.actuators.actuated_period`, which projects after each
+        step); the tension is the one at x."""
+        return self.formation.integrate(x, rotor_speeds, dt, steps)
+
+    def physics_constants(self) -> tuple[np.ndarray, ...]:
+        """(uavs, gusts, formation, allocation, actuators): the arrays the compiled tick reads
+        (`FormationModel.physics_constants`), in the null-space form with its projection."""
+        return self.formation.physics_constants()
 
     def project(self, x: np.ndarray) -> np.ndarray:
         """x moved onto the constraint manifold (`physics.nullspace.project`: positions by

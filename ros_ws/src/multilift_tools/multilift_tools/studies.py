@@ -28,7 +28,7 @@ from multilift_sim.modal import scenario_equilibrium
 from multilift_sim.nullspace import NullSpaceModel
 from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.scenario import Scenario, ScenarioError, load
-from multilift_sim.simulation import initial_state
+from multilift_sim.start import initial_state
 
 STUDIES = ('baumgarte', 'swing_feedback')  # the second: multilift_tools.swing_study
 DEFAULT_DURATION = 60.0   # [s] the drift of alpha_f = 0 needs time to show (Fig. 4.2)

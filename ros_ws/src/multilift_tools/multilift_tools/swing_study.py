@@ -30,7 +30,7 @@ import numpy as np
 
 from multilift_control.engine import Engine
 from multilift_sim.scenario import Scenario, load
-from multilift_sim.simulation import formation_start
+from multilift_sim.start import formation_start
 from multilift_sim.statistics import payload_swing
 
 # the swing feedback flown (control.payload_feedback, the same for every mission): chosen by

@@ -7,21 +7,16 @@ import numpy as np
 
 from multilift_control import laws
 from multilift_control.engine import tick as compiled
-from multilift_control.engine.arrays import (FINISHED, NOT_FINITE, OFF_CONSTRAINT, OFF_RATE,
-                                             RUNNING, FormationArrays, FormationMemory,
+from multilift_control.engine.arrays import (FINISHED, RUNNING, FormationArrays, FormationMemory,
                                              TickRecord, batch_arrays, empty_record)
 from multilift_control.laws.layout import REFERENCE_SIZE, UAV_STATE_SIZE
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import stop_message
 from multilift_sim.schedules import event_records, run_seeds
+from multilift_sim.tick_arrays import STOP_CHECKS
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                      TrackingStatistics)
-from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
-
-
-# the engine's stop statuses -> the check's codes (the simulator's words: stop_message)
-_CHECKS = {NOT_FINITE: CHECK_NON_FINITE, OFF_CONSTRAINT: CHECK_G, OFF_RATE: CHECK_G_DOT}
 
 
 class Engine:
@@ -202,7 +197,7 @@ class Engine:
 
     def stop_reason(self, b: int) -> str | None:
         """Why formation b stopped, in the simulator's words (None while it has not)."""
-        check = _CHECKS.get(int(self.memory.status[b]))
+        check = STOP_CHECKS.get(int(self.memory.status[b]))
         if check is None:
             return None
         return stop_message(check, int(self.memory.worst_cable[b]),

@@ -1,7 +1,9 @@
 """The compiled control tick of a formation and the loop over ticks and formations.
 
 `formation_tick` is seed Algorithm 1 for one tick of formation b, in the order of the ROS graph
-(`multilift_control.runtime.answer_tick`, then `FormationSimulator.advance`); `run_ticks` runs
+(the controllers' answers, as `multilift_control.runtime.answer_tick` gives them, then the
+physics' half, `multilift_sim.physics.tick.advance`, which the simulator node steps as a
+batch of one); `run_ticks` runs
 up to `ticks` ticks of each of the B formations in one call. Every equation is a call into the
 laws (`multilift_control.laws`) or the physics (`multilift_sim.physics`); the arrays are
 `engine.arrays`' and their slots the layouts'.
@@ -10,26 +12,17 @@ import math
 
 import numpy as np
 
-from multilift_control.engine.arrays import (FINISHED, MODE_CASCADE, NOT_FINITE, OFF_CONSTRAINT,
-                                             OFF_RATE, RUNNING)
+from multilift_control.engine.arrays import MODE_CASCADE, RUNNING
 from multilift_control.laws import jit
 from multilift_control.laws.cascade import attitude_command, leader_update
 from multilift_control.laws.follower import follower_update, formation_terms, lift_vectors
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
-from multilift_sim.physics.actuators import actuated_period
-from multilift_sim.physics.events import apply_events, held_commands
-from multilift_sim.physics.formation_dae import air_velocity, residuals
-from multilift_sim.physics.layout import (EVENT_KIND, EVENT_UAV, FORMATION_WIND,
-                                          KIND_ROTOR_EFFECTIVENESS)
-from multilift_sim.physics.measurement import (measured_states, payload_position,
-                                               payload_velocity)
-from multilift_sim.physics.sensors import sensed_states
-from multilift_sim.statistics.accumulators import (formation_error_add, run_add_commands,
-                                                   run_add_gust_speed, run_add_slack,
-                                                   run_add_tensions, run_check, tracking_add)
-from multilift_sim.statistics.layout import CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE
+from multilift_sim.physics import tick as physics
+from multilift_sim.physics.layout import EVENT_KIND, EVENT_UAV, KIND_ROTOR_EFFECTIVENESS
+from multilift_sim.physics.measurement import payload_position, payload_velocity
+from multilift_sim.statistics.accumulators import formation_error_add, tracking_add
 
 
 @jit
@@ -86,41 +79,11 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
 
 
 @jit
-def check(a, m, b):
-    """Algorithm 1, lines 10-13, at formation b's current state (its g, g_dot), the run's
-    figures accumulated (`statistics.accumulators.run_check`, then the gust at the payload, as
-    `FormationSimulator._check`): its status becomes NOT_FINITE, OFF_CONSTRAINT or OFF_RATE
-    (the cable in worst_cable, its |g| or |g_dot| in worst_value) when Algorithm 1 stops it."""
-    t = m.tick[b] * a.period_ns[b] * 1e-9
-    x = m.state[b]
-    status, cable = run_check(m.run[b], x, m.g[b], m.g_dot[b], m.taut[b], a.tolerances[b, 0],
-                              a.tolerances[b, 1], t, m.tick[b], a.swing_every[b], a.reach[b])
-    if status == CHECK_NON_FINITE:
-        m.status[b] = NOT_FINITE
-        return
-    payload = 6 * a.uavs.shape[1]
-    gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
-    m.gust[b, 0], m.gust[b, 1], m.gust[b, 2] = gust_x, gust_y, gust_z
-    if a.gusts.shape[1]:
-        run_add_gust_speed(m.run[b], math.sqrt(gust_x * gust_x + gust_y * gust_y
-                                               + gust_z * gust_z))
-    if status == CHECK_G:
-        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_CONSTRAINT, cable, abs(
-            m.g[b, cable])
-    elif status == CHECK_G_DOT:
-        m.status[b], m.worst_cable[b], m.worst_value[b] = OFF_RATE, cable, abs(
-            m.g_dot[b, cable])
-
-
-@jit
-def events(a, m, b):
-    """The scenario's events of formation b's current tick: in the physics
-    (`physics.events.apply_events`), and the controllers told of a fault at once (a rotor's:
-    its UAV's mixer reallocated, `faults.fault_mixers`; a cable's release: the formation's new
-    offsets, on their way along `faults.target_schedule`)."""
-    first = m.next_event[b]
-    m.next_event[b] = apply_events(a.events[b], first, m.tick[b], m.effectiveness[b], m.taut[b],
-                                   m.released[b], m.silent_until[b])
+def tell_controllers(a, m, b, first):
+    """The controllers told at once of the events of formation b from row `first` on (those
+    the physics' tick just applied): a rotor's fault reallocates its UAV's mixer
+    (`faults.fault_mixers`); a cable's release sends the formation's new offsets along
+    `faults.target_schedule`, whose rows take effect at their tick."""
     for k in range(first, m.next_event[b]):
         if int(a.events[b, k, EVENT_KIND]) == KIND_ROTOR_EFFECTIVENESS:
             m.mixers[b, int(a.events[b, k, EVENT_UAV])] = a.fault_mixers[b, k]
@@ -132,51 +95,13 @@ def events(a, m, b):
 
 @jit
 def advance_formation(a, m, b, speeds, saturated, tension):
-    """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
-    limit) commanded over the control period (a silent controller's held: `physics.events`;
-    RK4, the rotors through their actuators:
-    `physics.actuators`), the events of the new tick applied (`physics.events`), then
-    checked; the tension T_i = 2 l_i lambda_i
-    [N] at the tick into tension. The second half of a tick, whoever answered."""
-    n = speeds.shape[0]
-    period = a.period_ns[b] * 1e-9
-    held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
-                  m.held_saturated[b])
-    run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
-    formation = a.formation[b]
-    if a.wind_series.shape[1]:  # the steady wind plus the tick's unsteady wind, over the period
-        formation = formation.copy()
-        for j in range(3):
-            formation[FORMATION_WIND + j] += a.wind_series[b, m.tick[b], j]
-    state, multipliers, g, g_dot = actuated_period(
-        m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
-        a.uavs[b], a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
-        a.physics_dt[b], a.physics_steps[b])
-    for i in range(n):
-        tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
-    run_add_tensions(m.run[b], tension)
-    if a.slack[b]:
-        run_add_slack(m.run[b], m.taut[b], period)
-    m.state[b, :] = state
-    m.g[b, :] = g
-    m.g_dot[b, :] = g_dot
-    m.tick[b] += 1
-    events(a, m, b)
-    check(a, m, b)
-    if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
-        m.status[b] = FINISHED
-
-
-@jit
-def measure(a, m, b, states):
-    """What formation b's controllers receive of its UAVs at its current tick, into states
-    (n, UAV_STATE_SIZE): the measured states (seed Eq. 2.7), with `sensors:` as its sensors
-    deliver them (`physics.sensors.sensed_states`)."""
-    measured_states(m.state[b], states.shape[0], states)
-    if a.sensor_errors.shape[1]:
-        sensed_states(states, m.tick[b], a.sensor_errors[b], a.sensor_delivered[b],
-                      a.sensor_every[b], a.sensor_latency[b], m.sensor_history[b],
-                      m.sensor_seen[b])
+    """Formation b under rotor `speeds` (n, rotors) [rad/s] commanded over the control period
+    (`multilift_sim.physics.tick.advance`: the physics' half, the one implementation), then
+    its controllers told of the new tick's events (`tell_controllers`); the tension [N] into
+    tension. The second half of a tick, whoever answered."""
+    first = m.next_event[b]
+    physics.advance(a, m, b, speeds, saturated, tension)
+    tell_controllers(a, m, b, first)
 
 
 @jit
@@ -186,7 +111,7 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
     control period (RK4), then check; the tension T_i = 2 l_i lambda_i [N] at the tick into
     tension."""
     t = m.tick[b] * a.period_ns[b] * 1e-9
-    measure(a, m, b, states)
+    physics.measure(a, m, b, states)
     answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
                      errors, rates)
     advance_formation(a, m, b, speeds, saturated, tension)
@@ -197,7 +122,7 @@ def measure_all(a, m, states):
     """What every formation's controllers receive (B, n, UAV_STATE_SIZE) at its current tick
     (`measure`)."""
     for b in range(m.state.shape[0]):
-        measure(a, m, b, states[b])
+        physics.measure(a, m, b, states[b])
 
 
 @jit
@@ -256,16 +181,13 @@ def run_commanded(a, m, speeds, saturated, which, tension):
 
 @jit
 def start(a, m, which):
-    """The residuals, events and check of each formation b with which[b] at its initial state
-    (before its first tick)."""
+    """Each formation b with which[b] at its initial state, before its first tick: the
+    physics' start (`multilift_sim.physics.tick.start`: residuals, events, check) and its
+    controllers told of the events at t = 0."""
+    physics.start(a, m, which)
     for b in range(m.state.shape[0]):
-        if not which[b]:
-            continue
-        residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
-        events(a, m, b)
-        check(a, m, b)
-        if m.status[b] == RUNNING and m.tick[b] >= a.tick_count[b]:
-            m.status[b] = FINISHED
+        if which[b]:
+            tell_controllers(a, m, b, 0)
 
 
 @jit

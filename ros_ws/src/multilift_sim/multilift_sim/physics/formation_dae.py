@@ -22,13 +22,13 @@ from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  
                                               attached_off_centre, cable_moment_arm,
                                               payload_force_per_mass, rotational_compliance,
                                               uav_attach_motion, uav_free_motion)
-from multilift_sim.physics.nullspace import nullspace_solve
+from multilift_sim.physics.nullspace import nullspace_solve, project, translational_masses
 from multilift_sim.physics.rigid_payload import (normalize_quaternion, rigid_residuals,
                                                  rigid_solve)
 from multilift_sim.physics.layout import (
     CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST,
-    FORMATION_BETA_SQ,
-    FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
+    FORMATION_BETA_SQ, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
+    FORMATION_PAYLOAD_MASS, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
     FORMATION_TWO_ALPHA, PAYLOAD_COORDINATES, POSITION, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
 
@@ -246,8 +246,10 @@ def residuals(x, uavs, g, g_dot):
 @jit
 def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
     """`steps` RK4 steps of dt [s] from x with the wrenches held (one control period of seed
-    Algorithm 1), the `taut` cables constrained: (the state at the end, the multipliers
-    [N/m] at x, g [m^2] and g_dot [m^2/s] at the end). x is not written."""
+    Algorithm 1), the `taut` cables constrained, each step projected back onto g = 0,
+    g_dot = 0 where the formation asks for it (FORMATION_PROJECTION_STEPS: the null-space
+    form's coordinate projection, `physics.nullspace.project`): (the state at the end, the
+    multipliers [N/m] at x, g [m^2] and g_dot [m^2/s] at the end). x is not written."""
     n = uavs.shape[0]
     size = x.shape[0]
     work = np.empty((WORK_ROWS, size))
@@ -255,9 +257,14 @@ def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
     first = np.empty(n)
     later = np.empty(n)
     state = x.copy()
+    projection_steps = int(formation[FORMATION_PROJECTION_STEPS])
+    masses = translational_masses(uavs, formation)
     for step in range(steps):
         rk4_step(state, wrenches, uavs, gusts, formation, taut, dt, state,
                  first if step == 0 else later, work, cables)
+        if projection_steps > 0:
+            project(state, uavs, masses, formation[FORMATION_PROJECTION_TOLERANCE],
+                    projection_steps)
     g = np.empty(n)
     g_dot = np.empty(n)
     residuals(state, uavs, g, g_dot)

@@ -100,7 +100,10 @@ FORMATION_NULL_SPACE = 9        # 1: q_ddot by the null-space form (Eq. 2.71-2.7
 #                                 `nullspace` formulation; 0: the multipliers (Eq. 2.59-2.60)
 FORMATION_PAYLOAD_INERTIA = 10  # a rigid payload's principal moments J_p [kg m^2], payload
 #                                 frame (3 slots; whether it is rigid: x's length)
-FORMATION_SCALARS = 13
+FORMATION_PROJECTION_STEPS = 13  # the null-space form's Newton steps onto g = 0 after each RK4
+#                                 step (physics.nullspace.project); 0: no projection
+FORMATION_PROJECTION_TOLERANCE = 14  # |g_i| / l_i^2 the projection accepts
+FORMATION_SCALARS = 15
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
 CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots; from the attach points)
@@ -154,3 +157,11 @@ ODOMETRY_ROTATION = 12      # R = Rz(psi) Ry(theta) Rx(phi), body -> world, row 
 ODOMETRY_BODY_VELOCITY = 21  # R^T r_i_dot [m/s], body FLU (3)
 ODOMETRY_QUATERNION = 24    # (x, y, z, w) of R, scalar last as geometry_msgs orders it (4)
 ODOMETRY_COLUMNS = 28
+
+# -- a formation's status in a batch (the memory's `status`; physics.tick) ----------------------
+STATUS_RUNNING = 0          # ticks left
+STATUS_FINISHED = 1         # reached its duration (the state at t_max is the last)
+STATUS_NOT_FINITE = 2       # stopped: the state became non-finite (Algorithm 1)
+STATUS_OFF_CONSTRAINT = 3   # stopped: a taut cable's |g| left constraint_tolerance (Algorithm 1)
+STATUS_OFF_RATE = 4         # stopped: a taut cable's |g_dot| left constraint_rate_tolerance
+STATUS_ATTITUDE = 5         # stopped: a UAV pitched beyond what its Euler angles represent

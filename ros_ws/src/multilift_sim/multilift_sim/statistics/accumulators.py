@@ -14,12 +14,12 @@ import math
 import numpy as np
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.layout import POSITION, UAV_COORDINATES
+from multilift_sim.physics.layout import EULER, POSITION, UAV_COORDINATES
 from multilift_sim.statistics.layout import (
-    CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS, FORMATION_NORM_SUM,
-    FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
-    RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION,
-    RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
+    CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS,
+    FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ, PITCH_LIMIT,
+    RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION,
+    RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
     RUN_UAV_COLUMNS, TRACKING_ERROR)
 from multilift_sim.statistics.swing import swing_at
 
@@ -94,12 +94,17 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
     tick % swing_every == 0 (`swing_at` with the cables' reach (n,) [m]), the simulated time.
 
     Returns (status, cable): CHECK_NON_FINITE (the state is not finite; nothing accumulated),
-    CHECK_G or CHECK_G_DOT (the first cable of the largest |g| or |g_dot| is over its
-    tolerance; |g| is checked first), else CHECK_OK; cable: that cable (from 0), else -1.
+    CHECK_ATTITUDE (UAV `cable` pitched beyond PITCH_LIMIT, where the state's Euler angles
+    stop representing its attitude; nothing accumulated), CHECK_G or CHECK_G_DOT (the first
+    cable of the largest |g| or |g_dot| is over its tolerance; |g| is checked first), else
+    CHECK_OK; cable: that cable (from 0), else -1.
     """
     for value in state:
         if not math.isfinite(value):
             return CHECK_NON_FINITE, -1
+    for i in range(g.shape[0]):  # cos(pitch) < cos(limit): beyond it on either side, or past 90
+        if math.cos(state[UAV_COORDINATES * i + EULER + 1]) < math.cos(PITCH_LIMIT):
+            return CHECK_ATTITUDE, i
     peak, worst, peak_rate, worst_rate = -1.0, -1, -1.0, -1
     for i in range(g.shape[0]):
         abs_g, abs_g_dot = (abs(g[i]), abs(g_dot[i])) if taut[i] else (0.0, 0.0)

@@ -178,11 +178,14 @@ class RunStatistics:
     """The simulator's figures of a run, accumulated tick by tick: a view of `run`
     (`layout.run_size(n)` floats, RUN_*), which the compiled functions update in place."""
 
-    def __init__(self, n_uavs: int):
+    def __init__(self, n_uavs: int, run: np.ndarray | None = None):
+        """Empty figures of n UAVs, or a view of `run` (run_size(n_uavs),), another's."""
         self.n_uavs = n_uavs
-        self.run = np.zeros(run_size(n_uavs))
-        self.run[RUN_MIN_TENSION] = math.inf
-        self.run[RUN_MAX_TENSION] = -math.inf
+        if run is None:
+            run = np.zeros(run_size(n_uavs))
+            run[RUN_MIN_TENSION] = math.inf
+            run[RUN_MAX_TENSION] = -math.inf
+        self.run = run
         self.swing = PeakRms(self.run, RUN_SWING)      # payload swing [m]
         self._functions = {name: compiled('accumulators', name) for name in (
             'run_add_commands', 'run_add_tensions', 'run_add_slack', 'run_add_gust_speed',

@@ -60,3 +60,8 @@ CHECK_OK = 0
 CHECK_NON_FINITE = 1        # the formation state is not finite
 CHECK_G = 2                 # a taut cable's |g| exceeds the constraint tolerance
 CHECK_G_DOT = 3             # a taut cable's |g_dot| exceeds the rate tolerance
+CHECK_ATTITUDE = 4          # a UAV's attitude left what its ZYX Euler angles represent
+# the largest |pitch| the state's ZYX Euler angles (seed Eq. 2.6) carry a UAV to [rad]: their
+# rates (Eq. 2.7's W(eta)^-1) hold 1/cos(pitch), which diverges at 90 deg; a run stops
+# there, named, rather than fly on numbers that only look finite
+PITCH_LIMIT = 1.5533430342749532  # 89 deg

@@ -96,7 +96,7 @@ def reduced_swing(scenario: Scenario, times: np.ndarray) -> tuple[np.ndarray, np
     from multilift_sim.frames import world_to_seed_euler, world_to_seed_vector
     from multilift_sim.modal import scenario_equilibrium
     from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
-    from multilift_sim.simulation import initial_state
+    from multilift_sim.start import initial_state
 
     uav = scenario.uavs[0]
     model = ReducedSingleLiftModel(uav.vehicle, scenario.payload.mass, uav.cable_length,
@@ -152,7 +152,7 @@ def single_lift_table(study_dir: str | Path | None = None) -> list[dict]:
     from multilift_sim.formation_params import StateLayout
     from multilift_sim.frames import world_to_seed_vector
     from multilift_sim.modal import scenario_modal_analysis
-    from multilift_sim.simulation import initial_state
+    from multilift_sim.start import initial_state
     from multilift_tools.studies import baumgarte_study
 
     rows = []

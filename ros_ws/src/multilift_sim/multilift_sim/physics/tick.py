@@ -1,0 +1,159 @@
+"""The physics' half of a control tick, compiled once for every caller: formation b of a batch
+under the rotor commands its controllers gave, integrated over the control period, the
+scenario's events of the new tick applied, and seed Algorithm 1's check (lines 10-13).
+
+The one implementation of that half: the simulator node and `run_headless` step it as a
+batch of one (`simulation.FormationSimulator`), the engine (`multilift_control.engine`),
+campaigns and the learning environments as batches of B. `a` holds what a run does not
+change and `m` what a tick changes (`multilift_sim.tick_arrays.PhysicsArrays` and
+`PhysicsMemory`, or the engine's arrays, which carry the same fields); their slots are named
+in `physics.layout` and `statistics.layout`. Units: SI, world frame z up.
+"""
+import math
+
+import numpy as np
+
+from multilift_sim.kernels import jit
+from multilift_sim.physics.actuators import actuated_period
+from multilift_sim.physics.allocation import rotor_wrenches
+from multilift_sim.physics.events import apply_events, held_commands
+from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
+from multilift_sim.physics.layout import (CABLE_COLUMNS, EULER, FORMATION_WIND,
+                                          PAYLOAD_COORDINATES, STATUS_ATTITUDE, STATUS_FINISHED,
+                                          STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
+                                          STATUS_OFF_RATE, STATUS_RUNNING, UAV_COORDINATES,
+                                          WRENCH_COLUMNS)
+from multilift_sim.physics.measurement import measured_states
+from multilift_sim.physics.sensors import sensed_states
+from multilift_sim.statistics.accumulators import (run_add_commands, run_add_gust_speed,
+                                                   run_add_slack, run_add_tensions, run_check)
+from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
+                                             CHECK_NON_FINITE)
+
+
+@jit
+def period_formation(a, m, b):
+    """Formation b's scalars (FORMATION_*) for the period from its current tick: the steady
+    wind plus the tick's unsteady wind (`schedules.wind_series`); the constants themselves
+    when the air is steady."""
+    formation = a.formation[b]
+    if a.wind_series.shape[1]:
+        formation = formation.copy()
+        for j in range(3):
+            formation[FORMATION_WIND + j] += a.wind_series[b, m.tick[b], j]
+    return formation
+
+
+@jit
+def check(a, m, b):
+    """Algorithm 1, lines 10-13, at formation b's current state (its g, g_dot), the run's
+    figures accumulated (`statistics.accumulators.run_check`, then the gust at the payload):
+    its status becomes STATUS_NOT_FINITE, _ATTITUDE (the UAV in worst_cable, its pitch in
+    worst_value), _OFF_CONSTRAINT or _OFF_RATE (the cable in worst_cable, its |g| or |g_dot|
+    in worst_value) when Algorithm 1 stops it."""
+    t = m.tick[b] * a.period_ns[b] * 1e-9
+    x = m.state[b]
+    status, cable = run_check(m.run[b], x, m.g[b], m.g_dot[b], m.taut[b], a.tolerances[b, 0],
+                              a.tolerances[b, 1], t, m.tick[b], a.swing_every[b], a.reach[b])
+    if status == CHECK_NON_FINITE:
+        m.status[b] = STATUS_NOT_FINITE
+        return
+    if status == CHECK_ATTITUDE:  # the UAV in worst_cable, its pitch [rad] in worst_value
+        m.status[b], m.worst_cable[b] = STATUS_ATTITUDE, cable
+        m.worst_value[b] = x[UAV_COORDINATES * cable + EULER + 1]
+        return
+    payload = 6 * a.uavs.shape[1]
+    gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
+    m.gust[b, 0], m.gust[b, 1], m.gust[b, 2] = gust_x, gust_y, gust_z
+    if a.gusts.shape[1]:
+        run_add_gust_speed(m.run[b], math.sqrt(gust_x * gust_x + gust_y * gust_y
+                                               + gust_z * gust_z))
+    if status == CHECK_G:
+        m.status[b], m.worst_cable[b], m.worst_value[b] = STATUS_OFF_CONSTRAINT, cable, abs(
+            m.g[b, cable])
+    elif status == CHECK_G_DOT:
+        m.status[b], m.worst_cable[b], m.worst_value[b] = STATUS_OFF_RATE, cable, abs(
+            m.g_dot[b, cable])
+
+
+@jit
+def advance(a, m, b, speeds, saturated, tension):
+    """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
+    limit; a smaller UAV's padded with zeros) commanded over the control period (a silent
+    controller's held: `physics.events.held_commands`; RK4 through the rotors' actuators:
+    `physics.actuators`), the events of the new tick applied (`physics.events`), then checked
+    (`check`); the tension T_i = 2 l_i lambda_i [N] at the tick it started from into
+    tension. The second half of a tick, whoever answered."""
+    n = speeds.shape[0]
+    period = a.period_ns[b] * 1e-9
+    held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
+                  m.held_saturated[b])
+    run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
+    state, multipliers, g, g_dot = actuated_period(
+        m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
+        a.uavs[b], a.gusts[b], period_formation(a, m, b), m.taut[b], m.released[b], a.slack[b],
+        a.physics_dt[b], a.physics_steps[b])
+    for i in range(n):
+        tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
+    run_add_tensions(m.run[b], tension)
+    if a.slack[b]:
+        run_add_slack(m.run[b], m.taut[b], period)
+    m.state[b, :] = state
+    m.g[b, :] = g
+    m.g_dot[b, :] = g_dot
+    m.tick[b] += 1
+    m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b], m.effectiveness[b],
+                                   m.taut[b], m.released[b], m.silent_until[b])
+    check(a, m, b)
+    if m.status[b] == STATUS_RUNNING and m.tick[b] >= a.tick_count[b]:
+        m.status[b] = STATUS_FINISHED
+
+
+@jit
+def start(a, m, which):
+    """The residuals, events and check of each formation b with which[b] at its initial state
+    (before its first tick)."""
+    for b in range(m.state.shape[0]):
+        if not which[b]:
+            continue
+        residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
+        m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b],
+                                       m.effectiveness[b], m.taut[b], m.released[b],
+                                       m.silent_until[b])
+        check(a, m, b)
+        if m.status[b] == STATUS_RUNNING and m.tick[b] >= a.tick_count[b]:
+            m.status[b] = STATUS_FINISHED
+
+
+@jit
+def measure(a, m, b, states):
+    """What formation b's controllers receive of its UAVs at its current tick, into states
+    (n, MEASURED_COLUMNS): the measured states (seed Eq. 2.7), with `sensors:` as its sensors
+    deliver them (`physics.sensors.sensed_states`; the same result however often it is
+    called at one tick)."""
+    measured_states(m.state[b], states.shape[0], states)
+    if a.sensor_errors.shape[1]:
+        sensed_states(states, m.tick[b], a.sensor_errors[b], a.sensor_delivered[b],
+                      a.sensor_every[b], a.sensor_latency[b], m.sensor_history[b],
+                      m.sensor_seen[b])
+
+
+@jit
+def tension_at(a, m, b, speeds, tension):
+    """The cable tensions T_i = 2 l_i lambda_i [N] at formation b's current state under rotor
+    `speeds` (n, rotors) [rad/s] held (the multipliers of the DAE's solve, as the first stage
+    of `advance` computes them; a slack cable's 0, a taut one's not below 0), into tension
+    (n,): the tension of a tick the run ends at, which no integration leaves."""
+    n = speeds.shape[0]
+    wrenches = np.empty((n, WRENCH_COLUMNS))
+    rotor_wrenches(a.allocation[b], speeds, m.effectiveness[b], wrenches)
+    x = m.state[b]
+    acc = np.empty(x.shape[0] - UAV_COORDINATES * n - PAYLOAD_COORDINATES)  # q_ddot (+ a body's)
+    multipliers = np.empty(n)
+    solve(x, wrenches, a.uavs[b], a.gusts[b], period_formation(a, m, b), m.taut[b], acc,
+          multipliers, np.empty((n, CABLE_COLUMNS)))
+    for i in range(n):
+        value = multipliers[i]
+        if a.slack[b]:
+            value = max(value, 0.0) if m.taut[b, i] else 0.0
+        tension[i] = 2.0 * a.cable_lengths[b, i] * value

@@ -1,0 +1,127 @@
+"""The arrays the physics' half of a tick (`physics.tick`) reads and writes, named once.
+
+`PhysicsArrays` holds what a run does not change, `PhysicsMemory` what a tick changes; every
+field has the batch axis first (B formations; the simulator's batch is one). The engine's
+arrays (`multilift_control.engine.arrays`) carry these same fields and the controllers' after
+them, so the compiled functions of `physics.tick` serve both. Both are built here, from one
+scenario, by `physics_fields`: the events, the unsteady wind and the sensors' draws once per
+run. Units: SI, world frame z up (docs/conventions.md).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from multilift_sim.formulations import Formulation, make_formulation
+from multilift_sim.physics.layout import (STATUS_ATTITUDE, STATUS_NOT_FINITE,
+                                          STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
+from multilift_sim.scenario import Scenario
+from multilift_sim.schedules import event_array, sensor_arrays, wind_series
+from multilift_sim.start import cable_reach, initial_state, swing_sampling
+from multilift_sim.statistics import RunStatistics
+from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
+                                             CHECK_NON_FINITE)
+
+
+class PhysicsArrays(NamedTuple):
+    """What does not change during a run, for B formations (first axis)."""
+    uavs: np.ndarray              # (B, n, UAV_COLUMNS)
+    gusts: np.ndarray             # (B, k, GUST_COLUMNS)
+    formation: np.ndarray         # (B, FORMATION_SCALARS)
+    allocation: np.ndarray        # (B, n, 4, rotors): wrench per omega^2 (seed Eq. 2.14),
+    #                               a UAV with fewer rotors padded with zero columns
+    actuators: np.ndarray         # (B, n, ACTUATOR_COLUMNS): each UAV's rotor lag and rate limit
+    cable_lengths: np.ndarray     # (B, n) [m]
+    slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
+    events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
+    wind_series: np.ndarray       # (B, ticks + 1 or 0, 3): the unsteady wind by tick [m/s]
+    state_size: np.ndarray        # (B,) int: the state's length (a rigid payload adds its attitude)
+    # what the controllers receive (`sensors:`; schedules.SensorArrays, physics.sensors)
+    sensor_errors: np.ndarray     # (B, S or 0, n, MEASURED_COLUMNS): each sample's error
+    sensor_delivered: np.ndarray  # (B, S or 0, n) bool: whether the sample arrives
+    sensor_every: np.ndarray      # (B,) int: control ticks between two samples
+    sensor_latency: np.ndarray    # (B,) int: control ticks from a sample to its arrival
+    # time and Algorithm 1's tolerances
+    physics_dt: np.ndarray        # (B,) [s]
+    physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
+    period_ns: np.ndarray         # (B,) int: the control period [ns]
+    tick_count: np.ndarray        # (B,) int: control periods of the run
+    tolerances: np.ndarray        # (B, 2): |g| [m^2], |g_dot| [m^2/s]
+    swing_every: np.ndarray       # (B,) int: the payload swing sampled every this many ticks
+    reach: np.ndarray             # (B, n) [m]: each cable's reach for the swing's equilibrium
+
+
+class PhysicsMemory(NamedTuple):
+    """What a tick changes, for B formations (first axis)."""
+    state: np.ndarray             # (B, state_size): the formation state at the current tick
+    taut: np.ndarray              # (B, n) bool: which cables are taut
+    rotors: np.ndarray            # (B, n, rotors): rotor speeds [rad/s], NaN before a command
+    effectiveness: np.ndarray     # (B, n, rotors): each rotor's share of its thrust, in [0, 1]
+    released: np.ndarray          # (B, n) bool: the cables let go of for good (events)
+    next_event: np.ndarray        # (B,) int: the row of the next event to come
+    silent_until: np.ndarray      # (B, n) int: the first tick a silent controller is heard
+    held: np.ndarray              # (B, n, rotors): the commands applied last [rad/s] (NaN: none)
+    held_saturated: np.ndarray    # (B, n, rotors) bool: their saturation flags
+    tick: np.ndarray              # (B,) int: control periods flown
+    status: np.ndarray            # (B,) int: STATUS_RUNNING, _FINISHED or why it stopped
+    worst_cable: np.ndarray       # (B,) int: the cable of a stop (from 0)
+    worst_value: np.ndarray       # (B,): its |g| or |g_dot|
+    g: np.ndarray                 # (B, n): g at the current tick [m^2]
+    g_dot: np.ndarray             # (B, n): g_dot at the current tick [m^2/s]
+    gust: np.ndarray              # (B, 3): the air velocity at the payload [m/s], world
+    sensor_history: np.ndarray    # (B, latency + 1, n, MEASURED_COLUMNS): the last exact states
+    sensor_seen: np.ndarray       # (B, n, MEASURED_COLUMNS): what the controllers hold (NaN: none)
+    run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
+
+
+def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tuple[dict, dict]:
+    """One formation's (PhysicsArrays fields, PhysicsMemory fields), without the batch axis,
+    from `model` (the formulation `simulation.integrator` names, made here if not given: its
+    constants, in the null-space form where it says so)."""
+    n = scenario.n_uavs
+    sim = scenario.simulation
+    if model is None:
+        model = make_formulation(sim.integrator, scenario.formation_params(),
+                                 scenario.cable_model)
+    uavs, gusts, formation, allocation, actuators = model.physics_constants()
+    sensors = sensor_arrays(scenario)
+    sensor_history, sensor_seen = sensors.memory()
+    state = initial_state(scenario)
+    rotors = allocation.shape[::2]  # (n, the largest rotor count)
+    arrays = dict(
+        uavs=uavs, gusts=gusts, formation=formation, allocation=allocation, actuators=actuators,
+        cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
+        slack=scenario.cable_model == 'slack', events=event_array(scenario),
+        wind_series=wind_series(scenario), state_size=state.size,
+        sensor_errors=sensors.errors, sensor_delivered=sensors.delivered,
+        sensor_every=sensors.every, sensor_latency=sensors.latency,
+        physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
+        period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
+        tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),
+        swing_every=swing_sampling(n), reach=cable_reach(scenario))
+    memory = dict(
+        state=state, taut=np.ones(n, dtype=bool), rotors=np.full(rotors, math.nan),
+        effectiveness=np.ones(rotors), released=np.zeros(n, dtype=bool), next_event=0,
+        silent_until=np.zeros(n, dtype=np.int64), held=np.full(rotors, math.nan),
+        held_saturated=np.zeros(rotors, dtype=bool), tick=0, status=STATUS_RUNNING,
+        worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n), gust=np.zeros(3),
+        sensor_history=sensor_history, sensor_seen=sensor_seen, run=RunStatistics(n).run)
+    return arrays, memory
+
+
+def stacked(name: str, values: Sequence) -> np.ndarray:
+    """The formations' values of field `name` stacked along a new first (batch) axis."""
+    shapes = {np.shape(v) for v in values}
+    if len(shapes) != 1:
+        raise ValueError(f'the formations of a batch differ in the shape of {name}: '
+                         f'{sorted(shapes)} (one batch: the same n, rotors, gusts, mission '
+                         'segments and formation rows)')
+    return np.ascontiguousarray(np.stack([np.asarray(v) for v in values]))
+
+
+# a stopped formation's status -> the check's code (the words: simulation.stop_message)
+STOP_CHECKS = {STATUS_NOT_FINITE: CHECK_NON_FINITE, STATUS_OFF_CONSTRAINT: CHECK_G,
+               STATUS_OFF_RATE: CHECK_G_DOT, STATUS_ATTITUDE: CHECK_ATTITUDE}

@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
+from multilift_sim.analysis.equilibrium import scenario_equilibrium
+from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.frames import world_to_seed_euler, world_to_seed_vector
-from multilift_sim.modal import scenario_equilibrium
 from multilift_sim.nullspace import NullSpaceModel
-from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.scenario import Scenario, ScenarioError, load
 from multilift_sim.simulation import initial_state
 

@@ -1,6 +1,6 @@
 """The single-lift numbers of seed §2.8.1 and §4.1 (`single_lift_table`), which
 tests/unit/test_reproduction.py regenerates and compares with the committed report: the release,
-the linearised open loop (multilift_sim.modal), the periods of the simulated swing, of the
+the linearised open loop (multilift_sim.analysis.modal), the periods of the simulated swing, of the
 reduced model and of the amplitude law, the Baumgarte study and the static tension; and their
 markdown (`render_table`). World frame, z up, SI units.
 """
@@ -94,8 +94,8 @@ def reduced_swing(scenario: Scenario, times: np.ndarray) -> tuple[np.ndarray, np
     """(UAV, payload) world positions (T, 3) [m] of the reduced single-lift model (seed Eq.
     2.34, DOP853 rtol 1e-10) from the scenario's release, rotor speeds held at Eq. 2.73."""
     from multilift_sim.frames import world_to_seed_euler, world_to_seed_vector
-    from multilift_sim.modal import scenario_equilibrium
-    from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
+    from multilift_sim.analysis.equilibrium import scenario_equilibrium
+    from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
     from multilift_sim.simulation import initial_state
 
     uav = scenario.uavs[0]
@@ -141,17 +141,17 @@ def single_lift_table(study_dir: str | Path | None = None) -> list[dict]:
 
     Rows (dicts with key, quantity, seed, ours, command, value; `render_row` makes the markdown):
     the release r_p(0); size of A, eigenvalues and period of the linearised open loop
-    (multilift_sim.modal); the periods of the simulated swing (run_headless, the formation DAE
-    of Algorithm 1) released at 1/1 deg and at the seed's 15/25 deg, of the nonlinear reduced
-    model (Eq. 2.34) at 15/25 deg and of the plane-pendulum amplitude law; the Baumgarte study
-    (max |g| for alpha_f = 0, 20, 100; alpha_f = 100 against the reduced model) over
-    BAUMGARTE_DURATION; the scenario's own run against the reduced model; the static tension
+    (multilift_sim.analysis.modal); the periods of the simulated swing (run_headless, the
+    formation DAE of Algorithm 1) released at 1/1 deg and at the seed's 15/25 deg, of the
+    nonlinear reduced model (Eq. 2.34) at 15/25 deg and of the plane-pendulum amplitude law; the
+    Baumgarte study (max |g| for alpha_f = 0, 20, 100; alpha_f = 100 against the reduced model)
+    over BAUMGARTE_DURATION; the scenario's own run against the reduced model; the static tension
     against m_p g. `study_dir`: where the Baumgarte study writes its table and figures (Fig.
     4.2, 4.3); default a temporary directory, removed.
     """
     from multilift_sim.formation_params import StateLayout
     from multilift_sim.frames import world_to_seed_vector
-    from multilift_sim.modal import scenario_modal_analysis
+    from multilift_sim.analysis.modal import scenario_modal_analysis
     from multilift_sim.simulation import initial_state
     from multilift_tools.studies import baumgarte_study
 

@@ -33,18 +33,18 @@ class Layout:
 
     def primitive(self, code: str, count: int = 1) -> None:
         """`count` values of struct code `code` (i, I, d, f, ?, B): count args."""
-        size = struct.calcsize(code)
-        if count:
-            self._align(size)
-            self._fmt.append(f'{count}{code}')
-            self._offset += size * count
+        self._field(code, count, f'{count}{code}')
 
     def zeros(self, code: str, count: int = 1) -> None:
         """`count` values of `code` that are always zero: no args."""
+        self._field(code, count, f'{struct.calcsize(code) * count}x')
+
+    def _field(self, code: str, count: int, fmt: str) -> None:
+        """`count` values of `code`, aligned to its size, as the struct format `fmt`."""
         size = struct.calcsize(code)
         if count:
             self._align(size)
-            self._fmt.append(f'{size * count}x')
+            self._fmt.append(fmt)
             self._offset += size * count
 
     def string(self, text: str) -> bytes:

@@ -253,7 +253,7 @@ def profile_headless(scenario, seconds: float) -> tuple[float, list]:
 
 def profile_ros(scenario_name: str, seconds: float, domain: int, workdir: Path) -> dict:
     """The twin-lift's sim_node, leader_node and follower_node each under cProfile."""
-    from multilift_tools.cli import _ros_args
+    from multilift_tools.run_command import ros_args
     scenario = scenario_io.load(scenario_name)
     path = str(scenario_io.resolve(scenario_name).resolve())
     summary = workdir / 'profile_summary'
@@ -268,7 +268,7 @@ def profile_ros(scenario_name: str, seconds: float, domain: int, workdir: Path) 
                                           dict(common, uav_index=i), 'controller',
                                           ['-r', f'__node:=follower{i}'])
     children = [Child(label, [*py, str(workdir / f'{label}.prof'), str(exe),
-                              *_ros_args(params), *extra],
+                              *ros_args(params), *extra],
                       workdir / f'{label}.log', role)
                 for label, (exe, params, role, extra) in parts.items()]
     old = os.environ.copy()

@@ -37,7 +37,7 @@ def best_us(fn, number: int, repeat: int = 5) -> float:
 def messages_table() -> None:
     from rclpy.serialization import serialize_message
 
-    from multilift_sim.wire import cdr, msgvalues
+    from multilift_sim.wire import cdr, cdr_scene, msgvalues
     from multilift_sim import scenario as scenario_io
     from multilift_sim.ros import messages
     from multilift_sim.ros.markers import formation_markers
@@ -56,7 +56,7 @@ def messages_table() -> None:
     snapshot = cdr.FormationSnapshot([4, 4])
     clock = cdr.Clock()
     scene = FormationScene(scenario)
-    markers = cdr.MarkerArray(scene.specs)
+    markers = cdr_scene.MarkerArray(scene.specs)
 
     def pack_markers():
         scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],

@@ -242,9 +242,9 @@ def test_recover_a_torn_file(tmp_path):
 
 @pytest.mark.parametrize('compression', ['zstd', 'lz4', 'none'])
 def test_messages_are_written_as_the_mcap_library_writes_them(tmp_path, compression):
-    """BagWriter packs each Message record itself (bag._MessageAppender): the file is the one
-    the library's Writer.add_message gives, byte for byte, across several chunks, topics and
-    log times out of order."""
+    """BagWriter packs each Message record itself (bag.mcap_records.MessageAppender): the file
+    is the one the library's Writer.add_message gives, byte for byte, across several chunks,
+    topics and log times out of order."""
     # serialized once for both bags: rclpy leaves CDR padding uninitialised, so serializing
     # a message again need not give the same bytes
     payloads = [(serialize_message(_odometry(i)), serialize_message(_rotor(i)))

@@ -1,7 +1,7 @@
-"""multilift_sim.wire.cdr against rclpy: every packer's bytes decode (with rosbags from the
-installed .msg definitions, and with rclpy) to the message the rclpy builders of multilift_sim.ros
-make from the same inputs, and equal rclpy's `serialize_message` except in the padding, which the
-packers zero."""
+"""multilift_sim.wire.cdr and cdr_scene against rclpy: every packer's bytes decode (with rosbags
+from the installed .msg definitions, and with rclpy) to the message the rclpy builders of
+multilift_sim.ros make from the same inputs, and equal rclpy's `serialize_message` except in the
+padding, which the packers zero."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,7 +9,7 @@ import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from multilift_sim.wire import cdr, msgdefs, msgvalues
+from multilift_sim.wire import cdr, cdr_layout, cdr_scene, msgdefs, msgvalues
 from multilift_sim.ros import messages
 from multilift_sim.ros.markers import FormationMarkers
 
@@ -45,7 +45,7 @@ def fields(value):
             if s.strip('_') not in ('check_fields', 'msgtype') and not s.isupper()}
 
 
-def unpadded(data: bytes, layout: cdr.Layout) -> bytes:
+def unpadded(data: bytes, layout: cdr_layout.Layout) -> bytes:
     out = bytearray(data)
     for offset, length in layout.pad:
         out[offset:offset + length] = bytes(length)
@@ -54,7 +54,7 @@ def unpadded(data: bytes, layout: cdr.Layout) -> bytes:
 
 def check(packed: bytes, packer, msg, typestore) -> None:
     """`packer`: the packer or the Layout it packed with."""
-    layout = packer if isinstance(packer, cdr.Layout) else packer.layout
+    layout = packer if isinstance(packer, cdr_layout.Layout) else packer.layout
     rclpy_bytes = serialize_message(msg)
     assert len(packed) == len(rclpy_bytes)
     assert packed == unpadded(rclpy_bytes, layout)
@@ -163,7 +163,7 @@ def test_marker_array(twin, typestore):
     scene = packer_markers.scene
     scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
                  snap.payload_position, tensions)
-    packer = cdr.MarkerArray(scene.specs)
+    packer = cdr_scene.MarkerArray(scene.specs)
     check(packer.pack(T_NS), packer, msg, typestore)
 
 
@@ -186,13 +186,13 @@ def test_tf_message(twin, typestore):
         q = ts.transform.rotation
         q.x, q.y, q.z, q.w = r
         msg.transforms.append(ts)
-    packer = cdr.TFMessage(children)
+    packer = cdr_scene.TFMessage(children)
     check(packer.pack(T_NS, translations, rotations), packer, msg, typestore)
 
 
 def test_tf_message_decodes_with_rosbags(typestore):
     """Without tf2_msgs installed for rclpy: rosbags decodes it against the definition."""
-    packer = cdr.TFMessage(['uav1/base_link', 'payload'])
+    packer = cdr_scene.TFMessage(['uav1/base_link', 'payload'])
     data = packer.pack(T_NS, [(1.0, 2.0, 3.0), (4.0, 5.0, 6.5)],
                        [(0.0, 0.0, 0.0, 1.0), (0.5, 0.5, 0.5, 0.5)])
     store = get_typestore(Stores.ROS2_JAZZY)

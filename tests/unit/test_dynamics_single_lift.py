@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
+from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.dynamics import FormationModel, initial_state_single_lift
 from multilift_sim.formation_params import FormationParams
 from multilift_sim.frames import world_to_seed_vector
 from multilift_sim.multirotor import MultirotorParams
-from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 
 GRAVITY = 9.81
 UAV = MultirotorParams(mass=2.5, inertia=(0.957, 0.486, 0.355), frame_type='quad_x',

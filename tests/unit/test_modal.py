@@ -13,14 +13,15 @@ import pytest
 
 from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
+from multilift_sim.analysis.coordinates import coordinate_names
+from multilift_sim.analysis.equilibrium import scenario_equilibrium
+from multilift_sim.analysis.modal import (default_dependent_coordinates, elimination_basis,
+                                          modal_analysis, mode_state, scenario_modal_analysis)
+from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.constraints import constraint_jacobian
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.kinematics import rotation_matrix
-from multilift_sim.modal import (coordinate_names, default_dependent_coordinates,
-                                 elimination_basis, modal_analysis, mode_state,
-                                 scenario_equilibrium, scenario_modal_analysis)
-from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_tools.modal_cli import modal_main
 
 SCENARIO_NAMES = sorted(p.stem for p in SCENARIOS.glob('*.yaml')

@@ -1,5 +1,5 @@
 """Modal analysis with cables held off the UAVs' centres (uavs[i].attach_point a_i, body FLU;
-multilift_sim.modal, docs/rigid_payload.md), held against physics worked out here: the
+multilift_sim.analysis, docs/rigid_payload.md), held against physics worked out here: the
 equilibrium rests in the full DAE with the rotors cancelling the cable's moment about each
 centre; a_i = 0 written out is the seed's case; G is the derivative of the constraint; a
 payload on a held UAV swings as a plain pendulum from the attach point; the full DAE started
@@ -16,13 +16,14 @@ import yaml
 
 from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
+from multilift_sim.analysis.coordinates import (displaced_state, formation_jacobian,
+                                                formation_residuals)
+from multilift_sim.analysis.equilibrium import scenario_equilibrium, static_equilibrium
+from multilift_sim.analysis.modal import modal_analysis, mode_state, scenario_modal_analysis
+from multilift_sim.analysis.modes import motion_shares
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.kinematics import rotation_matrix
-from multilift_sim.modal import (displaced_state, formation_jacobian, formation_residuals,
-                                 modal_analysis, mode_state, motion_shares,
-                                 scenario_equilibrium, scenario_modal_analysis,
-                                 static_equilibrium)
 from multilift_sim.start import formation_start
 
 G = 9.81

@@ -1,5 +1,5 @@
 """Modal analysis of a rigid-body payload (issue 20 item 3: `multilift modal` lists the rigid
-payload's modes; multilift_sim.modal, docs/rigid_payload.md), held against solutions found
+payload's modes; multilift_sim.analysis, docs/rigid_payload.md), held against solutions found
 without it: a body whose attach points all sit at its centre of mass has the point payload's
 pendulum eigenvalues and its three rotations at zero; a bifilar suspension (suspension points
 held still) has the simple pendulum's swings and the yaw period 2 pi sqrt(I l / (m g d^2)), and
@@ -17,11 +17,13 @@ import pytest
 
 from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
+from multilift_sim.analysis.coordinates import coordinate_names
+from multilift_sim.analysis.equilibrium import (scenario_configuration, scenario_equilibrium,
+                                                static_equilibrium)
+from multilift_sim.analysis.modal import modal_analysis, mode_state, scenario_modal_analysis
+from multilift_sim.analysis.modes import motion_shares
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
-from multilift_sim.modal import (coordinate_names, modal_analysis, mode_state,
-                                 motion_shares, scenario_configuration, scenario_equilibrium,
-                                 scenario_modal_analysis, static_equilibrium)
 from multilift_tools.modal_cli import _label_groups, modal_main
 
 G = 9.81

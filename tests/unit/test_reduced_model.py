@@ -4,10 +4,10 @@ import math
 
 import numpy as np
 
+from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.constraints import cable_residual_rates, cable_residuals
 from multilift_sim.kinematics import euler_rate_matrix
 from multilift_sim.multirotor import MultirotorParams
-from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 
 UAV = MultirotorParams(mass=2.5, inertia=(0.957, 0.486, 0.355), frame_type='quad_x',
                        arm_length=0.2, thrust_coefficient=1.83e-6, moment_coefficient=1.85e-7,

@@ -1,5 +1,5 @@
 """`multilift modal SCENARIO [--out DIR] [--hold-uavs]`: the modal analysis of
-multilift_sim.modal (seed Sec. 2.8; a rigid-body payload's too, docs/rigid_payload.md) printed
+multilift_sim.analysis (seed Sec. 2.8; a rigid-body payload's too, docs/rigid_payload.md) printed
 as a table, each mode named by where its kinetic energy sits (the payload's swing, heave, roll,
 pitch, yaw; the UAVs), plotted in the complex plane (the analogue of seed Fig. 2.12) and
 written as JSON. World frame (z up), SI units; eigenvalues [1/s], periods [s].
@@ -15,9 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from multilift_sim.analysis.coordinates import coordinate_names
+from multilift_sim.analysis.modal import ModalAnalysis, scenario_modal_analysis
+from multilift_sim.analysis.modes import MODE_KINDS, motion_shares
 from multilift_sim.formation_params import StateLayout
-from multilift_sim.modal import (MODE_KINDS, ModalAnalysis, coordinate_names, motion_shares,
-                                 scenario_modal_analysis)
 from multilift_sim.scenario import ScenarioError, load
 
 

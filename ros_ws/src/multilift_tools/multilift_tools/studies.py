@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
+from multilift_sim.analysis.equilibrium import scenario_equilibrium
+from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.frames import world_to_seed_euler, world_to_seed_vector
-from multilift_sim.modal import scenario_equilibrium
 from multilift_sim.nullspace import NullSpaceModel
-from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.scenario import Scenario, ScenarioError, load
 from multilift_sim.start import initial_state
 
@@ -55,6 +55,22 @@ class IntegratorRun:
                 'max_uav_error': float(self.uav_error.max()),
                 'max_payload_error': float(self.payload_error.max()),
                 'wall_per_simulated_second': self.wall_per_second}
+
+
+def reduced_swing(scenario: Scenario, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(UAV, payload) world positions (T, 3) [m] of the reduced single-lift model (seed Eq.
+    2.34, DOP853 rtol 1e-10) from the scenario's release, rotor speeds held at Eq. 2.73."""
+    uav = scenario.uavs[0]
+    model = ReducedSingleLiftModel(uav.vehicle, scenario.payload.mass, uav.cable_length,
+                                   scenario.simulation.gravity)
+    x0 = initial_state(scenario)
+    start = rest_state(world_to_seed_vector(x0[0:3]), world_to_seed_euler(x0[3:6]),
+                       scenario.payload.alpha, scenario.payload.beta)
+    solution = model.simulate(start, scenario_equilibrium(scenario).rotor_speeds[0],
+                              float(times[-1]), t_eval=times)
+    if not solution.success:
+        raise RuntimeError(f'reduced single-lift model: {solution.message}')
+    return model.to_world_positions(solution.y.T)
 
 
 def _integrate(model, x0: np.ndarray, rotor_speeds: list[np.ndarray], steps: int,
@@ -105,16 +121,8 @@ def baumgarte_study(out_dir: str | Path, duration: float = DEFAULT_DURATION,
     times = np.arange(steps + 1) * dt
     rotor_speeds = list(scenario_equilibrium(setup).rotor_speeds)
 
-    uav = setup.uavs[0]
-    reduced = ReducedSingleLiftModel(uav.vehicle, setup.payload.mass, uav.cable_length,
-                                     setup.simulation.gravity)
     x0 = initial_state(setup)
-    start = rest_state(world_to_seed_vector(x0[0:3]), world_to_seed_euler(x0[3:6]),
-                       setup.payload.alpha, setup.payload.beta)
-    solution = reduced.simulate(start, rotor_speeds[0], times[-1], t_eval=times)
-    if not solution.success:
-        raise RuntimeError(f'the reduced-model reference failed: {solution.message}')
-    uav_reference, payload_reference = reduced.to_world_positions(solution.y.T)
+    uav_reference, payload_reference = reduced_swing(setup, times)
 
     models = [(f'Baumgarte alpha_f = {gain:g}',
                FormationModel(setup.formation_params(gain, gain))) for gain in gains]

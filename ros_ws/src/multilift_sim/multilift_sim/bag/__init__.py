@@ -3,6 +3,8 @@ record -s mcap` writes them.
 
     mcap_writer    `BagWriter` (a bag written tick by tick, readable up to its last chunk if
                    the process dies) and `recover` (a killed bag's MCAP and metadata rebuilt)
+    mcap_records   the MCAP file below mcap's Writer: unbuffered, Message records packed in one
+                   call each
     metadata_yaml  YAML as rosbag2 (yaml-cpp) writes it: metadata.yaml, offered QoS profiles
     recording      what the recorder decides without ROS: topic specs, which topics, log time
 

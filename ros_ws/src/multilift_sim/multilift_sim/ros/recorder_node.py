@@ -39,7 +39,7 @@
   signal stops at once), close the bag (`metadata.yaml` written) and exit 0. A drain or close
   still running HANG_REPORT s after the signal writes its stacks to stderr (the log). A recorder
   that dies without closing the bag leaves its complete chunks: `multilift run` rebuilds the bag
-  from them and says so (`multilift_tools.cli._bag_state`).
+  from them and says so (`multilift_tools.run_command._bag_state`).
 """
 
 from __future__ import annotations

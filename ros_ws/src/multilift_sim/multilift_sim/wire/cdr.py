@@ -1,86 +1,19 @@
 """CDR (XCDR1, little endian) of the messages a run publishes and records, packed without rclpy.
 
 Each packer compiles one `struct.Struct` for its message layout once (the frame names and the
-sequence lengths of a run are fixed), then packs a message in one call from plain numbers: the
-values come from `wire.msgvalues` and `wire.scene`, the same functions the rclpy builders of
-multilift_sim.ros.messages use. The bytes are rclpy's `serialize_message` output
-with the padding zeroed (rclpy leaves it uninitialised):
-
-- a 4-byte encapsulation header `00 01 00 00` (CDR, little endian), then the message;
-- every primitive aligned to its own size, counted from the end of that header;
-- a string is a uint32 length including the NUL, its bytes, the NUL;
-- a sequence is a uint32 count, then its elements (aligned from the first element);
-- no padding after the last field.
+sequence lengths of a run are fixed; `cdr_layout` builds it by CDR's rules), then packs a
+message in one call from plain numbers: the values come from `wire.msgvalues`, the same
+functions the rclpy builders of multilift_sim.ros.messages use. The scene's messages (/tf,
+the markers) are `cdr_scene`'s.
 """
 from __future__ import annotations
 
-import struct
 from typing import Sequence
 
 import numpy as np
 
+from multilift_sim.wire.cdr_layout import ENCAPSULATION, Layout, header_layout
 from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp
-from multilift_sim.wire.scene import MarkerSpec
-
-ENCAPSULATION = b'\x00\x01\x00\x00'
-_ZERO_VECTOR = (0.0, 0.0, 0.0)
-
-
-class Layout:
-    """Builds a struct format for a CDR message field by field, tracking alignment; `pad`
-    lists the (offset, length) of every padding run in the packed bytes (header included)."""
-
-    def __init__(self) -> None:
-        self._fmt = ['<4s']
-        self._offset = 0  # from the end of the encapsulation header
-        self.pad: list[tuple[int, int]] = []
-
-    def _align(self, size: int) -> None:
-        gap = -self._offset % size
-        if gap:
-            self._fmt.append(f'{gap}x')
-            self.pad.append((4 + self._offset, gap))
-            self._offset += gap
-
-    def primitive(self, code: str, count: int = 1) -> None:
-        """`count` values of struct code `code` (i, I, d, f, ?, B): count args."""
-        size = struct.calcsize(code)
-        if count:
-            self._align(size)
-            self._fmt.append(f'{count}{code}')
-            self._offset += size * count
-
-    def zeros(self, code: str, count: int = 1) -> None:
-        """`count` values of `code` that are always zero: no args."""
-        size = struct.calcsize(code)
-        if count:
-            self._align(size)
-            self._fmt.append(f'{size * count}x')
-            self._offset += size * count
-
-    def string(self, text: str) -> bytes:
-        """A string field whose value is `text` (fixed for the layout): args (length, bytes);
-        returns the bytes to pass."""
-        data = text.encode('utf-8')
-        self.primitive('I')
-        self._fmt.append(f'{len(data) + 1}s')  # struct pads with the NUL
-        self._offset += len(data) + 1
-        return data
-
-    def header(self, frame: str) -> bytes:
-        """std_msgs/Header: args (sec, nanosec, length, frame bytes)."""
-        self.primitive('i')
-        self.primitive('I')
-        return self.string(frame)
-
-    def compile(self) -> struct.Struct:
-        return struct.Struct(''.join(self._fmt))
-
-
-def _header_layout(frame: str) -> tuple[Layout, tuple]:
-    layout = Layout()
-    data = layout.header(frame)
-    return layout, (len(data) + 1, data)
 
 
 class Clock:
@@ -100,7 +33,7 @@ class Odometry:
     """nav_msgs/Odometry with zero covariances, frame `frame`, child `child`."""
 
     def __init__(self, child: str, frame: str = WORLD_FRAME) -> None:
-        layout, self._frame = _header_layout(frame)
+        layout, self._frame = header_layout(frame)
         child_data = layout.string(child)
         self._frame += (len(child_data) + 1, child_data)
         layout.primitive('d', 7)    # pose: position, orientation
@@ -125,7 +58,7 @@ class _Stamped:
     TrackingReference)."""
 
     def __init__(self, floats: int, frame: str) -> None:
-        layout, self._frame = _header_layout(frame)
+        layout, self._frame = header_layout(frame)
         layout.primitive('d', floats)
         self.layout, self._struct = layout, layout.compile()
 
@@ -160,7 +93,7 @@ class FloatSequences:
     g_dot; VirtualConstraintError: error, error_rate): pack(t_ns, *sequences)."""
 
     def __init__(self, lengths: Sequence[int], frame: str = WORLD_FRAME) -> None:
-        layout, self._frame = _header_layout(frame)
+        layout, self._frame = header_layout(frame)
         for length in lengths:
             layout.primitive('I')
             layout.primitive('d', length)
@@ -208,7 +141,7 @@ class FormationEvent:
 
     def pack(self, t_ns: int, kind: str, uav: int, rotor: int, value: float,
              scheduled_time: float, description: str) -> bytes:
-        layout, frame = _header_layout(self._frame)
+        layout, frame = header_layout(self._frame)
         kind_bytes = layout.string(kind)
         layout.primitive('I', 2)
         layout.primitive('d', 2)
@@ -240,7 +173,7 @@ class FormationSnapshot:
         self._rows = 3 * n
         self._structs = {}
         for previous in (0, sum(self._counts)):
-            layout, self._frame = _header_layout(frame)
+            layout, self._frame = header_layout(frame)
             for _ in range(4):                 # position, velocity, euler, body_rates
                 layout.primitive('I')
                 layout.primitive('d', 3 * n)
@@ -324,7 +257,7 @@ class RotorCommand:
     """multilift_msgs/RotorCommand of `n_rotors` rotors: pack(t_ns, speeds, saturated)."""
 
     def __init__(self, n_rotors: int, frame: str) -> None:
-        layout, self._frame = _header_layout(frame)
+        layout, self._frame = header_layout(frame)
         layout.primitive('I')
         layout.primitive('d', n_rotors)
         layout.primitive('I')
@@ -335,85 +268,3 @@ class RotorCommand:
     def pack(self, t_ns: int, speeds: Sequence[float], saturated: Sequence[bool]) -> bytes:
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, self._n, *speeds,
                                  self._n, *saturated)
-
-
-class TFMessage:
-    """tf2_msgs/TFMessage of one TransformStamped per child frame, each from `frame` (or from
-    its entry of `parents`): pack(t_ns, translations, rotations), one (x, y, z) and one
-    (x, y, z, w) per child."""
-
-    def __init__(self, children: Sequence[str], frame: str = WORLD_FRAME,
-                 parents: Sequence[str] | None = None) -> None:
-        layout = Layout()
-        layout.primitive('I')
-        self._names = []
-        for k, child in enumerate(children):
-            frame_data = layout.header(frame if parents is None else parents[k])
-            child_data = layout.string(child)
-            layout.primitive('d', 7)
-            self._names.append((len(frame_data) + 1, frame_data, len(child_data) + 1,
-                                child_data))
-        self.layout, self._struct = layout, layout.compile()
-
-    def pack(self, t_ns: int, translations: Sequence[Sequence[float]],
-             rotations: Sequence[Sequence[float]]) -> bytes:
-        sec, nanosec = stamp(t_ns)
-        args = [ENCAPSULATION, len(self._names)]
-        for (flen, fdata, clen, cdata), translation, rotation in zip(
-                self._names, translations, rotations, strict=True):
-            args += (sec, nanosec, flen, fdata, clen, cdata, *translation, *rotation)
-        return self._struct.pack(*args)
-
-
-class MarkerArray:
-    """visualization_msgs/MarkerArray of `specs` (scene.MarkerSpec; their names, types and
-    point counts fix the layout, their other values are read at every `pack`), frame `frame`."""
-
-    def __init__(self, specs: Sequence[MarkerSpec], frame: str = WORLD_FRAME) -> None:
-        layout = Layout()
-        layout.primitive('I')
-        self._specs = list(specs)
-        self._constant = []  # per marker: (frame length, frame, ns length, ns, id, type, action)
-        for spec in self._specs:
-            frame_data = layout.header(frame)
-            ns_data = layout.string(spec.ns)
-            layout.primitive('i', 3)           # id, type, action
-            layout.primitive('d', 10)          # pose (7), scale (3)
-            layout.primitive('f', 4)           # color
-            layout.zeros('i', 2)               # lifetime
-            layout.zeros('?')                  # frame_locked
-            layout.primitive('I')              # points
-            layout.primitive('d', 3 * len(spec.points))
-            layout.zeros('I')                  # colors: empty
-            layout.string('')                  # texture_resource
-            layout.zeros('i', 2)               # texture.header.stamp
-            layout.string('')                  # texture.header.frame_id
-            layout.string('')                  # texture.format
-            layout.zeros('I')                  # texture.data: empty
-            layout.zeros('I')                  # uv_coordinates: empty
-            layout.string('')                  # text
-            layout.string('')                  # mesh_resource
-            layout.string('')                  # mesh_file.filename
-            layout.zeros('I')                  # mesh_file.data: empty
-            layout.zeros('?')                  # mesh_use_embedded_materials
-            self._constant.append((len(frame_data) + 1, frame_data, len(ns_data) + 1, ns_data))
-        self.layout, self._struct = layout, layout.compile()
-
-    def pack(self, t_ns: int) -> bytes:
-        """The array of the specs' current values, every marker stamped t_ns."""
-        sec, nanosec = stamp(t_ns)
-        args = [ENCAPSULATION, len(self._specs)]
-        empty = (1, b'')
-        for spec, (flen, fdata, nlen, ndata) in zip(self._specs, self._constant):
-            args += (sec, nanosec, flen, fdata, nlen, ndata, spec.id, spec.type, spec.action,
-                     *spec.position, *spec.orientation, *spec.scale, *spec.color,
-                     len(spec.points))
-            for point in spec.points:
-                args += point
-            args += empty  # texture_resource
-            args += empty  # texture.header.frame_id
-            args += empty  # texture.format
-            args += empty  # text
-            args += empty  # mesh_resource
-            args += empty  # mesh_file.filename
-        return self._struct.pack(*args)

@@ -14,7 +14,7 @@ from typing import Sequence
 import numpy as np
 
 from multilift_sim import kernels
-from multilift_sim.wire import cdr
+from multilift_sim.wire import cdr, cdr_scene
 from multilift_sim.wire.msgvalues import (IDENTITY, PAYLOAD_FRAME, SNAPSHOT_BLOCKS, WORLD_FRAME,
                                           formation_event, formation_snapshot, uav_frame, vec3)
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS,
@@ -58,11 +58,11 @@ class SimulatorMessages:
         self._attach = list(scenario.payload.attach_points or ())
         frames = [uav_frame(i) for i in range(1, n + 1)] + [PAYLOAD_FRAME]
         attach_frames = [f'{PAYLOAD_FRAME}/attach{i}' for i in range(1, len(self._attach) + 1)]
-        self._tf = cdr.TFMessage(frames + attach_frames, parents=[WORLD_FRAME] * len(frames)
+        self._tf = cdr_scene.TFMessage(frames + attach_frames, parents=[WORLD_FRAME] * len(frames)
                                  + [PAYLOAD_FRAME] * len(attach_frames))
         self._state = cdr.formation_state(n)
         self._scene = FormationScene(scenario)
-        self._markers = cdr.MarkerArray(self._scene.specs)
+        self._markers = cdr_scene.MarkerArray(self._scene.specs)
         self._event = cdr.FormationEvent()
 
     def state(self, snap: Snapshot, gust: Sequence[float],

@@ -80,7 +80,8 @@ def _still_air(name: str, progress: _ProgressFile) -> dict:
 def _modal_case(figures: Path, progress: _ProgressFile) -> dict:
     """Modal analyses of the twin-lift (Fig. 2.12) and the V at their Eq. 2.73 equilibria."""
     from multilift_sim.formation_params import StateLayout
-    from multilift_sim.modal import coordinate_names, scenario_modal_analysis
+    from multilift_sim.analysis.coordinates import coordinate_names
+    from multilift_sim.analysis.modal import scenario_modal_analysis
     from multilift_tools.modal_cli import plot_eigenvalues
 
     out = {}

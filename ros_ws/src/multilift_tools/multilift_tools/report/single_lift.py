@@ -1,6 +1,6 @@
 """The single-lift numbers of seed §2.8.1 and §4.1 (`single_lift_table`), which
 tests/unit/test_reproduction.py regenerates and compares with the committed report: the release,
-the linearised open loop (multilift_sim.modal), the periods of the simulated swing, of the
+the linearised open loop (multilift_sim.analysis.modal), the periods of the simulated swing, of the
 reduced model and of the amplitude law, the Baumgarte study and the static tension; and their
 markdown (`render_table`). World frame, z up, SI units.
 """
@@ -90,27 +90,6 @@ def swing_period(t: np.ndarray, uav: np.ndarray, payload: np.ndarray) -> float:
     return float(np.mean(np.diff(crossings)))
 
 
-def reduced_swing(scenario: Scenario, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(UAV, payload) world positions (T, 3) [m] of the reduced single-lift model (seed Eq.
-    2.34, DOP853 rtol 1e-10) from the scenario's release, rotor speeds held at Eq. 2.73."""
-    from multilift_sim.frames import world_to_seed_euler, world_to_seed_vector
-    from multilift_sim.modal import scenario_equilibrium
-    from multilift_sim.reduced_model import ReducedSingleLiftModel, rest_state
-    from multilift_sim.start import initial_state
-
-    uav = scenario.uavs[0]
-    model = ReducedSingleLiftModel(uav.vehicle, scenario.payload.mass, uav.cable_length,
-                                   scenario.simulation.gravity)
-    x0 = initial_state(scenario)
-    start = rest_state(world_to_seed_vector(x0[0:3]), world_to_seed_euler(x0[3:6]),
-                       scenario.payload.alpha, scenario.payload.beta)
-    solution = model.simulate(start, scenario_equilibrium(scenario).rotor_speeds[0],
-                              float(times[-1]), t_eval=times)
-    if not solution.success:
-        raise RuntimeError(f'reduced single-lift model: {solution.message}')
-    return model.to_world_positions(solution.y.T)
-
-
 def release_amplitude(scenario: Scenario) -> float:
     """Angle [rad] of the released cable from the vertical: cos = cos(alpha) cos(beta)."""
     return math.acos(math.cos(scenario.payload.alpha) * math.cos(scenario.payload.beta))
@@ -141,19 +120,19 @@ def single_lift_table(study_dir: str | Path | None = None) -> list[dict]:
 
     Rows (dicts with key, quantity, seed, ours, command, value; `render_row` makes the markdown):
     the release r_p(0); size of A, eigenvalues and period of the linearised open loop
-    (multilift_sim.modal); the periods of the simulated swing (run_headless, the formation DAE
-    of Algorithm 1) released at 1/1 deg and at the seed's 15/25 deg, of the nonlinear reduced
-    model (Eq. 2.34) at 15/25 deg and of the plane-pendulum amplitude law; the Baumgarte study
-    (max |g| for alpha_f = 0, 20, 100; alpha_f = 100 against the reduced model) over
-    BAUMGARTE_DURATION; the scenario's own run against the reduced model; the static tension
+    (multilift_sim.analysis.modal); the periods of the simulated swing (run_headless, the
+    formation DAE of Algorithm 1) released at 1/1 deg and at the seed's 15/25 deg, of the
+    nonlinear reduced model (Eq. 2.34) at 15/25 deg and of the plane-pendulum amplitude law; the
+    Baumgarte study (max |g| for alpha_f = 0, 20, 100; alpha_f = 100 against the reduced model)
+    over BAUMGARTE_DURATION; the scenario's own run against the reduced model; the static tension
     against m_p g. `study_dir`: where the Baumgarte study writes its table and figures (Fig.
     4.2, 4.3); default a temporary directory, removed.
     """
+    from multilift_sim.analysis.modal import scenario_modal_analysis
     from multilift_sim.formation_params import StateLayout
     from multilift_sim.frames import world_to_seed_vector
-    from multilift_sim.modal import scenario_modal_analysis
     from multilift_sim.start import initial_state
-    from multilift_tools.studies import baumgarte_study
+    from multilift_tools.studies import baumgarte_study, reduced_swing
 
     rows = []
     scenario = _swing_scenario()

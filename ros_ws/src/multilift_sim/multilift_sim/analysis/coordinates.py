@@ -1,0 +1,158 @@
+"""The formation's coordinates q_f at rest, for its analysis (seed Eq. 2.42, 2.47, 2.65-2.67):
+their names, the inertia M_f, the constraint residuals g and Jacobian G, and a packed state
+moved by (dq, dq_dot). World frame (z up), SI units, q_f of docs/conventions.md (6n + 3
+coordinates; a rigid-body payload's rotation vector after them: 6n + 6); the derivation is in
+the package docstring (multilift_sim/analysis/__init__.py).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from multilift_sim.constraints import cable_residuals, constraint_jacobian
+from multilift_sim.formation_params import FormationParams, StateLayout
+from multilift_sim.kinematics import rotation_matrix
+from multilift_sim.multirotor import euler_mass_matrix
+from multilift_sim.physics.rigid_payload import payload_rotation
+
+ROTATION_NAMES = ('rx_p', 'ry_p', 'rz_p')  # a rigid payload's rotation vector, payload frame
+
+
+def quaternion_rotation(quaternion: ArrayLike) -> np.ndarray:
+    """R_p (3, 3), payload frame -> world, of a unit quaternion (w, x, y, z)."""
+    state = np.concatenate((np.zeros(1), np.asarray(quaternion, dtype=float)))
+    return payload_rotation(state, 1)
+
+
+def cable_offsets(params: FormationParams, uavs: np.ndarray, payload: np.ndarray,
+                  rotation: np.ndarray | None, uav_euler: np.ndarray | None = None
+                  ) -> np.ndarray:
+    """d_i (n, 3) [m], world: from UAV i's centre to where cable i holds the payload, r_p - r_i
+    (a point payload) or r_p + R_p b_i - r_i (a rigid body of attitude `rotation`); with
+    attach points a_i (params.uav_attach_points) and the UAVs' Euler angles `uav_euler`
+    (n, 3), from r_i + R_i a_i instead."""
+    if not params.rigid_payload:
+        offsets = payload - uavs
+    else:
+        offsets = payload + np.asarray(params.payload_attach_points) @ rotation.T - uavs
+    if params.uav_attach_points is not None and uav_euler is not None:
+        offsets = offsets - attach_offsets(params, uav_euler)
+    return offsets
+
+
+def attach_offsets(params: FormationParams, uav_euler: np.ndarray) -> np.ndarray:
+    """o_i = R_i a_i (n, 3) [m], world: each cable's upper end from its UAV's centre."""
+    attach = np.asarray(params.uav_attach_points, dtype=float)
+    return np.einsum('ijk,ik->ij', rotation_matrix(np.asarray(uav_euler, dtype=float)), attach)
+
+
+def _attach_derivatives(euler: np.ndarray, attach: np.ndarray) -> np.ndarray:
+    """d(R a)/d(phi, theta, psi) (3, 3) [m/rad], columns, of R = Rz(psi) Ry(theta) Rx(phi):
+    R (e_x x a), Rz Ry (e_y x Rx a), e_z x R a."""
+    phi, theta, psi = (float(v) for v in euler)
+    r_x = rotation_matrix([phi, 0.0, 0.0])
+    r_y = rotation_matrix([0.0, theta, 0.0])
+    r_z = rotation_matrix([0.0, 0.0, psi])
+    rotation = r_z @ r_y @ r_x
+    return np.column_stack((rotation @ np.cross([1.0, 0.0, 0.0], attach),
+                            r_z @ r_y @ np.cross([0.0, 1.0, 0.0], r_x @ attach),
+                            np.cross([0.0, 0.0, 1.0], rotation @ attach)))
+
+
+def cable_moments(params: FormationParams, offsets: np.ndarray,
+                  rotation: np.ndarray) -> np.ndarray:
+    """c_i = b_i x R_p^T d_i (n, 3) [m^2], payload frame (docs/rigid_payload.md)."""
+    return np.cross(np.asarray(params.payload_attach_points), offsets @ rotation)
+
+
+def _state_rotation(layout: StateLayout, x: np.ndarray) -> np.ndarray | None:
+    """A rigid payload's R_p (3, 3) at state x; None for a point payload."""
+    return quaternion_rotation(layout.payload_quaternion(x)) if layout.rigid_payload else None
+
+
+def coordinate_names(n_uavs: int, rigid_payload: bool = False) -> tuple[str, ...]:
+    """Names of the 6n + 3 coordinates q_f: x1 y1 z1 phi1 theta1 psi1 ... x_p y_p z_p, and a
+    rigid payload's rotation vector rx_p ry_p rz_p [rad] (payload frame) after them."""
+    names = [f'{c}{i + 1}' for i in range(n_uavs)
+             for c in ('x', 'y', 'z', 'phi', 'theta', 'psi')]
+    return tuple(names + ['x_p', 'y_p', 'z_p'] + (list(ROTATION_NAMES) if rigid_payload else []))
+
+
+def mass_matrix(params: FormationParams, uav_euler: ArrayLike) -> np.ndarray:
+    """Formation inertia M_f (Eq. 2.47): blocks m_i I, M_eta,i = W^T J W (Eq. 2.24), m_p I;
+    a rigid payload's J_p = diag(J_xx, J_yy, J_zz) [kg m^2] (payload frame) after them."""
+    n = params.n_uavs
+    euler = np.asarray(uav_euler, dtype=float).reshape(n, 3)
+    size = 6 * n + (6 if params.rigid_payload else 3)
+    mass = np.zeros((size, size))
+    for i, uav in enumerate(params.uavs):
+        mass[6 * i:6 * i + 3, 6 * i:6 * i + 3] = uav.mass * np.eye(3)
+        mass[6 * i + 3:6 * i + 6, 6 * i + 3:6 * i + 6] = euler_mass_matrix(uav.inertia, euler[i])
+    mass[6 * n:6 * n + 3, 6 * n:6 * n + 3] = params.payload_mass * np.eye(3)
+    if params.rigid_payload:
+        mass[6 * n + 3:, 6 * n + 3:] = np.diag(params.payload_inertia)
+    return mass
+
+
+def formation_jacobian(params: FormationParams, x: np.ndarray) -> np.ndarray:
+    """G [m] (n, 6n + 3) at state x (Eq. 2.65-2.67, constraints.constraint_jacobian); a rigid
+    payload's (n, 6n + 6) with the columns dg_i/dtheta = 2 c_i [m^2] of its rotation vector
+    (R_p = R Exp(theta), c_i = b_i x R^T d_i at x's attitude R; docs/rigid_payload.md).
+    Cables held off the UAVs' centres: d_i from r_i + R_i a_i, and the UAVs' Euler columns
+    dg_i/deta_i = -2 d_i . d(R_i a_i)/deta_i [m^2/rad] (package docstring)."""
+    layout = StateLayout(params.n_uavs, params.rigid_payload)
+    uavs, payload = layout.uav_positions(x), layout.payload_position(x)
+    attached = params.uav_attach_points is not None
+    if not params.rigid_payload and not attached:
+        return constraint_jacobian(uavs, payload)
+    n = params.n_uavs
+    rotation = _state_rotation(layout, x)
+    euler = layout.uav_euler(x)
+    offsets = cable_offsets(params, uavs, payload, rotation, euler)
+    jacobian = np.zeros((n, 6 * n + (6 if params.rigid_payload else 3)))
+    for i in range(n):
+        jacobian[i, 6 * i:6 * i + 3] = -2.0 * offsets[i]
+        jacobian[i, 6 * n:6 * n + 3] = 2.0 * offsets[i]
+        if attached:
+            jacobian[i, 6 * i + 3:6 * i + 6] = -2.0 * offsets[i] @ _attach_derivatives(
+                euler[i], np.asarray(params.uav_attach_points[i], dtype=float))
+    if params.rigid_payload:
+        jacobian[:, 6 * n + 3:] = 2.0 * cable_moments(params, offsets, rotation)
+    return jacobian
+
+
+def formation_residuals(params: FormationParams, x: np.ndarray) -> np.ndarray:
+    """g_i = |d_i|^2 - l_i^2 [m^2] (n,) at state x (Eq. 2.42; a rigid payload's d_i, and from
+    the UAVs' attach points r_i + R_i a_i when params.uav_attach_points)."""
+    layout = StateLayout(params.n_uavs, params.rigid_payload)
+    uavs, payload = layout.uav_positions(x), layout.payload_position(x)
+    if not params.rigid_payload and params.uav_attach_points is None:
+        return cable_residuals(uavs, payload, params.cable_lengths)
+    offsets = cable_offsets(params, uavs, payload, _state_rotation(layout, x),
+                             layout.uav_euler(x))
+    return np.einsum('ij,ij->i', offsets, offsets) - np.asarray(params.cable_lengths) ** 2
+
+
+def displaced_state(layout: StateLayout, x: np.ndarray, dq: np.ndarray,
+                    dq_dot: np.ndarray) -> np.ndarray:
+    """The packed state x moved by dq (q_f [m, rad], a rigid payload's rotation vector theta
+    [rad], payload frame, after it) and dq_dot (q_f_dot [m/s, rad/s], then omega_p [rad/s]):
+    x + (dq, dq_dot) for a point payload; a rigid one's attitude q (x) Exp(theta) (a body-frame
+    rotation, the quaternion kept unit) and body rates omega_p + dq_dot's last three."""
+    if not layout.rigid_payload:
+        return x + np.concatenate((dq, dq_dot))
+    nq = layout.n_coordinates
+    out = np.array(x, dtype=float)
+    out[:nq] += dq[:nq]
+    out[nq:2 * nq] += dq_dot[:nq]
+    theta = np.asarray(dq[nq:nq + 3], dtype=float)
+    angle = float(np.linalg.norm(theta))
+    w, v = layout.payload_quaternion(x)[0], layout.payload_quaternion(x)[1:]
+    turn_w = math.cos(0.5 * angle)
+    turn_v = theta * (0.5 if angle == 0.0 else math.sin(0.5 * angle) / angle)
+    layout.payload_quaternion(out)[:] = np.concatenate((
+        [w * turn_w - v @ turn_v], w * turn_v + turn_w * v + np.cross(v, turn_v)))
+    layout.payload_body_rates(out)[:] += dq_dot[nq:nq + 3]
+    return out

@@ -1,0 +1,105 @@
+"""What `multilift run` shows of a run: its simulated time and real-time factor while it runs
+(`Progress`), and the summary at its end from what each node left (`read_summaries`,
+`print_summary`: max |g|, rotor speeds, saturation, tensions, swing, tracking, formation
+errors; with a bag also BAG/summary.json). Times in [s], lengths in [m].
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+
+class Progress:
+    """Simulated time and real-time factor, on one terminal line (or a line every 10 %)."""
+
+    def __init__(self, path: Path | None, tty: bool):
+        self.path = path
+        self.tty = tty
+        self.last_decile = -1
+
+    def __call__(self) -> None:
+        """Show what the simulator node last wrote to the progress file."""
+        try:
+            t, t_max, wall = (float(v) for v in self.path.read_text().split())
+        except (OSError, ValueError):
+            return
+        self.show(t, t_max, wall)
+
+    def show(self, t: float, t_max: float, wall: float) -> None:
+        """Simulated time t of t_max [s] after `wall` seconds."""
+        rtf = t / wall if wall > 0 else 0.0
+        if self.tty:
+            print(f'\r  t = {t:7.2f} / {t_max:.1f} s   {rtf:5.1f}x real time ',
+                  end='', flush=True)
+        elif t_max > 0 and int(10 * t / t_max) > self.last_decile:
+            self.last_decile = int(10 * t / t_max)
+            print(f'  t = {t:.1f} / {t_max:.1f} s   {rtf:.1f}x real time', flush=True)
+
+    def close(self) -> None:
+        if self.tty:
+            print()
+
+
+def read_summaries(summary_dir: Path, scenario) -> dict:
+    """What each node of a run left in `summary_dir` (sim, leader, follower2, ...)."""
+    data = {}
+    parts = ['sim', 'leader'] + [f'follower{i}' for i in range(2, scenario.n_uavs + 1)]
+    for part in parts:
+        path = summary_dir / f'{part}.json'
+        if path.is_file():
+            data[part] = json.loads(path.read_text())
+    return data
+
+
+def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
+    """Print the end-of-run summary; with a bag, also leave it as BAG/summary.json."""
+    sim = data.get('sim', {})
+    lines = []
+    if sim:
+        wall = sim.get('wall_time') or 0.0
+        t = sim.get('simulated_time', 0.0)
+        lines.append(f'{name}: {t:.1f} s simulated in {wall:.1f} s wall '
+                     f'({t / wall if wall else 0:.1f}x real time)')
+        tol = scenario.simulation.constraint_tolerance
+        lines.append(f'  max |g|          {sim["max_abs_constraint"]:.3g} m^2 '
+                     f'(tolerance {tol:g})')
+        lines.append(f'  max |g_dot|      {sim["max_abs_constraint_rate"]:.3g} m^2/s')
+        for i, (w, s) in enumerate(zip(sim['max_rotor_speed'], sim['saturated_time'])):
+            limit = scenario.uavs[i].vehicle.rotor_speed_max
+            lines.append(f'  uav{i + 1} rotors      max {w:.1f} rad/s (limit {limit:g}), '
+                         f'saturated {s:.2f} s')
+        lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} N')
+        if any(sim.get('slack_time', [])):
+            lines.append('  slack cables     ' + ', '.join(
+                f'cable {i + 1} {s:.2f} s' for i, s in enumerate(sim['slack_time']) if s > 0))
+        if 'max_payload_swing' in sim:
+            lines.append(f'  payload swing    max {sim["max_payload_swing"]:.3f} m, '
+                         f'rms {sim["rms_payload_swing"]:.3f} m (horizontal, from its rest '
+                         'place under the UAVs)')
+        if scenario.gusts:
+            lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} m/s')
+        if sim.get('seeds'):
+            lines.append('  seeds            ' + ', '.join(
+                f'{what} {seed}' for what, seed in sim['seeds'].items()))
+        for event in sim.get('events', []):
+            lines.append(f'  event at {event["time"]:g} s   {event["description"]}')
+    control = scenario.control
+    if control.input_shaping != 'none' or control.swing_stiffness or control.swing_damping:
+        lines.append(f'  payload feedback {control.input_shaping} shaping of the corners, swing '
+                     f'k_s {control.swing_stiffness:g}, k_d {control.swing_damping:g}, a_max '
+                     f'{control.swing_limit:g} m/s^2 (control.payload_feedback)')
+    leader = data.get('leader')
+    if leader and leader.get('answered_states'):
+        lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} m, '
+                     f'rms {leader["rms_tracking_error"]:.3f} m')
+    for i in range(2, scenario.n_uavs + 1):
+        follower = data.get(f'follower{i}')
+        if follower and follower.get('answered_states'):
+            # the largest row and the mean norm of its rows: the mean can exceed the max
+            lines.append(f'  uav{i} formation  largest |g_vc| row '
+                         f'{follower["max_abs_formation_error"]:.3f}, mean |g_vc| '
+                         f'{follower["mean_formation_error_norm"]:.3f} (m)')
+    if bag is not None:
+        lines.append(f'  bag              {bag}')
+        (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))
+    print('\n'.join(lines))

@@ -17,6 +17,11 @@ SHAPES = {'box': 'its edges along the payload frame x, y, z',
           'cylinder': 'its length along x and its radius'}
 SHAPE_SIZES = {'box': 3, 'cylinder': 2}
 
+# how far outside its shape an attach point may lie: the larger of ATTACH_MARGIN [m] and
+# ATTACH_MARGIN_SHARE of the shape's largest dimension (a cable tied around an edge)
+ATTACH_MARGIN = 1e-3
+ATTACH_MARGIN_SHARE = 0.01
+
 
 def solid_inertia(shape: str, mass: float, size: tuple[float, ...]) -> tuple[float, float, float]:
     """Principal moments [kg m^2] of the uniform solid `shape` of `mass` [kg] and `size` [m],
@@ -38,3 +43,33 @@ def is_rigid_body_inertia(inertia: tuple[float, float, float]) -> bool:
     a, b, c = inertia
     return (min(inertia) > 0 and all(math.isfinite(v) for v in inertia)
             and a <= b + c and b <= a + c and c <= a + b)
+
+
+def shape_extent(shape: str, size: tuple[float, ...]) -> str:
+    """The shape's region in words, payload frame [m] (an error message's rule)."""
+    if shape == 'box':
+        a, b, c = (v / 2.0 for v in size)
+        return f'the box |x| <= {a:g}, |y| <= {b:g}, |z| <= {c:g}'
+    if shape == 'cylinder':
+        length, radius = size
+        return f'the cylinder |x| <= {length / 2.0:g}, sqrt(y^2 + z^2) <= {radius:g}'
+    raise ValueError(f'unknown payload shape {shape!r} (known: {", ".join(SHAPES)})')
+
+
+def attach_margin(shape: str, size: tuple[float, ...]) -> float:
+    """How far outside `shape` an attach point may lie [m]: ATTACH_MARGIN or
+    ATTACH_MARGIN_SHARE of the largest dimension (a cylinder's: its length or diameter)."""
+    largest = max(size[0], 2.0 * size[1]) if shape == 'cylinder' else max(size)
+    return max(ATTACH_MARGIN, ATTACH_MARGIN_SHARE * largest)
+
+
+def distance_outside(shape: str, size: tuple[float, ...], point: tuple[float, ...]) -> float:
+    """Euclidean distance [m] from `point` (payload frame [m]) to the solid `shape` of `size`
+    centred at the payload frame's origin: 0 on or inside it."""
+    x, y, z = point
+    if shape == 'box':
+        return math.sqrt(sum(max(abs(p) - s / 2.0, 0.0) ** 2 for p, s in zip(point, size)))
+    if shape == 'cylinder':
+        length, radius = size
+        return math.hypot(max(abs(x) - length / 2.0, 0.0), max(math.hypot(y, z) - radius, 0.0))
+    raise ValueError(f'unknown payload shape {shape!r} (known: {", ".join(SHAPES)})')

@@ -22,6 +22,7 @@ from multilift_tools.bagdata import Run
 from multilift_tools.metrics import interp_rows
 from multilift_tools.plot_style import (PAYLOAD_COLOR, WORLD, Parser, equal_3d, parse_and_load,
                                         plt, uav_color, uav_label)
+from multilift_tools.plots.scene import released_cables
 
 
 @dataclass(frozen=True)
@@ -34,6 +35,7 @@ class AnimationData:
     payload: np.ndarray
     tensions: np.ndarray
     frames: np.ndarray
+    attached: np.ndarray | None = None  # (n, T) bool: the cable holds the payload (not released)
 
 
 def animation_data(run: Run, fps: float, speed: float) -> AnimationData:
@@ -41,11 +43,14 @@ def animation_data(run: Run, fps: float, speed: float) -> AnimationData:
     t = run.t
     uavs = run.uav_positions()
     payload = interp_rows(t, run.payload_time, run.payload_position())
+    attached = np.ones((uavs.shape[0], len(t)), dtype=bool)
+    for i, release in released_cables(run).items():
+        attached[i - 1] = t < release
     tensions = (interp_rows(t, run.formation_time, run.tensions()) if run.has(FORMATION_STATE)
                 else np.zeros((len(t), run.n_uavs)))
     times = np.arange(t[0], t[-1] + 1e-9, speed / fps)
     frames = np.unique(np.clip(np.searchsorted(t, times), 0, len(t) - 1))
-    return AnimationData(t, uavs, payload, tensions, frames)
+    return AnimationData(t, uavs, payload, tensions, frames, attached)
 
 
 def _tension_norm(tensions: np.ndarray) -> colors.Normalize:
@@ -94,8 +99,10 @@ class FormationAnimator:
 
     def _segments(self, k: int) -> np.ndarray:
         d = self.data
-        return np.stack([d.uavs[:, k], np.repeat(d.payload[k][None], d.uavs.shape[0], 0)],
-                        axis=1)
+        ends = np.repeat(d.payload[k][None], d.uavs.shape[0], 0)
+        if d.attached is not None:  # a released cable: no segment (both ends at its UAV)
+            ends[~d.attached[:, k]] = d.uavs[~d.attached[:, k], k]
+        return np.stack([d.uavs[:, k], ends], axis=1)
 
     def _path(self, points: np.ndarray, k: int) -> np.ndarray:
         """points[:k + 1] thinned to every `stride`-th sample, ending exactly at sample k."""

@@ -5,6 +5,7 @@ one `Series` per known topic (times from the header stamps, simulated seconds [s
 and typed accessors in the units and frames of README.md / docs/conventions.md: world frame
 `world`, z up, SI units; UAV index i counts from 1 (1 = the leader), as the topic names do.
 `summary.json` next to `metadata.yaml` (written by `scripts/multilift run`) is read when present.
+What each message type becomes is `bagfields`.
 
 `run_scenario(run)` finds the scenario the run was made from (by the summary's scenario name, or
 a name/path given) for what the bag does not carry: rotor limits, k_T, gusts, formation geometry.
@@ -14,86 +15,18 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
 from multilift_sim.kinematics import euler_from_quaternion
-from multilift_sim.topics import (ATTITUDE_SETPOINT, ATTITUDE_SETPOINT_TYPE, EVENTS,
-                                  FORMATION_ERROR, FORMATION_ERROR_TYPE, FORMATION_EVENT_TYPE,
-                                  FORMATION_STATE, FORMATION_STATE_TYPE,
-                                  ODOM, ODOMETRY_TYPE, PAYLOAD_GUST, PAYLOAD_ODOM,
-                                  REFERENCE_TOPIC, ROTOR_CMD, ROTOR_COMMAND_TYPE,
-                                  TRACKING_REFERENCE_TYPE, VECTOR3_STAMPED_TYPE, topic_type,
+from multilift_sim.topics import (ATTITUDE_SETPOINT, EVENTS, FORMATION_ERROR, FORMATION_STATE,
+                                  ODOM, PAYLOAD_GUST, PAYLOAD_ODOM, REFERENCE_TOPIC, ROTOR_CMD,
                                   uav_topic)
+from multilift_tools.bagfields import EXTRACT, RunDataError, wanted_type
 
 if TYPE_CHECKING:
     from multilift_sim.scenario import Scenario
-
-
-class RunDataError(ValueError):
-    """A bag could not be read as a multilift run, or lacks a topic; says which bag and why."""
-
-
-def _vec(v: Any) -> list[float]:
-    return [float(v.x), float(v.y), float(v.z)]
-
-
-def _odometry(msg: Any) -> dict[str, list[float]]:
-    pose, twist = msg.pose.pose, msg.twist.twist
-    q = pose.orientation
-    return {'position': _vec(pose.position),
-            'orientation': [float(q.x), float(q.y), float(q.z), float(q.w)],
-            'linear': _vec(twist.linear), 'angular': _vec(twist.angular)}
-
-
-def _formation_state(msg: Any) -> dict[str, Any]:
-    # bags from before the `taut` field (rigid cables) hold every cable taut
-    taut = getattr(msg, 'taut', None)
-    if taut is None or len(taut) != len(msg.cable_tension):
-        taut = [True] * len(msg.cable_tension)
-    return {'tension': msg.cable_tension, 'g': msg.constraint_position,
-            'g_dot': msg.constraint_velocity, 'taut': [bool(v) for v in taut]}
-
-
-def _rotor_command(msg: Any) -> dict[str, Any]:
-    return {'omega': msg.angular_velocity, 'saturated': msg.saturated}
-
-
-def _attitude_setpoint(msg: Any) -> dict[str, Any]:
-    return {'euler': [float(msg.roll), float(msg.pitch), float(msg.yaw)],
-            'thrust': float(msg.thrust)}
-
-
-def _reference(msg: Any) -> dict[str, Any]:
-    return {'position': _vec(msg.position), 'velocity': _vec(msg.velocity),
-            'acceleration': _vec(msg.acceleration)}
-
-
-def _formation_error(msg: Any) -> dict[str, Any]:
-    return {'error': msg.error, 'error_rate': msg.error_rate}
-
-
-def _vector3_stamped(msg: Any) -> dict[str, Any]:
-    return {'vector': _vec(msg.vector)}
-
-
-def _formation_event(msg: Any) -> dict[str, Any]:
-    return {'type': str(msg.type), 'uav': int(msg.uav), 'description': str(msg.description)}
-
-
-_EXTRACT: dict[str, Callable[[Any], dict[str, Any]]] = {
-    ODOMETRY_TYPE: _odometry, FORMATION_STATE_TYPE: _formation_state,
-    ROTOR_COMMAND_TYPE: _rotor_command, ATTITUDE_SETPOINT_TYPE: _attitude_setpoint,
-    TRACKING_REFERENCE_TYPE: _reference, FORMATION_ERROR_TYPE: _formation_error,
-    VECTOR3_STAMPED_TYPE: _vector3_stamped, FORMATION_EVENT_TYPE: _formation_event,
-}
-
-
-def _wanted_type(topic: str) -> str | None:
-    """The message type a multilift topic has, or None for a topic this module ignores."""
-    wanted = topic_type(topic)
-    return wanted if wanted in _EXTRACT else None
 
 
 @dataclass(frozen=True)
@@ -372,7 +305,7 @@ def load_run(bag_dir: str | Path) -> Run:
     rows: dict[str, list[dict[str, Any]]] = {}
     try:
         with AnyReader([path]) as reader:
-            connections = [c for c in reader.connections if _wanted_type(c.topic) == c.msgtype]
+            connections = [c for c in reader.connections if wanted_type(c.topic) == c.msgtype]
             # (an empty list would mean every connection to rosbags)
             messages = reader.messages(connections=connections) if connections else ()
             for connection, _, raw in messages:
@@ -380,7 +313,7 @@ def load_run(bag_dir: str | Path) -> Run:
                 stamp = msg.header.stamp
                 stamps.setdefault(connection.topic, []).append(
                     stamp.sec + 1e-9 * stamp.nanosec)
-                rows.setdefault(connection.topic, []).append(_EXTRACT[connection.msgtype](msg))
+                rows.setdefault(connection.topic, []).append(EXTRACT[connection.msgtype](msg))
     except AnyReaderError as exc:
         raise RunDataError(f'cannot read bag {path}: {exc}') from None
     except Exception as exc:  # noqa: BLE001 - a corrupt file raises many kinds of error

@@ -2,7 +2,8 @@
 
 Everything is drawn in the world frame (z up, SI units) from the bag (`bagdata.load_run`);
 vehicle parameters the bag does not carry (rotor limits, k_T, gusts, formation geometry) come
-from the scenario named in the bag's summary.json, or `--scenario`. One figure per function;
+from the scenario named in the bag's summary.json, or `--scenario`. One figure per function
+(the views in space and the rotors' in `plots/`, FIGURES the registry of all);
 the Agg backend (plot_style), no display needed. Exit codes: 0 done, 2 bad input (one `error:`
 line).
 """
@@ -16,116 +17,22 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_STATE, PAYLOAD_GUST,
-                                  PAYLOAD_ODOM, REFERENCE_TOPIC, ROTOR_CMD, uav_topic)
-from multilift_tools.bagdata import Run, RunDataError, rotor_limits
+from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_ERROR, FORMATION_STATE,
+                                  PAYLOAD_GUST, PAYLOAD_ODOM, REFERENCE_TOPIC, ROTOR_CMD,
+                                  uav_topic)
+from multilift_tools.bagdata import Run, RunDataError
 from multilift_tools.metrics import interp_rows
-from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, SATURATION_GREY, WORLD,
-                                        Context, Parser, equal_3d, finish_time_axes,
-                                        formation_row_labels, legend, mark_events,
-                                        parse_and_load, plot_context, plt, save_figure,
-                                        shade_flags, uav_color, uav_label, uav_width,
-                                        value_span, vehicle_of)
+from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, WORLD, Context, Parser,
+                                        finish_time_axes, formation_row_labels, legend,
+                                        mark_events, parse_and_load, plot_context, plt,
+                                        save_figure, shade_flags, uav_color, uav_label,
+                                        uav_width)
+from multilift_tools.plots.rotors import fig_rotor_speeds, fig_thrust
+from multilift_tools.plots.scene import released_cables
+from multilift_tools.plots.views import fig_top_view, fig_trajectories_3d
 
 if TYPE_CHECKING:
-    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
-
-    from multilift_sim.scenario import Scenario
-
-
-def fig_trajectories_3d(ctx: Context) -> Figure:
-    """3-D paths of the UAVs and the payload, with the cables at the start and the end."""
-    run = ctx.run
-    r, rp = run.uav_positions(), interp_rows(run.t, run.payload_time, run.payload_position())
-    fig = plt.figure(figsize=(10, 6.5))
-    ax = fig.add_axes((-0.02, 0.0, 0.8, 0.94), projection='3d')
-    for i in range(1, run.n_uavs + 1):
-        ax.plot(*r[i - 1].T, color=uav_color(i), label=uav_label(i), lw=1.4)
-    ax.plot(*rp.T, color=PAYLOAD_COLOR, lw=1.4, label='payload')
-    for k, (style, what) in enumerate(((':', 'start'), ('--', 'end'))):
-        idx = 0 if k == 0 else -1
-        for i in range(run.n_uavs):
-            ax.plot(*np.stack([r[i, idx], rp[idx]]).T, color='0.45', ls=style, lw=1.0,
-                    label=f'cables at {what} (t = {run.t[idx]:.0f} s)' if i == 0 else None)
-        ax.scatter(*r[:, idx].T, color=[uav_color(i) for i in range(1, run.n_uavs + 1)],
-                   marker='o' if k == 0 else 's', s=30, depthshade=False)
-        ax.scatter(*rp[idx], color=PAYLOAD_COLOR, marker='o' if k == 0 else 's', s=30,
-                   depthshade=False)
-    equal_3d(ax, np.concatenate([r.reshape(-1, 3), rp]))
-    ax.set_xlabel('x [m]')
-    ax.set_ylabel('y [m]')
-    ax.set_zlabel('z [m]')
-    ax.plot([], [], 'o', color='0.3', label='start')
-    ax.plot([], [], 's', color='0.3', label='end')
-    fig.suptitle(f'{run.label}: trajectories ({WORLD})')
-    fig.legend(loc='center right', fontsize='small')
-    return fig
-
-
-def _gust_regions(ax: Axes, scenario: Scenario | None) -> None:
-    if scenario is None:
-        return
-    for k, gust in enumerate(scenario.gusts, start=1):
-        cx, cy = gust.center
-        ax.add_patch(plt.Circle((cx, cy), gust.gradient_distance, color='tab:cyan',
-                                alpha=0.25, lw=0,
-                                label='gust regions (radius H)' if k == 1 else None))
-        dx, dy = gust.direction[0], gust.direction[1]
-        ax.annotate('', xy=(cx + dx * gust.gradient_distance, cy + dy * gust.gradient_distance),
-                    xytext=(cx, cy), arrowprops={'arrowstyle': '->', 'color': 'tab:blue'})
-        ax.text(cx, cy, f' gust {k}\n {gust.reference_speed:g} m/s', fontsize='x-small',
-                color='tab:blue', va='top')
-
-
-def _snapshot_times(ax: Axes, t: np.ndarray, payload: np.ndarray, idxs: np.ndarray,
-                    near: float = 0.6) -> None:
-    """'t = ... s' next to the payload at the snapshot samples; snapshots whose payloads lie
-    within `near` [m] of each other share one label."""
-    groups: list[list[int]] = []
-    for idx in idxs:
-        for group in groups:
-            if np.linalg.norm(payload[group[0], :2] - payload[idx, :2]) < near:
-                group.append(idx)
-                break
-        else:
-            groups.append([idx])
-    for group in groups:
-        text = ', '.join(f'{t[k]:.0f}' for k in group)
-        ax.annotate(f't = {text} s', payload[group[0], :2], textcoords='offset points',
-                    xytext=(4, -10), fontsize='x-small', color='0.3')
-
-
-def fig_top_view(ctx: Context) -> Figure:
-    """x-y paths seen from above, formation snapshots (UAVs and cables) and gust regions."""
-    run = ctx.run
-    r, rp = run.uav_positions(), interp_rows(run.t, run.payload_time, run.payload_position())
-    fig, ax = plt.subplots(figsize=(8, 7), layout='constrained')
-    _gust_regions(ax, ctx.scenario)
-    if run.has(REFERENCE_TOPIC):
-        ax.plot(*run.reference_position()[:, :2].T, color='0.5', ls='--', lw=1.0,
-                label='leader reference')
-    for i in range(1, run.n_uavs + 1):
-        ax.plot(*r[i - 1, :, :2].T, color=uav_color(i), lw=1.4, label=uav_label(i))
-    ax.plot(*rp[:, :2].T, color=PAYLOAD_COLOR, lw=1.4, label='payload')
-    for k, idx in enumerate(np.linspace(0, len(run.t) - 1, 5).astype(int)):
-        for i in range(run.n_uavs):
-            ax.plot(*np.stack([r[i, idx, :2], rp[idx, :2]]).T, color='0.55', lw=0.8,
-                    label='cables (projected), snapshots' if k == i == 0 else None)
-        if run.n_uavs > 1:
-            ring = np.vstack([r[:, idx, :2], r[:1, idx, :2]])
-            ax.plot(*ring.T, color='0.55', lw=0.8, ls=':')
-        ax.scatter(*r[:, idx, :2].T, color=[uav_color(i) for i in range(1, run.n_uavs + 1)],
-                   s=18, zorder=3)
-        ax.scatter(*rp[idx, :2], color=PAYLOAD_COLOR, marker='s', s=14, zorder=3)
-    _snapshot_times(ax, run.t, rp, np.linspace(0, len(run.t) - 1, 5).astype(int))
-    ax.set_aspect('equal', adjustable='datalim')
-    ax.set_xlabel('x [m]')
-    ax.set_ylabel('y [m]')
-    ax.set_title(f'{run.label}: top view ({WORLD}, seen from above)')
-    ax.grid(True, alpha=0.35)
-    legend(ax, loc='best')
-    return fig
 
 
 def fig_cable_constraints(ctx: Context) -> Figure:
@@ -214,77 +121,6 @@ def fig_payload_attitude(ctx: Context) -> Figure:
     return fig
 
 
-def _lacks_payload_attitude(run: Run) -> list[str]:
-    if not run.has(PAYLOAD_ODOM):
-        return [PAYLOAD_ODOM]
-    orientation = run.topic(PAYLOAD_ODOM)['orientation']
-    rotates = bool(np.any(orientation[:, :3] != 0.0))
-    return [] if rotates else ['a rigid payload (a point payload has no attitude)']
-
-
-def fig_thrust(ctx: Context) -> Figure:
-    """Collective thrust per UAV [N]: set-point and, with k_T known, k_T sum(omega^2)."""
-    run = ctx.run
-    fig, ax = plt.subplots(figsize=(9, 4.8), layout='constrained')
-    max_thrust = []
-    for i in range(1, run.n_uavs + 1):
-        if run.has(uav_topic(i, ATTITUDE_SETPOINT)):
-            ax.plot(run.setpoint_time(i), run.thrust(i), color=uav_color(i), lw=uav_width(i),
-                    label=f'{uav_label(i)} set-point')
-        vehicle = vehicle_of(ctx, i)
-        if vehicle is not None and run.has(uav_topic(i, ROTOR_CMD)):
-            omega = run.rotor_speeds(i)
-            ax.plot(run.rotor_time(i), vehicle.collective_thrust(omega),
-                    color=uav_color(i), lw=0.8, ls='--', alpha=0.8,
-                    label=f'{uav_label(i)} delivered $k_T \\sum\\omega^2$')
-            max_thrust.append(vehicle.max_thrust)
-    if max_thrust and np.allclose(max_thrust, max_thrust[0]):
-        ax.axhline(max_thrust[0], color='tab:red', lw=1.0, ls='-.',
-                   label=f'max thrust {max_thrust[0]:.2f} N (all rotors at ω_max)')
-    ax.set_ylabel('thrust along body z [N]')
-    ax.set_title(f'{run.label}: collective thrust per UAV', fontsize='medium')
-    legend(ax, loc='best', ncols=2)
-    finish_time_axes([ax])
-    return fig
-
-
-def _rotor_panel(ax: Axes, run: Run, i: int, limits: tuple[float, float] | None,
-                 limit_note: str) -> None:
-    t, omega, sat = run.rotor_time(i), run.rotor_speeds(i), run.saturated(i)
-    for k in range(omega.shape[1]):
-        ax.plot(t, omega[:, k], lw=0.9, color=f'C{k}', label=f'rotor {k + 1}')
-    lo, hi = value_span(omega)
-    if limits is not None:
-        w_min, w_max = limits
-        lo, hi = min(lo, w_max), max(hi, w_max)
-        margin = 0.08 * max(hi - lo, 1.0)
-        ax.axhspan(w_max, hi + margin, color=SATURATION_GREY, zorder=0,
-                   label=f'saturation ω ≥ ω_max = {w_max:g} rad/s{limit_note}')
-        if w_min > 0 and lo - margin < w_min:
-            ax.axhspan(lo - margin, w_min, color=SATURATION_GREY, zorder=0,
-                       label=f'saturation ω ≤ ω_min = {w_min:g} rad/s')
-        ax.set_ylim(lo - margin, hi + margin)
-    shade_flags(ax, t, sat.any(axis=1), 'a rotor clipped (saturated flag)')
-    ax.set_ylabel(f'UAV {i}: ω [rad/s]')
-    ax.set_title(f'{uav_label(i)}: saturated {np.mean(sat.any(axis=1)) * 100:.1f} % of the '
-                 f'time, mean ω = {omega.mean():.0f} rad/s', fontsize='small')
-    legend(ax, loc='lower left', ncols=3)
-
-
-def fig_rotor_speeds(ctx: Context) -> Figure:
-    """Rotor speeds per UAV [rad/s] after saturation, the saturation band shaded grey."""
-    run = ctx.run
-    uavs = [i for i in range(1, run.n_uavs + 1) if run.has(uav_topic(i, ROTOR_CMD))]
-    fig, axes = plt.subplots(len(uavs), 1, sharex=True, squeeze=False,
-                             figsize=(9, 1.5 + 2.6 * len(uavs)), layout='constrained')
-    for ax, i in zip(axes[:, 0], uavs):
-        note = '' if ctx.scenario is not None else ' (inferred from the flags)'
-        _rotor_panel(ax, run, i, rotor_limits(run, ctx.scenario, i), note)
-    fig.suptitle(f'{run.label}: rotor speeds (commands after saturation)', fontsize='medium')
-    finish_time_axes(axes[:, 0])
-    return fig
-
-
 def fig_payload_position(ctx: Context) -> Figure:
     """Payload x, y, z [m] over time (seed Fig. 4.15) and the gust speed met [m/s]."""
     run = ctx.run
@@ -310,15 +146,21 @@ def fig_payload_position(ctx: Context) -> Figure:
 
 
 def fig_tensions(ctx: Context) -> Figure:
-    """Cable tensions T_i [N]; negative values (compression of the rigid rod) shaded, and
-    the intervals a cable was slack (cable_model: slack) as a strip in its colour."""
+    """Cable tensions T_i [N]; negative values (compression of the rigid rod) shaded, the
+    intervals a cable was slack (cable_model: slack) as a strip in its colour, and a released
+    cable (a cable_release event) as a strip from its release on, labelled so."""
     run = ctx.run
     t, tension, taut = run.formation_time, run.tensions(), run.taut()
+    released = released_cables(run)
     fig, ax = plt.subplots(figsize=(9, 4.8), layout='constrained')
     for k in range(tension.shape[1]):
-        ax.plot(t, tension[:, k], color=uav_color(k + 1), lw=uav_width(k + 1, 1.0),
-                label=f'$T_{k + 1}$ (UAV {k + 1} - payload)')
-        shade_flags(ax, t, ~taut[:, k], f'cable {k + 1} slack', color=uav_color(k + 1))
+        i = k + 1
+        ax.plot(t, tension[:, k], color=uav_color(i), lw=uav_width(i, 1.0),
+                label=f'$T_{i}$ (UAV {i} - payload)')
+        gone = t >= released[i] if i in released else np.zeros(len(t), dtype=bool)
+        shade_flags(ax, t, ~taut[:, k] & ~gone, f'cable {i} slack', color=uav_color(i))
+        shade_flags(ax, t, gone, f'cable {i} released ({released.get(i, 0.0):.0f} s on)',
+                    color=uav_color(i), side='bottom')
     ax.axhline(0.0, color='0.3', lw=0.7)
     lo = tension.min()
     if lo < 0:
@@ -363,12 +205,26 @@ class FigureSpec:
 
 
 def _topics(*topics: str) -> Callable[[Run], list[str]]:
-    """A `lacks` function: the topics of `topics` the bag has no messages on."""
-    return lambda run: [topic for topic in topics if not run.has(topic)]
+    """A `lacks` function: for each topic of `topics` without messages, why."""
+    return lambda run: [f'no messages on {topic}' for topic in topics if not run.has(topic)]
 
 
 def _lacks_followers(run: Run) -> list[str]:
-    return [] if run.followers else ['follower (no /uav{i}/formation_error topic)']
+    if run.n_uavs < 2:
+        return ['one UAV: no follower']
+    if run.followers:
+        return []
+    return [f'no messages on {uav_topic(2, FORMATION_ERROR)} .. '
+            f'{uav_topic(run.n_uavs, FORMATION_ERROR)} (the followers\' virtual-constraint '
+            'errors)']
+
+
+def _lacks_payload_attitude(run: Run) -> list[str]:
+    if not run.has(PAYLOAD_ODOM):
+        return [f'no messages on {PAYLOAD_ODOM}']
+    orientation = run.topic(PAYLOAD_ODOM)['orientation']
+    rotates = bool(np.any(orientation[:, :3] != 0.0))
+    return [] if rotates else ['the payload is a point (no attitude; a rigid_body has one)']
 
 
 FIGURES: tuple[FigureSpec, ...] = (
@@ -393,7 +249,7 @@ def make_plots(ctx: Context, out: Path) -> tuple[list[Path], list[str]]:
     for spec in FIGURES:
         missing = spec.lacks(ctx.run)
         if missing:
-            skipped.append(f'{spec.name}: bag has no {", ".join(missing)}')
+            skipped.append(f'{spec.name}: {"; ".join(missing)}')
             continue
         try:
             fig = spec.make(ctx)

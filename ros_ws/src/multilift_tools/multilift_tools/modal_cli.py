@@ -19,6 +19,7 @@ from multilift_sim.analysis.coordinates import coordinate_names
 from multilift_sim.analysis.modal import ModalAnalysis, scenario_modal_analysis
 from multilift_sim.analysis.modes import MODE_KINDS, motion_shares
 from multilift_sim.formation_params import StateLayout
+from multilift_sim.kinematics import euler_from_quaternion, rotation_matrix
 from multilift_sim.scenario import ScenarioError, load
 
 
@@ -78,23 +79,78 @@ def modal_report(analysis: ModalAnalysis, name: str) -> str:
         period = f'{2 * math.pi / value.imag:.4f}' if value.imag > 0 else '-'
         lines.append(f'  {row:>2}  {value.real:>+10.2e}  {imag:>12}  {period:>10}  '
                      f'{kind:<11}  {analysis.motion(k):<36}  {_shape_text(analysis, k)}')
-    rigid = analysis.rigid_count
-    largest = max((abs(v) for v, c in zip(analysis.eigenvalues, analysis.kinds) if c == 'rigid'),
-                  default=0.0)
-    held = ('motions of the payload its cables do not hold' if analysis.held_uavs else
-            'translation of the free formation and the UAV attitudes, which nothing holds in '
-            'open loop' + (', and any rotation of the body its cables do not hold'
-                           if params.rigid_payload else ''))
-    lines += ['',
-              f'  rigid-body modes: {rigid} eigenvalues with |lambda| < '
-              f'{analysis.zero_tolerance:g} 1/s (largest {largest:.1e}): {held}',
+    lines += ['', rigid_line(analysis),
               '  pendulum periods: ' + (', '.join(f'{p:.4f}' for p in analysis.pendulum_periods)
                                         or 'none') + ' s']
+    lines += suspension_lines(analysis)
     unstable = analysis.indices('unstable')
     if unstable.size:
         lines.append('  unstable: ' + ', '.join(f'{analysis.eigenvalues[k]:.4g}'
                                                 for k in unstable) + ' 1/s')
     return '\n'.join(lines)
+
+
+def rigid_line(analysis: ModalAnalysis) -> str:
+    """The near-zero (rigid-body) modes: how many, the largest |lambda| among them, what they
+    are; 'none' when there are none (no 'largest 0' of an empty set)."""
+    zeros = [abs(v) for v, c in zip(analysis.eigenvalues, analysis.kinds) if c == 'rigid']
+    tolerance = f'|lambda| < {analysis.zero_tolerance:g} 1/s'
+    if not zeros:
+        return f'  rigid-body modes: none (no eigenvalue with {tolerance})'
+    held = ('motions of the payload its cables do not hold' if analysis.held_uavs else
+            'translation of the free formation and the UAV attitudes, which nothing holds in '
+            'open loop' + (', and any rotation of the body its cables do not hold'
+                           if analysis.params.rigid_payload else ''))
+    return (f'  rigid-body modes: {len(zeros)} eigenvalues with {tolerance} (largest '
+            f'{max(zeros):.1e}): {held}')
+
+
+def cable_drops(analysis: ModalAnalysis) -> np.ndarray:
+    """Each cable's vertical drop h_i [m] at the equilibrium: the height of its upper end (the
+    UAV's centre, or R_i a_i from it) above its lower end (the payload, or a rigid body's
+    attach point r_p + R_p b_i); h_i = l_i cos(splay_i)."""
+    params = analysis.params
+    layout = StateLayout(params.n_uavs, params.rigid_payload)
+    x = analysis.equilibrium.state
+    upper = layout.uav_positions(x).copy()
+    if params.uav_attach_points is not None:
+        upper += np.einsum('ijk,ik->ij', rotation_matrix(layout.uav_euler(x)),
+                           np.asarray(params.uav_attach_points, dtype=float))
+    lower = np.repeat(layout.payload_position(x)[None], params.n_uavs, axis=0)
+    if params.rigid_payload:
+        w, qx, qy, qz = layout.payload_quaternion(x)
+        rotation = rotation_matrix(euler_from_quaternion([qx, qy, qz, w]))
+        lower = lower + np.asarray(params.payload_attach_points, dtype=float) @ rotation.T
+    return upper[:, 2] - lower[:, 2]
+
+
+def suspension_lines(analysis: ModalAnalysis) -> list[str]:
+    """Why a swing's period is not 2 pi sqrt(l/g): the cables' length l, their vertical drop
+    h = l cos(splay) and each pendulum mode's effective length g / omega^2 [m]. A swing across
+    parallel cables (a point payload under one cable; a beam swinging out of its cables' plane)
+    is a pendulum of length h; where the cables splay out from a body's attach points (a
+    trapezoid: box_lift's corners, beam_lift's ends in their plane) a swing also turns the body
+    (the mode's shape), and the effective length differs from both h and l."""
+    params = analysis.params
+    g = float(params.gravity)
+    lengths = np.asarray(params.cable_lengths, dtype=float)
+    drops = cable_drops(analysis)
+    splay = np.degrees(np.arccos(np.clip(drops / lengths, -1.0, 1.0)))
+    h, length = float(np.mean(drops)), float(np.mean(lengths))
+    omegas = [analysis.eigenvalues[k].imag for k in analysis.pendulum_modes]
+    effective = ', '.join(f'{g / w ** 2:.3f}' for w in omegas) or 'none'
+    lines = ['  cables          length l ' + ', '.join(f'{v:.3f}' for v in lengths)
+             + ' m; vertical drop h = l cos(splay) ' + ', '.join(f'{v:.3f}' for v in drops)
+             + ' m (splayed ' + ', '.join(f'{v:.1f}' for v in splay) + ' deg)',
+             f'  swing length    g/omega^2 of the pendulum modes {effective} m; a pendulum of '
+             f'length h swings in {2 * math.pi * math.sqrt(h / g):.4f} s, of length l in '
+             f'{2 * math.pi * math.sqrt(length / g):.4f} s (mean h, l)']
+    if params.rigid_payload and float(np.max(splay)) > 1.0:
+        lines.append('                  the cables splay out from the body\'s attach points (a '
+                     'trapezoid, not parallel strings): a swing across them turns the body too '
+                     '(the shapes above), so its period is neither 2 pi sqrt(l/g) nor '
+                     '2 pi sqrt(h/g)')
+    return lines
 
 
 def _label_groups(analysis: ModalAnalysis, gap: float = 0.03) -> list[list[int]]:

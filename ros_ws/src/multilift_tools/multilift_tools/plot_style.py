@@ -31,6 +31,7 @@ DPI = 120
 SATURATION_GREY = '0.82'
 EVENT_COLOR = 'tab:red'  # a scenario event's line (mark_events)
 AXES_XYZ = ('x', 'y', 'z')
+FLAG_STRIP = 0.06  # a `shade_flags` strip's height, share of the axes
 
 
 def uav_color(i: int) -> str:
@@ -88,11 +89,13 @@ def value_span(values: np.ndarray) -> tuple[float, float]:
 
 
 def shade_flags(ax: Axes, t: np.ndarray, mask: np.ndarray, label: str,
-                 color: str = 'tab:red') -> None:
-    """A strip along the top of `ax` where `mask` is True (time intervals)."""
+                color: str = 'tab:red', side: str = 'top') -> None:
+    """A strip along the top (or `side='bottom'`) of `ax` where `mask` is True (time
+    intervals); its height FLAG_STRIP of the axes."""
     if not mask.any():
         return
-    ax.fill_between(t, 0.94, 1.0, where=mask, step='mid', color=color, alpha=0.8,
+    low, high = (1.0 - FLAG_STRIP, 1.0) if side == 'top' else (0.0, FLAG_STRIP)
+    ax.fill_between(t, low, high, where=mask, step='mid', color=color, alpha=0.8,
                     transform=ax.get_xaxis_transform(), label=label, linewidth=0)
 
 

@@ -5,7 +5,8 @@ Every scenario is written in the world frame (z up, REP-103 SI units). A bad val
 turns it into a single line on stderr and exit code 2.
 
 The package: `config` (the dataclasses), `reading` (a mapping read with checks), `vehicle`,
-`parse` (a file's mapping -> Scenario), `files` (names, paths, load/loads). Its names are
+`parse` (a file's mapping -> Scenario), `limits` (what the bodies cannot be or the vehicles
+cannot fly), `files` (names, paths, load/loads). Its names are
 imported from here: `from multilift_sim import scenario as scenario_io; scenario_io.load(...)`.
 """
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES,  # noqa: F401

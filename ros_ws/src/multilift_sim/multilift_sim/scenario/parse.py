@@ -1,7 +1,8 @@
 """A scenario file's mapping -> `Scenario`, validated once: every section read with checks
 (`reading.Section`), the vehicles (`vehicle`), the formation, gusts, wind, sensors, events,
-control and mission, then what only the Baumgarte DAE models refused under another formulation
-and what the rotors cannot lift at all."""
+control and mission, then what the rotors cannot lift at all, what the bodies cannot be or the
+vehicles cannot fly (`limits`), and what only the Baumgarte DAE models refused under another
+formulation."""
 from __future__ import annotations
 
 import dataclasses
@@ -21,6 +22,7 @@ from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATIO
                                            Scenario, ScenarioError, SensorConfig,
                                            SimulationConfig, TurbulenceConfig, UavConfig,
                                            flies_a_period, one_period_rule)
+from multilift_sim.scenario.limits import check_limits
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
                                             vehicle_params)
@@ -200,6 +202,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
                         cable_model=cable_model, events=events, wind=tuple(wind),
                         turbulence=turbulence, sensors=sensors)
     _check_feasible(scenario)
+    check_limits(scenario)
     # what only the engine's DAE (physics/) models: refused with another formulation
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]

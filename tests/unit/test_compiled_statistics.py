@@ -193,7 +193,7 @@ def test_the_classes_read_their_arrays():
     assert list(stats.as_dict()) == [
         'n_uavs', 'max_abs_constraint', 'max_abs_constraint_rate', 'max_rotor_speed',
         'saturated_time', 'min_tension', 'max_tension', 'simulated_time', 'max_gust_speed',
-        'slack_time', 'max_payload_swing', 'rms_payload_swing']
+        'slack_time', 'max_payload_swing', 'rms_payload_swing', 'swing_from', 'compressed_time']
     tracking = TrackingStatistics()
     for error in (3.0, 4.0):
         tracking.add([error, 0.0, 0.0], [0.0, 0.0, 0.0])

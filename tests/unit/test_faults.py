@@ -31,10 +31,14 @@ def test_the_reallocated_mixer_gives_the_wrench_over_the_other_rotors(frame_type
     mixer = RotorMixer(vehicle, effectiveness)
     matrix = allocation_matrix(frame_type, vehicle.arm_length, vehicle.thrust_coefficient,
                                vehicle.moment_coefficient) * effectiveness
+    # the rotor the reallocation pins at omega_min: live, no collective share
+    pinned = (np.abs(mixer.pinv).sum(axis=1) > 0) & (mixer.collective <= 0)
     for wrench in ([30.0, 0.0, 0.0, 0.0], [30.0, 0.4, -0.3, 0.05], [25.0, -0.2, 0.5, -0.05]):
         speeds, saturated = mixer.rotor_speeds(wrench[0], np.array(wrench[1:]))
         assert speeds[0] == vehicle.rotor_speed_min and not saturated[0]  # left out
-        if not saturated.any():  # what the other rotors give is the wrench asked for
+        assert not saturated[pinned].any()  # pinned, not saturated (issue 37)
+        if not saturated.any() and np.all(speeds[pinned] > vehicle.rotor_speed_min):
+            # nothing held at a limit: what the other rotors give is the wrench asked for
             assert matrix @ speeds ** 2 == pytest.approx(wrench, abs=1e-9)
     hover, _ = mixer.rotor_speeds(30.0, np.zeros(3))
     assert matrix @ hover ** 2 == pytest.approx([30.0, 0, 0, 0], abs=1e-9)

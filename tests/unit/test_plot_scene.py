@@ -20,7 +20,7 @@ from multilift_sim.topics import PAYLOAD_ODOM  # noqa: E402
 from multilift_tools import figures  # noqa: E402
 from multilift_tools.bagdata import load_run  # noqa: E402
 from multilift_tools.headless_bag import record_headless  # noqa: E402
-from multilift_tools.plot_style import FLAG_STRIP, Context, plt  # noqa: E402
+from multilift_tools.plot_style import Context, plt  # noqa: E402
 from multilift_tools.plots import rotors, views  # noqa: E402
 from multilift_tools.plots.scene import formation_scene  # noqa: E402
 
@@ -186,9 +186,9 @@ def test_six_rotors_are_told_apart_and_the_clipped_strip_is_at_the_lower_limit(h
     assert len({rotors.rotor_style(k)['color'] for k in range(6)}) == 6
     assert len(styles) == 6
     strips = {c.get_label(): c for c in leader.collections if c.get_label().startswith('clipped')}
-    assert set(strips) == {rotors.CLIP_LOW}  # the failed rotor and its opposite: at omega_min
-    heights = np.concatenate([p.vertices[:, 1] for p in strips[rotors.CLIP_LOW].get_paths()])
-    assert heights.min() >= 0.0 and heights.max() <= FLAG_STRIP + 1e-12  # at the bottom
+    # the failed rotor and the one its reallocation pins at omega_min are not saturation
+    # (issue 37: the hexa's rotors are never held at a limit they were wanted beyond)
+    assert not strips
     texts = [t.get_text() for t in leader.texts]
     assert 'rotors 1, 4' in texts  # the failed rotor 1 and its opposite share the line at 0
     plt.close(fig)

@@ -8,6 +8,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 
 class Progress:
     """Simulated time and real-time factor, on one terminal line (or a line every 10 %)."""
@@ -68,14 +70,23 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
             limit = scenario.uavs[i].vehicle.rotor_speed_max
             lines.append(f'  uav{i + 1} rotors      max {w:.1f} rad/s (limit {limit:g}), '
                          f'saturated {s:.2f} s')
+        lines.extend(fault_lines(scenario, sim.get('events', []), sim.get('simulated_time')))
         lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} N')
+        if sim.get('compressed_time'):
+            lines.append(f'  warning: a cable pushed for {sim["compressed_time"]:.2f} s (least '
+                         f'tension {sim["min_tension"]:.2f} N): rigid cables can push; '
+                         '`cable_model: slack` lets them go slack instead')
         if any(sim.get('slack_time', [])):
             lines.append('  slack cables     ' + ', '.join(
                 f'cable {i + 1} {s:.2f} s' for i, s in enumerate(sim['slack_time']) if s > 0))
         if 'max_payload_swing' in sim:
-            lines.append(f'  payload swing    max {sim["max_payload_swing"]:.3f} m, '
-                         f'rms {sim["rms_payload_swing"]:.3f} m (horizontal, from its rest '
-                         'place under the UAVs)')
+            since = sim.get('swing_from', 0.0)
+            if sim.get('simulated_time', 0.0) < since:
+                lines.append(f'  payload swing    not measured (from t = {since:g} s on)')
+            else:
+                lines.append(f'  payload swing    max {sim["max_payload_swing"]:.3f} m, '
+                             f'rms {sim["rms_payload_swing"]:.3f} m (horizontal, from its rest '
+                             f'place under the UAVs, from t = {since:g} s: not the release)')
         if scenario.gusts:
             lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} m/s')
         if sim.get('seeds'):
@@ -103,3 +114,34 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
         lines.append(f'  bag              {bag}')
         (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))
     print('\n'.join(lines))
+
+
+def fault_lines(scenario, events: list[dict], t_end: float | None) -> list[str]:
+    """The summary's lines for the rotors that failed (the `rotor_effectiveness` events that
+    happened: the summary's first `len(events)` event rows) and the rotors their UAV's
+    reallocated mixer then pins at omega_min (live, no collective share:
+    `faults.fault_mixers`), each with how long [s]: neither counts as saturated."""
+    from multilift_control.faults import fault_mixers
+    from multilift_control.laws.layout import MIXER_COLLECTIVE, MIXER_WRENCH
+    from multilift_sim.physics.layout import (EVENT_KIND, EVENT_ROTOR, EVENT_TIME, EVENT_UAV,
+                                              EVENT_VALUE, KIND_ROTOR_EFFECTIVENESS)
+    from multilift_sim.schedules import event_array
+
+    rows = event_array(scenario)[:len(events)]
+    if not any(int(row[EVENT_KIND]) == KIND_ROTOR_EFFECTIVENESS for row in rows):
+        return []
+    mixers = fault_mixers(scenario)
+    end = t_end if t_end is not None else scenario.simulation.duration
+    lines = []
+    for k, row in enumerate(rows):
+        if int(row[EVENT_KIND]) != KIND_ROTOR_EFFECTIVENESS:
+            continue
+        uav, start = int(row[EVENT_UAV]) + 1, float(row[EVENT_TIME])
+        lines.append(f'  uav{uav} rotor {int(row[EVENT_ROTOR]) + 1}    effectiveness '
+                     f'{row[EVENT_VALUE]:g} from {start:g} s ({end - start:.2f} s)')
+        for r, mixer_row in enumerate(mixers[k]):
+            live = np.any(mixer_row[MIXER_WRENCH:MIXER_WRENCH + 4] != 0.0)
+            if live and mixer_row[MIXER_COLLECTIVE] <= 0.0:
+                lines.append(f'  uav{uav} rotor {r + 1}    pinned at its minimum speed by the '
+                             f'reallocation from {start:g} s ({end - start:.2f} s)')
+    return lines

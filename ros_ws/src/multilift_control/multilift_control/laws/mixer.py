@@ -14,15 +14,20 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
 
     Attitude comes first: when a rotor would leave [omega_min, omega_max], the collective part
     is shifted (equal omega^2 on every rotor changes thrust only) to bring the request inside;
-    what still does not fit is clipped. `saturated` flags the rotors whose request was out of
-    range.
+    what still does not fit is clipped. `saturated` flags the rotors held at a limit the
+    allocator wanted them beyond: clipped, or the rotor that set the shift (at its limit
+    after it); not a rotor whose request the shift brought inside (issue 37: a hexa after a
+    rotor failure counted 88.85 s saturated with its fastest rotor at 1996 of 2100 rad/s).
 
     After a rotor fails (`RotorMixer` of an effectiveness, issue 21) its row is 0: it is held
     at omega_min and takes no part; a rotor that carries no collective share (the failed
-    one's opposite in a hexa's reallocation) is clipped but cannot take part in the shift."""
+    one's opposite in a hexa's reallocation) is clipped but cannot take part in the shift:
+    it is pinned at omega_min by the reallocation, not saturated."""
     n_rotors = mixer.shape[0]
     request = np.empty(n_rotors)
-    saturated = np.empty(n_rotors, dtype=np.bool_)
+    wanted = np.empty(n_rotors)  # the request before the shift [rad^2/s^2]
+    saturated = np.zeros(n_rotors, dtype=np.bool_)
+    shares = np.zeros(n_rotors, dtype=np.bool_)  # live, with a collective share
     # np.argmax, np.argmin over the rotors with a collective share: the first of equals
     highest = lowest = -1
     for k in range(n_rotors):
@@ -33,12 +38,13 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
             live = live or mixer[k, MIXER_WRENCH + j] != 0.0
         if not live:
             request[k] = square_min
-            saturated[k] = False
+            wanted[k] = square_min
             continue
         request[k] = total
-        saturated[k] = total > square_max or total < square_min
+        wanted[k] = total
         if mixer[k, MIXER_COLLECTIVE] <= 0.0:
             continue
+        shares[k] = True
         if highest < 0 or total > request[highest]:
             highest = k
         if lowest < 0 or total < request[lowest]:
@@ -52,6 +58,12 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
             shift = -above if above > 0 else (below if below > 0 else 0.0)
             for k in range(n_rotors):
                 request[k] = request[k] + shift * mixer[k, MIXER_COLLECTIVE]
+    # held at a limit it was wanted beyond (after the shift: at the limit to rounding)
+    at_limit = 1e-12 * square_max
+    for k in range(n_rotors):
+        if shares[k]:
+            saturated[k] = ((wanted[k] > square_max and request[k] > square_max - at_limit)
+                            or (wanted[k] < square_min and request[k] < square_min + at_limit))
     for k in range(n_rotors):  # what does not fit (a no-op for a request within the range)
         request[k] = min(max(request[k], square_min), square_max)
     return np.sqrt(request), saturated

@@ -25,8 +25,9 @@ from multilift_sim.physics.layout import (CABLE_COLUMNS, EULER, FORMATION_WIND,
                                           WRENCH_COLUMNS)
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.sensors import sensed_states
-from multilift_sim.statistics.accumulators import (run_add_commands, run_add_gust_speed,
-                                                   run_add_slack, run_add_tensions, run_check)
+from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
+                                                   run_add_gust_speed, run_add_slack,
+                                                   run_add_tensions, run_check)
 from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
                                              CHECK_NON_FINITE)
 
@@ -96,6 +97,7 @@ def advance(a, m, b, speeds, saturated, tension):
     for i in range(n):
         tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
     run_add_tensions(m.run[b], tension)
+    run_add_compression(m.run[b], tension, period)
     if a.slack[b]:
         run_add_slack(m.run[b], m.taut[b], period)
     m.state[b, :] = state

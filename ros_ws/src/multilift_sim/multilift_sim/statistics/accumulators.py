@@ -18,9 +18,9 @@ from multilift_sim.physics.layout import EULER, POSITION, UAV_COORDINATES
 from multilift_sim.statistics.layout import (
     CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS,
     FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ, PITCH_LIMIT,
-    RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION,
-    RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
-    RUN_UAV_COLUMNS, TRACKING_ERROR)
+    RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED,
+    RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
+    RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
 from multilift_sim.statistics.swing import swing_at
 
 
@@ -52,6 +52,16 @@ def run_add_commands(run: np.ndarray, rotor_speeds: np.ndarray, saturated: np.nd
             if saturated[i, r]:
                 run[block + RUN_SATURATED_TIME] += period
                 break
+
+
+@jit
+def run_add_compression(run: np.ndarray, tension: np.ndarray, period: float) -> None:
+    """One control period [s] starting with the cable tensions T_i (n,) [N]: when a cable
+    pushes (T_i < 0, which rigid cables allow), the period counts as compressed."""
+    for i in range(tension.shape[0]):
+        if tension[i] < 0.0:
+            run[RUN_COMPRESSED_TIME] += period
+            return
 
 
 @jit
@@ -91,7 +101,9 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
     """Algorithm 1, lines 10-13, at the state x (docs/conventions.md) of time t [s]: the
     constraint residuals g (n,) [m^2] and g_dot (n,) [m^2/s] of the taut cables (taut (n,)
     bool: the tolerances hold for those only) into the run's peaks, the payload swing when
-    tick % swing_every == 0 (`swing_at` with the cables' reach (n,) [m]), the simulated time.
+    tick % swing_every == 0 and t >= SWING_FROM (`swing_at` under the UAVs whose cables are
+    taut, with their reach (n,) [m]: a released or slack cable holds nothing), the simulated
+    time.
 
     Returns (status, cable): CHECK_NON_FINITE (the state is not finite; nothing accumulated),
     CHECK_ATTITUDE (UAV `cable` pitched beyond PITCH_LIMIT, where the state's Euler angles
@@ -116,11 +128,24 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
         run[RUN_MAX_ABS_G] = peak
     if peak_rate > run[RUN_MAX_ABS_G_DOT]:
         run[RUN_MAX_ABS_G_DOT] = peak_rate
-    if tick % swing_every == 0:
+    if tick % swing_every == 0 and t >= SWING_FROM:
         n = g.shape[0]
-        uavs = state[:UAV_COORDINATES * n].reshape((n, UAV_COORDINATES))
-        payload = state[UAV_COORDINATES * n:UAV_COORDINATES * n + 3]  # physics.layout.payload_slot
-        peak_rms_add(run, RUN_SWING, swing_at(uavs[:, POSITION:POSITION + 3], payload, reach))
+        held = 0  # the swing under the UAVs whose cables hold the payload (not a released one)
+        for i in range(n):
+            if taut[i]:
+                held += 1
+        if held > 0:
+            uavs = np.empty((held, 3))
+            reaches = np.empty(held)
+            k = 0
+            for i in range(n):
+                if taut[i]:
+                    for axis in range(3):
+                        uavs[k, axis] = state[UAV_COORDINATES * i + POSITION + axis]
+                    reaches[k] = reach[i]
+                    k += 1
+            payload = state[UAV_COORDINATES * n:UAV_COORDINATES * n + 3]  # layout.payload_slot
+            peak_rms_add(run, RUN_SWING, swing_at(uavs, payload, reaches))
     run[RUN_SIMULATED_TIME] = t
     if peak > constraint_tolerance:
         return CHECK_G, worst

@@ -16,10 +16,10 @@ from numpy.typing import ArrayLike
 from multilift_sim import kernels
 from multilift_sim.statistics.layout import (
     FORMATION_MAX_ABS, FORMATION_NORM_SUM, FORMATION_SAMPLES, FORMATION_SIZE, PEAK_MAX,
-    PEAK_SAMPLES, PEAK_SIZE, PEAK_SUM_SQ, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED,
-    RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
-    RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, TRACKING_ERROR,
-    TRACKING_SIZE, run_size)
+    PEAK_SAMPLES, PEAK_SIZE, PEAK_SUM_SQ, RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
+    RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION,
+    RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
+    RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR, TRACKING_SIZE, run_size)
 
 
 def compiled(module: str, name: str) -> Callable:
@@ -212,7 +212,8 @@ class RunStatistics:
 
     @property
     def saturated_time(self) -> list[float]:
-        """Per UAV, time with a rotor at a speed limit [s]."""
+        """Per UAV, time with a rotor held at a speed limit the allocator wanted it beyond
+        [s] (not a failed rotor, nor one the reallocation pins at its minimum)."""
         return self._per_uav(RUN_SATURATED_TIME)
 
     @property
@@ -229,6 +230,11 @@ class RunStatistics:
     def simulated_time(self) -> float:
         """The time of the last state checked [s]."""
         return float(self.run[RUN_SIMULATED_TIME])
+
+    @property
+    def compressed_time(self) -> float:
+        """Time with a cable pushing (a rigid cable's T_i < 0) [s]."""
+        return float(self.run[RUN_COMPRESSED_TIME])
 
     @property
     def max_gust_speed(self) -> float:
@@ -279,4 +285,6 @@ class RunStatistics:
                 'max_gust_speed': self.max_gust_speed,
                 'slack_time': self.slack_time,
                 'max_payload_swing': self.swing.max,
-                'rms_payload_swing': self.swing.rms}
+                'rms_payload_swing': self.swing.rms,
+                'swing_from': SWING_FROM,
+                'compressed_time': self.compressed_time}

@@ -25,11 +25,17 @@ RUN_MIN_TENSION = 2         # min over cables and ticks of T_i [N] (+inf: none y
 RUN_MAX_TENSION = 3         # max over cables and ticks of T_i [N] (-inf: none yet)
 RUN_SIMULATED_TIME = 4      # the time of the last state checked [s]
 RUN_MAX_GUST_SPEED = 5      # the peak gust speed met by the payload [m/s]
-RUN_SWING = 6               # a peak/rms block (PEAK_*): the payload swing [m]
-RUN_SCALARS = RUN_SWING + PEAK_SIZE
+RUN_SWING = 6               # a peak/rms block (PEAK_*): the payload swing [m], from SWING_FROM
+RUN_COMPRESSED_TIME = RUN_SWING + PEAK_SIZE  # time with a cable pushing (T_i < 0: rigid) [s]
+RUN_SCALARS = RUN_COMPRESSED_TIME + 1
+# the payload swing is measured from this time on [s]: before it, a released payload's first
+# swing (twin_lift's 15 deg release: 2.6 m) would be every run's maximum, the same whatever
+# the controllers do
+SWING_FROM = 10.0
 # a UAV's block, RUN_UAV_COLUMNS floats from run_uav_slot(i, 0)
 RUN_MAX_ROTOR_SPEED = 0     # its peak commanded rotor speed [rad/s]
-RUN_SATURATED_TIME = 1      # time with any rotor at a speed limit [s]
+RUN_SATURATED_TIME = 1      # time with a rotor held at a speed limit the allocator wanted it
+#                             beyond (the mixer's `saturated`; not a failed or pinned rotor) [s]
 RUN_SLACK_TIME = 2          # time its cable was slack (cable_model: slack) [s]
 RUN_UAV_COLUMNS = 3
 

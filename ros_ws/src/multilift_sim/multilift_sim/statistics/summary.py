@@ -28,6 +28,7 @@ def summary_row(summary: dict) -> dict:
         'payload_swing_rms': sim.get('rms_payload_swing'),
         'max_gust_speed': sim.get('max_gust_speed'),
         'slack_time': sum(sim['slack_time']) if sim.get('slack_time') else None,
+        'compressed_time': sim.get('compressed_time'),
         'tracking_error_max': leader.get('max_tracking_error') if tracked else None,
         'tracking_error_rms': leader.get('rms_tracking_error') if tracked else None,
         'formation_error_max': (max(f['max_abs_formation_error'] for f in followers)

@@ -102,15 +102,16 @@ def test_csv_and_parquet_tables_read_back(tmp_path):
              'status': 'ok', 'message': '', 'x': 0.1},
             {'run': 1, 'vehicle.inertia': [1, 1, 3], 'payload.mass': 1, 'seed': 5,
              'status': 'error', 'message': 'a, "b"', 'x': None}]
+    meta_in = {'grid': {'payload.mass': ['0.4', '1']}, 'sample': {'vehicle.inertia': 'x'}}
     for name in ('t.csv', 't.parquet'):
-        cp.write_table(tmp_path / name, columns, rows, {'grid': {'payload.mass': []}})
+        cp.write_table(tmp_path / name, columns, rows, meta_in)
         got_columns, got, meta = cp.read_table(tmp_path / name)
         assert got_columns == columns
         assert [r['vehicle.inertia'] for r in got] == ['[1, 1, 2]', '[1, 1, 3]']
         assert [r['payload.mass'] for r in got] == [0.4, 1.0]
         assert [r['seed'] for r in got] == [2 ** 62, 5]
         assert got[1]['message'] == 'a, "b"' and got[1]['x'] is None and got[0]['x'] == 0.1
-        assert meta == ({} if name.endswith('csv') else {'grid': {'payload.mass': []}})
+        assert meta == meta_in   # in the Parquet file, beside the CSV (t.csv.campaign.json)
 
 
 def test_run_one_turns_a_rejected_value_into_an_error_row():

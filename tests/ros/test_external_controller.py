@@ -9,6 +9,7 @@ test_multi_host.py.
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -61,6 +62,10 @@ def test_the_example_leader_flies_single_lift_and_is_recorded(multilift_run, exa
     finally:
         os.killpg(leader.pid, signal.SIGINT)
         leader.wait(timeout=30)
+    # its last line after Ctrl-C, and no log call into a context the signal shut down
+    log = (tmp_path / 'leader.log').read_text()
+    assert re.search(r'answered [1-9]\d* states', log), log
+    assert 'Failed to publish log message to rosout' not in log, log
     assert 'leader tracking' not in run.output()  # none of our controllers ran
     recorded = raw_messages(bag)
     commands = [deserialize_message(d, RotorCommand) for d in recorded['/uav1/rotor_cmd']]

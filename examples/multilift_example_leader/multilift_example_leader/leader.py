@@ -13,6 +13,7 @@ Written the usual way: default QoS (reliable, volatile, depth 10) on both topics
 from __future__ import annotations
 
 import rclpy
+import rclpy.logging
 from multilift_msgs.msg import RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.executors import ExternalShutdownException
@@ -59,8 +60,13 @@ def main(args: list[str] | None = None) -> None:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.get_logger().info(f'answered {node.answered} states')
+        # Ctrl-C (SIGINT) or SIGTERM has shut the context down by now (rclpy's signal handler),
+        # and a node's logger would still try its /rosout publisher ("Failed to publish log
+        # message to rosout"): the last line goes out after the node is destroyed, through a
+        # logger no node owns (the console and the log file, not /rosout)
+        answered = node.answered
         node.destroy_node()
+        rclpy.logging.get_logger('example_leader').info(f'answered {answered} states')
         rclpy.try_shutdown()
 
 

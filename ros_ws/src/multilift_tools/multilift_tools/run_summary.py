@@ -1,7 +1,7 @@
 """What `multilift run` shows of a run: its simulated time and real-time factor while it runs
 (`Progress`), and the summary at its end from what each node left (`read_summaries`,
 `print_summary`: max |g|, rotor speeds, saturation, tensions, swing, tracking, formation
-errors; with a bag also BAG/summary.json). Times in [s], lengths in [m].
+errors; with a bag also BAG/summary.json), each figure in its unit from `multilift_sim.units`.
 """
 from __future__ import annotations
 
@@ -9,6 +9,8 @@ import json
 from pathlib import Path
 
 import numpy as np
+
+from multilift_sim.units import unit_of
 
 
 class Progress:
@@ -60,35 +62,43 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
     if sim:
         wall = sim.get('wall_time') or 0.0
         t = sim.get('simulated_time', 0.0)
-        lines.append(f'{name}: {t:.1f} s simulated in {wall:.1f} s wall '
+        lines.append(f'{name}: {t:.1f} {unit_of("simulated_time")} simulated in {wall:.1f} '
+                     f'{unit_of("wall_time")} wall '
                      f'({t / wall if wall else 0:.1f}x real time)')
         tol = scenario.simulation.constraint_tolerance
-        lines.append(f'  max |g|          {sim["max_abs_constraint"]:.3g} m^2 '
+        lines.append(f'  max |g|          {sim["max_abs_constraint"]:.3g} {unit_of("max_abs_g")} '
                      f'(tolerance {tol:g})')
-        lines.append(f'  max |g_dot|      {sim["max_abs_constraint_rate"]:.3g} m^2/s')
+        lines.append(f'  max |g_dot|      {sim["max_abs_constraint_rate"]:.3g} '
+                     f'{unit_of("max_abs_g_dot")}')
         for i, (w, s) in enumerate(zip(sim['max_rotor_speed'], sim['saturated_time'])):
             limit = scenario.uavs[i].vehicle.rotor_speed_max
-            lines.append(f'  uav{i + 1} rotors      max {w:.1f} rad/s (limit {limit:g}), '
-                         f'saturated {s:.2f} s')
+            lines.append(f'  uav{i + 1} rotors      max {w:.1f} {unit_of("max_rotor_speed")} '
+                         f'(limit {limit:g}), saturated {s:.2f} {unit_of("saturated_time")}')
         lines.extend(fault_lines(scenario, sim.get('events', []), sim.get('simulated_time')))
-        lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} N')
+        lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} '
+                     f'{unit_of("max_tension")}')
         if sim.get('compressed_time'):
-            lines.append(f'  warning: a cable pushed for {sim["compressed_time"]:.2f} s (least '
-                         f'tension {sim["min_tension"]:.2f} N): rigid cables can push; '
+            lines.append(f'  warning: a cable pushed for {sim["compressed_time"]:.2f} '
+                         f'{unit_of("compressed_time")} (least tension {sim["min_tension"]:.2f} '
+                         f'{unit_of("min_tension")}): rigid cables can push; '
                          '`cable_model: slack` lets them go slack instead')
         if any(sim.get('slack_time', [])):
             lines.append('  slack cables     ' + ', '.join(
-                f'cable {i + 1} {s:.2f} s' for i, s in enumerate(sim['slack_time']) if s > 0))
+                f'cable {i + 1} {s:.2f} {unit_of("slack_time")}'
+                for i, s in enumerate(sim['slack_time']) if s > 0))
         if 'max_payload_swing' in sim:
             since = sim.get('swing_from', 0.0)
             if sim.get('simulated_time', 0.0) < since:
                 lines.append(f'  payload swing    not measured (from t = {since:g} s on)')
             else:
-                lines.append(f'  payload swing    max {sim["max_payload_swing"]:.3f} m, '
-                             f'rms {sim["rms_payload_swing"]:.3f} m (horizontal, from its rest '
-                             f'place under the UAVs, from t = {since:g} s: not the release)')
+                lines.append(f'  payload swing    max {sim["max_payload_swing"]:.3f} '
+                             f'{unit_of("payload_swing_max")}, rms '
+                             f'{sim["rms_payload_swing"]:.3f} {unit_of("payload_swing_rms")} '
+                             f'(horizontal, from its rest place under the UAVs, from t = '
+                             f'{since:g} s: not the release)')
         if scenario.gusts:
-            lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} m/s')
+            lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} '
+                         f'{unit_of("max_gust_speed")}')
         if sim.get('seeds'):
             lines.append('  seeds            ' + ', '.join(
                 f'{what} {seed}' for what, seed in sim['seeds'].items()))
@@ -101,15 +111,17 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
                      f'{control.swing_limit:g} m/s^2 (control.payload_feedback)')
     leader = data.get('leader')
     if leader and leader.get('answered_states'):
-        lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} m, '
-                     f'rms {leader["rms_tracking_error"]:.3f} m')
+        lines.append(f'  leader tracking  max {leader["max_tracking_error"]:.3f} '
+                     f'{unit_of("tracking_error_max")}, rms {leader["rms_tracking_error"]:.3f} '
+                     f'{unit_of("tracking_error_rms")}')
     for i in range(2, scenario.n_uavs + 1):
         follower = data.get(f'follower{i}')
         if follower and follower.get('answered_states'):
             # the largest row and the mean norm of its rows: the mean can exceed the max
             lines.append(f'  uav{i} formation  largest |g_vc| row '
                          f'{follower["max_abs_formation_error"]:.3f}, mean |g_vc| '
-                         f'{follower["mean_formation_error_norm"]:.3f} (m)')
+                         f'{follower["mean_formation_error_norm"]:.3f} '
+                         f'({unit_of("formation_error_mean")})')
     if bag is not None:
         lines.append(f'  bag              {bag}')
         (bag / 'summary.json').write_text(json.dumps(data, indent=1, sort_keys=True))

@@ -19,11 +19,11 @@ from multilift_tools.campaign.runs import (STATISTICS, STATUSES, error_message, 
 from multilift_tools.campaign.spec import (DISTRIBUTIONS, GridAxis, SampleSpec, SweepError,
                                            apply_edit, edited, format_value, parse_key,
                                            parse_sample, parse_set, parse_value, split_values)
-from multilift_tools.campaign.table import (make_row, read_table, table_columns, table_text,
-                                            write_table)
+from multilift_tools.campaign.table import (make_row, metadata_path, read_table, table_columns,
+                                            table_text, write_table)
 
 __all__ = ['Campaign', 'DISTRIBUTIONS', 'GridAxis', 'RunSpec', 'STATISTICS', 'STATUSES',
            'SampleSpec', 'SweepError', 'apply_edit', 'build_campaign', 'edited', 'error_message',
-           'format_value', 'load_base', 'make_row', 'parse_key', 'parse_sample', 'parse_set',
-           'parse_value', 'read_table', 'run_chunk', 'run_one', 'run_seeds', 'run_statistics_row',
-           'split_values', 'table_columns', 'table_text', 'write_table']
+           'format_value', 'load_base', 'make_row', 'metadata_path', 'parse_key', 'parse_sample',
+           'parse_set', 'parse_value', 'read_table', 'run_chunk', 'run_one', 'run_seeds',
+           'run_statistics_row', 'split_values', 'table_columns', 'table_text', 'write_table']

@@ -1,12 +1,16 @@
 """`multilift plot-sweep TABLE [--out DIR] [--rank METRIC] [--worst N]`: a sweep campaign's
 table (Parquet or CSV from `multilift sweep`) as pictures.
 
-One PNG per varied parameter (DIR/PARAM.png, default DIR: TABLE's name + `_plots` beside it)
-with a panel per run statistic against that parameter: a sampled parameter is a scatter (each
+One PNG per varied parameter (DIR/PARAM.png, default DIR: the table's full file name +
+`_plots` beside it, so runs.csv_plots/ and runs.parquet_plots/ do not overwrite each other)
+with a panel per run statistic that varies over the table against that parameter (a statistic
+with one value in every run, such as simulated_time, takes no panel: it is named on stderr),
+axes labelled with their units (`multilift_sim.units`): a sampled parameter is a scatter (each
 run a dot), a grid parameter a line through the mean at each value with the min-max spread of
 the runs there shaded; failed runs (stopped or error) that still have the figure are red
-crosses. Which parameters are grid or sampled comes from the Parquet table's campaign
-metadata; a CSV table has none, so a parameter with at most 12 distinct values, repeated, is
+crosses. Which parameters are grid or sampled comes from the campaign's metadata (in the
+Parquet file, beside a CSV as FILE.campaign.json: `campaign.table`); a CSV without it (the
+table written to stdout) is guessed: a parameter with at most 12 distinct values, repeated, is
 drawn as a grid. And DIR/worst_runs.md: the failed runs, then the N (default 10) worst by
 METRIC (default: the first of tracking_error_max, formation_error_max, max_abs_g the table
 fills), also printed. Exit codes: 0 done, 2 bad input.
@@ -19,6 +23,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from multilift_sim.units import label
 from multilift_tools import campaign as cp
 
 GRID_MAX_VALUES = 12
@@ -43,6 +48,16 @@ def metrics(columns: list[str], rows: list[dict]) -> list[str]:
             and any(_number(r.get(c)) is not None for r in rows)]
 
 
+def varying(metric_names: list[str], rows: list[dict]) -> list[str]:
+    """The statistics whose numbers are not all the same (the ones worth a panel)."""
+    out = []
+    for name in metric_names:
+        numbers = [n for n in (_number(r.get(name)) for r in rows) if n is not None]
+        if max(numbers) - min(numbers) > 1e-12 * max(1.0, abs(max(numbers))):
+            out.append(name)
+    return out
+
+
 def is_grid(name: str, rows: list[dict], meta: dict) -> bool:
     if meta:
         return name in meta.get('grid', {})
@@ -63,6 +78,17 @@ def _positions(name: str, rows: list[dict]) -> tuple[list[float], list[str] | No
 
 def plot_parameter(name: str, rows: list[dict], metric_names: list[str], grid: bool,
                    path: Path) -> None:
+    """`draw_parameter`'s figure as the PNG `path`."""
+    import matplotlib.pyplot as plt
+
+    fig = draw_parameter(name, rows, metric_names, grid)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def draw_parameter(name: str, rows: list[dict], metric_names: list[str], grid: bool):
+    """The figure of parameter `name`: a panel per statistic of `metric_names`, x and y
+    labelled with their units."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
@@ -91,8 +117,8 @@ def plot_parameter(name: str, rows: list[dict], metric_names: list[str], grid: b
             ax.scatter(*zip(*bad), marker='x', color='tab:red', label='failed')
         if labels is not None:
             ax.set_xticks(range(len(labels)), labels, rotation=30, fontsize=7)
-        ax.set_xlabel(name)
-        ax.set_ylabel(metric)
+        ax.set_xlabel(label(name))
+        ax.set_ylabel(label(metric))
         ax.grid(alpha=0.3)
     for ax in list(axes.flat)[len(metric_names):]:
         ax.axis('off')
@@ -100,8 +126,7 @@ def plot_parameter(name: str, rows: list[dict], metric_names: list[str], grid: b
     kind = 'grid: mean and min-max of the runs at each value' if grid else 'sampled: each run'
     fig.suptitle(f'{name} ({kind}; {len(rows)} runs)')
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig
 
 
 def worst_runs(columns: list[str], rows: list[dict], rank: str, count: int) -> str:
@@ -155,13 +180,19 @@ def plot_sweep_main(argv: list[str] | None = None) -> int:
         print(f'error: --rank {rank}: not a statistic with numbers in the table (have: '
               f'{", ".join(metric_names)})', file=sys.stderr)
         return 2
-    out = Path(args.out) if args.out else table.with_name(table.stem + '_plots')
+    out = Path(args.out) if args.out else table.with_name(table.name + '_plots')
     out.mkdir(parents=True, exist_ok=True)
+    panels = varying(metric_names, rows)
+    constant = [m for m in metric_names if m not in panels]
+    if constant:
+        print('the same in every run, no panel: ' + ', '.join(
+            f'{m} = {_number(next(r[m] for r in rows if _number(r.get(m)) is not None)):g}'
+            for m in constant), file=sys.stderr)
     written = []
     for name in parameters(columns):
-        if metric_names and rows:
+        if panels and rows:
             path = out / f'{name}.png'
-            plot_parameter(name, rows, metric_names, is_grid(name, rows, meta), path)
+            plot_parameter(name, rows, panels, is_grid(name, rows, meta), path)
             written.append(path)
     text = worst_runs(columns, rows, rank or 'wall_time', args.worst)
     (out / 'worst_runs.md').write_text(text)

@@ -30,8 +30,11 @@ the payload), tracking_error_max/tracking_error_rms [m] (leader
 against the mission reference, every tick; empty without a mission path), formation_error_max
 (largest |g_vc| of any follower row, m or m^2), formation_error_mean (mean over ticks and
 followers of the norm of its rows; empty for n = 1); a stopped run's figures cover the time
-flown. Then wall_time [s] and, with --bags DIR, bag (DIR/run_NNNNN, a rosbag2 directory written
-by the worker on its own host's filesystem).
+flown (every column's unit: `multilift_sim.units`). Then wall_time [s] (what the run cost its
+worker: `campaign.runs`) and, with --bags DIR, bag (DIR/run_NNNNN, a rosbag2 directory written
+by the worker on its own host's filesystem). Which parameters are grid axes and which sampled
+(`Campaign.metadata`) is in the Parquet file's metadata, or beside a CSV FILE in
+FILE.campaign.json (`campaign.table`).
 
 A worker (or a whole worker host) that dies mid-run: Dask runs its task again on another
 worker; each result is read once and released, so no row is lost or doubled. A run that kills

@@ -1,6 +1,10 @@
 """The table of a sweep campaign: a row per run (input order: run, the parameters, seed, status,
-message, the statistics, wall_time[, bag]), written as CSV or Parquet (pyarrow, with the
-campaign's metadata) and read back.
+message, the statistics, wall_time[, bag]), written as CSV or Parquet and read back.
+
+The campaign's metadata (`Campaign.metadata`: which parameters are grid axes and which are
+sampled, the seed, the scenario) travels with the table: in a Parquet file's schema metadata,
+beside a CSV file as FILE.campaign.json (`metadata_path`), since a CSV column's values cannot
+tell a grid from draws. Read back only when its parameters are the table's.
 """
 from __future__ import annotations
 
@@ -44,12 +48,24 @@ def _csv_cell(value: Any) -> str:
     return format_value(value)
 
 
+def metadata_path(path: Path) -> Path:
+    """Where a CSV table's campaign metadata lies: FILE.campaign.json beside it."""
+    return path.with_name(path.name + '.campaign.json')
+
+
 def write_table(path: Path, columns: list[str], rows: list[dict],
                 metadata: dict | None = None) -> None:
-    """Parquet (pyarrow) when `path` ends in .parquet, CSV otherwise; rows as given."""
+    """Parquet (pyarrow) when `path` ends in .parquet, CSV otherwise; rows as given; the
+    metadata in the Parquet file or beside the CSV (`metadata_path`; a CSV written without
+    metadata removes an older one's)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix != '.parquet':
         path.write_text(table_text(columns, rows))
+        sidecar = metadata_path(path)
+        if metadata is not None:
+            sidecar.write_text(json.dumps(metadata, indent=1) + '\n')
+        else:
+            sidecar.unlink(missing_ok=True)
         return
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -75,7 +91,8 @@ def _arrow_column(pa, values: list):
 
 def read_table(path: Path) -> tuple[list[str], list[dict], dict]:
     """(columns, rows, campaign metadata or {}) of a sweep table, Parquet or CSV (CSV cells:
-    numbers where they parse, '' as None)."""
+    numbers where they parse, '' as None; the metadata from FILE.campaign.json when its grid
+    and sampled keys are the table's parameter columns)."""
     if path.suffix == '.parquet':
         import pyarrow.parquet as pq
         table = pq.read_table(path)
@@ -84,7 +101,21 @@ def read_table(path: Path) -> tuple[list[str], list[dict], dict]:
     with path.open(newline='') as stream:
         reader = csv.DictReader(stream)
         rows = [{k: _csv_value(v) for k, v in row.items()} for row in reader]
-        return list(reader.fieldnames or []), rows, {}
+        columns = list(reader.fieldnames or [])
+    return columns, rows, _csv_metadata(path, columns)
+
+
+def _csv_metadata(path: Path, columns: list[str]) -> dict:
+    """FILE.campaign.json when it describes this table's parameters, else {}."""
+    try:
+        meta = json.loads(metadata_path(path).read_text())
+    except (OSError, ValueError):
+        return {}
+    if not isinstance(meta, dict) or 'run' not in columns or 'seed' not in columns:
+        return {}
+    params = columns[columns.index('run') + 1:columns.index('seed')]
+    keys = [*meta.get('grid', {}), *meta.get('sample', {})]
+    return meta if sorted(keys) == sorted(params) else {}
 
 
 def _csv_value(text: str | None) -> Any:

@@ -98,7 +98,11 @@ VECTOR_RULES = {  # key -> element rule for valid values (None: any finite), inv
     'control.attitude_gains.kd': (non_negative, st.floats(max_value=-1e-9)),
     'uavs[0].position': (finite, st.nothing()),
     'mission.start': (finite, st.nothing()),
-    'mission.segments[0].velocity': (finite, st.nothing()),
+    # a speed of at most 20 m/s (scenario.limits.MAX_MISSION_SPEED): |v| <= sqrt(3) 11 valid,
+    # one component beyond 20 m/s not
+    'mission.segments[0].velocity': (st.floats(min_value=-11.0, max_value=11.0),
+                                     st.one_of(st.floats(min_value=20.01, max_value=1e12),
+                                               st.floats(min_value=-1e12, max_value=-20.01))),
 }
 CHOICE_RULES = {'vehicle.frame_type': FRAME_TYPES, 'control.mode': scenario_io.CONTROL_MODES}
 REQUIRED = ['name', 'simulation', 'simulation.duration', 'simulation.physics_rate',

@@ -119,7 +119,8 @@ def test_the_run_summary_prints_the_tables_units(monkeypatch, capsys):
                     'max_abs_constraint_rate': 1e-8, 'max_rotor_speed': [1500.0, 1600.0],
                     'saturated_time': [0.0, 0.5], 'min_tension': 3.0, 'max_tension': 6.0,
                     'slack_time': [0.0, 0.25], 'max_payload_swing': 0.5,
-                    'rms_payload_swing': 0.2, 'max_gust_speed': 1.5},
+                    'rms_payload_swing': 0.2, 'max_gust_speed': 1.5,
+                    'compressed_time': 0.3},
             'leader': {'answered_states': 10, 'max_tracking_error': 0.3,
                        'rms_tracking_error': 0.1},
             'follower2': {'answered_states': 10, 'max_abs_formation_error': 0.2,
@@ -128,6 +129,6 @@ def test_the_run_summary_prints_the_tables_units(monkeypatch, capsys):
     out = capsys.readouterr().out
     for name in ('simulated_time', 'max_abs_g', 'max_abs_g_dot', 'max_rotor_speed',
                  'saturated_time', 'max_tension', 'slack_time', 'payload_swing_max',
-                 'payload_swing_rms', 'max_gust_speed', 'tracking_error_max',
+                 'payload_swing_rms', 'max_gust_speed', 'compressed_time', 'tracking_error_max',
                  'tracking_error_rms', 'formation_error_mean'):
         assert f'<{name}>' in out, (name, out)

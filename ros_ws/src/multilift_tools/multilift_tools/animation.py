@@ -211,11 +211,10 @@ def animate_main(argv: list[str]) -> int:
                         help='simulated seconds per second of animation (5)')
     parser.add_argument('--dpi', type=int, default=80, help='resolution (80: 560 x 448 px)')
     started = time.perf_counter()
-    loaded = parse_and_load(parser, argv)
+    loaded = parse_and_load(parser, argv, 'animation.gif')
     if isinstance(loaded, int):
         return loaded
-    args, run = loaded
-    out = Path(args.out) if args.out else run.path / 'animation.gif'
+    args, run, out = loaded
     try:
         frames = write_animation(run, out, args.fps, args.speed, args.dpi)
     except (ValueError, OSError) as exc:

@@ -273,11 +273,10 @@ def plot_main(argv: list[str]) -> int:
     parser.add_argument('--scenario', help='scenario name or YAML for the vehicle parameters '
                         "(default: the one in the bag's summary.json)")
     started = time.perf_counter()
-    loaded = parse_and_load(parser, argv)
+    loaded = parse_and_load(parser, argv, 'plots')
     if isinstance(loaded, int):
         return loaded
-    args, run = loaded
-    out = Path(args.out) if args.out else run.path / 'plots'
+    args, run, out = loaded
     written, skipped = make_plots(plot_context(run, args.scenario), out)
     for path in written:
         print(path)

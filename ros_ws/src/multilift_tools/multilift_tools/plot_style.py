@@ -182,12 +182,15 @@ def plot_context(run: Run, scenario: str | None) -> Context:
     return Context(run, found)
 
 
-def parse_and_load(parser: argparse.ArgumentParser, argv: list[str]
-                   ) -> tuple[argparse.Namespace, Run] | int:
-    """Parse `argv` (a positional `bag`) and load the bag: (arguments, run), or the exit code
-    (parse_args's, or 2 after load_bag's `error:` line)."""
+def parse_and_load(parser: argparse.ArgumentParser, argv: list[str], default_out: str
+                   ) -> tuple[argparse.Namespace, Run, Path] | int:
+    """Parse `argv` (a positional `bag`, an optional `--out`) and load the bag: (arguments,
+    run, where the output goes: `--out`, else `default_out` in the bag's folder), or the exit
+    code (parse_args's, or 2 after load_bag's `error:` line)."""
     args = parse_args(parser, argv)
     if isinstance(args, int):
         return args
     run = load_bag(args.bag)
-    return 2 if run is None else (args, run)
+    if run is None:
+        return 2
+    return args, run, Path(args.out) if args.out else run.path / default_out

@@ -133,6 +133,8 @@ def fault_lines(scenario, events: list[dict], t_end: float | None) -> list[str]:
     happened: the summary's first `len(events)` event rows) and the rotors their UAV's
     reallocated mixer then pins at omega_min (live, no collective share:
     `faults.fault_mixers`), each with how long [s]: neither counts as saturated."""
+    if not any(event['type'] == 'rotor_effectiveness' for event in events):
+        return []
     from multilift_control.faults import fault_mixers
     from multilift_control.laws.layout import MIXER_COLLECTIVE, MIXER_WRENCH
     from multilift_sim.physics.layout import (EVENT_KIND, EVENT_ROTOR, EVENT_TIME, EVENT_UAV,

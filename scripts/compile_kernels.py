@@ -1,0 +1,107 @@
+"""Compile the kernels into numba's on-disk cache (multilift_sim.kernels: how start-up stays
+low), a stage per call, so scripts/setup runs independent stages in parallel processes on the
+machine's two cores (a kernel one stage compiled is loaded from the cache by the next):
+
+- `physics`: the physics' tick (multilift_sim.physics.tick) as the simulator node steps it
+  (rigid and slack cables, a rigid payload, events and sensors);
+- `laws`: every controller's compiled laws as the controller nodes call them (the runtimes);
+- `engine`: the engine's tick over B formations (`run --headless`, sweeps), after the two;
+- `learning`: the engine's calls the learning environments make (answers, commanded ticks,
+  references, attitude commands), after the first two;
+- `rest`: the simulator's messages and a run of every kind, tick by tick (mostly loads).
+
+Run by scripts/setup with the workspace's environment (scripts/env.sh), MULTILIFT_KERNEL=jit.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import sys
+
+import yaml
+
+from multilift_sim import kernels, scenario  # NUMBA_CACHE_DIR: the folder of these sources
+
+
+def _short(name: str, cables: str | None = None) -> scenario.Scenario:
+    base = scenario.load(name)
+    short = base.with_duration(0.05)
+    return short if cables is None else dataclasses.replace(short, cable_model=cables)
+
+
+def _every_kind() -> scenario.Scenario:
+    """multi_lift with every kind of event (docs/events.md) and sensors (docs/sensors.md)."""
+    data = yaml.safe_load(scenario.resolve('multi_lift').read_text())
+    data['simulation']['duration'] = 0.05
+    data['events'] = [
+        {'time': 0.01, 'type': 'rotor_effectiveness', 'uav': 2, 'rotor': 1,
+         'effectiveness': 0.5},
+        {'time': 0.02, 'type': 'controller_silence', 'uav': 1, 'duration': 0.01},
+        {'time': 0.03, 'type': 'cable_release', 'uav': 3}]
+    data['sensors'] = {'position_noise': 0.01, 'latency_ticks': 1}
+    return scenario.loads(yaml.safe_dump(data))
+
+
+def physics() -> None:
+    from multilift_sim.simulation import FormationSimulator
+    for short in (_short('twin_lift'), _short('twin_lift', 'slack'), _short('box_lift'),
+                  _every_kind()):
+        sim = FormationSimulator(short)
+        speeds = [list(range(1400, 1400 + u.vehicle.n_rotors)) for u in short.uavs]
+        flags = [[False] * u.vehicle.n_rotors for u in short.uavs]
+        for _ in range(3):
+            sim.snapshot()
+            sim.advance(speeds, flags)
+        sim.cable_state(speeds)
+
+
+def laws() -> None:
+    from multilift_control.runtime import answer_tick, formation_runtimes, uav_states
+    from multilift_sim.simulation import FormationSimulator
+    for short in (_short('twin_lift'), _short('circle3'), _every_kind()):
+        # the simulator uncompiled (the `physics` stage compiles it), the laws compiled
+        os.environ[kernels.VARIABLE] = 'python'
+        snapshot = FormationSimulator(short).snapshot()
+        os.environ[kernels.VARIABLE] = 'jit'
+        answer_tick(formation_runtimes(short), 0, uav_states(snapshot))
+
+
+def engine() -> None:
+    from multilift_control.engine import Engine
+    for short in (_short('twin_lift'), _every_kind()):
+        Engine(short).step(5)
+
+
+def learning() -> None:
+    from multilift_control.engine import Engine
+    from multilift_learning.vector_env import FormationVectorEnv
+    short = _short('twin_lift')
+    for task in ('hover', 'mission'):
+        envs = FormationVectorEnv(2, short, task)
+        envs.reset(seed=0)
+        envs.step(envs.expert_actions())
+    engine = Engine(short)
+    engine.attitude_speeds(engine.measured()[:, :, :3] * 0.0, engine.measured()[:, :, 0] * 0.0)
+
+
+def rest() -> None:
+    from multilift_control.engine import Engine
+    from multilift_control.headless import run_headless
+    from multilift_sim.wire.tick_messages import SimulatorMessages
+    kernels.prune_cache()  # the folders of older sources
+    for short in (_short('twin_lift'), _short('circle3'), _short('twin_lift', 'slack')):
+        run_headless(short)
+        Engine(short).step(5)
+    events = _every_kind()
+    run = run_headless(events)
+    SimulatorMessages(events).state(run.simulator.snapshot(), [0.0] * 3, None)
+    rigid = _short('box_lift')
+    SimulatorMessages(rigid).state(run_headless(rigid).simulator.snapshot(), [0.0] * 3, None)
+
+
+STAGES = {'physics': physics, 'laws': laws, 'engine': engine, 'learning': learning,
+          'rest': rest}
+
+if __name__ == '__main__':
+    for stage in sys.argv[1:]:
+        STAGES[stage]()

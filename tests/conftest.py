@@ -75,6 +75,29 @@ def pytest_sessionstart(session) -> None:
     does (multilift_sim.ros.shared_memory)."""
     from multilift_sim.ros.shared_memory import remove_stale_files
     remove_stale_files()
+    session.config.semaphores_before = _semaphores()
+
+
+def _semaphores() -> set[str]:
+    """multiprocessing's named semaphores in /dev/shm (sem.mp-*): removed by their process's
+    resource tracker when it ends; one left is a process that did not end (issue 37: a
+    fresh-clone run once left 12)."""
+    shm = Path('/dev/shm')
+    return {p.name for p in shm.glob('sem.mp-*')} if shm.is_dir() else set()
+
+
+def pytest_sessionfinish(session, exitstatus) -> None:
+    """The session fails when its processes left multiprocessing semaphores behind (checked
+    once, by the controlling pytest process, after every worker ended)."""
+    if hasattr(session.config, 'workerinput'):  # an xdist worker: its controller checks
+        return
+    left = sorted(_semaphores() - getattr(session.config, 'semaphores_before', set()))
+    if left:
+        reporter = session.config.pluginmanager.get_plugin('terminalreporter')
+        if reporter is not None:
+            reporter.write_line(f'error: the tests left {len(left)} multiprocessing semaphores '
+                                f'in /dev/shm: {", ".join(left)}', red=True)
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 
 # The longest test files (a minute or more of wall time each) first: pytest-xdist hands a

@@ -34,21 +34,23 @@ def _scenario(name: str, duration: float, **top) -> scenario_io.Scenario:
     return scenario_io.loads(yaml.safe_dump(data))
 
 
-@pytest.fixture(scope='module')
-def released(tmp_path_factory):
-    scenario = _scenario('multi_lift', 2.5,
-                         events=[{'time': RELEASE, 'type': 'cable_release', 'uav': 3}])
-    bag = tmp_path_factory.mktemp('released') / 'bag'
+def _recorded(tmp_path_factory, scenario, name: str) -> Context:
+    """`scenario` flown headless into a bag of its own, loaded for the figures."""
+    bag = tmp_path_factory.mktemp(name) / 'bag'
     record_headless(scenario, bag)
     return Context(load_run(bag), scenario)
+
+
+@pytest.fixture(scope='module')
+def released(tmp_path_factory):
+    return _recorded(tmp_path_factory, _scenario(
+        'multi_lift', 2.5, events=[{'time': RELEASE, 'type': 'cable_release', 'uav': 3}]),
+        'released')
 
 
 @pytest.fixture(scope='module')
 def box(tmp_path_factory):
-    scenario = scenario_io.load('box_lift').with_duration(2.0)
-    bag = tmp_path_factory.mktemp('box') / 'bag'
-    record_headless(scenario, bag)
-    return Context(load_run(bag), scenario)
+    return _recorded(tmp_path_factory, scenario_io.load('box_lift').with_duration(2.0), 'box')
 
 
 def _close(a, b, tol=1e-9) -> bool:
@@ -168,10 +170,8 @@ def test_3d_axis_labels_clear_their_tick_labels(which, request):
 
 @pytest.fixture(scope='module')
 def hexa(tmp_path_factory):
-    scenario = scenario_io.load('hexa_rotor_failure').with_duration(31.0)
-    bag = tmp_path_factory.mktemp('hexa') / 'bag'
-    record_headless(scenario, bag)
-    return Context(load_run(bag), scenario)
+    return _recorded(tmp_path_factory,
+                     scenario_io.load('hexa_rotor_failure').with_duration(31.0), 'hexa')
 
 
 def test_six_rotors_are_told_apart_and_the_clipped_strip_is_at_the_lower_limit(hexa):

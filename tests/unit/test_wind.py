@@ -147,7 +147,7 @@ def test_a_gust_s_period_means_carry_its_whole_impulse():
     """gust_profile_mean: 0 outside the gust, the 1-cosine's peak 1 at its middle, and over any
     periods covering it the means sum to D / 2 per period (the profile's integral, in closed
     form: the wind's impulse over the gust is exact however the periods cut it)."""
-    from multilift_sim.schedules import gust_profile_mean
+    from multilift_sim.events.gust import profile_mean as gust_profile_mean
 
     period, onset, duration = 0.01, 1.234, 2.5
     starts = np.arange(0, 500) * period
@@ -201,7 +201,7 @@ def test_the_wind_is_on_a_topic_where_the_air_moves_everywhere(tmp_path):
     engine's bag and the per-object path's alike to the byte; none in a still-air run."""
     from rosbags.highlevel import AnyReader
 
-    from multilift_sim.schedules import gust_profile_mean
+    from multilift_sim.events.gust import profile_mean as gust_profile_mean
     from multilift_sim.topics import WIND, scenario_topics
     from multilift_tools.headless_bag import _record_per_object, record_headless
 

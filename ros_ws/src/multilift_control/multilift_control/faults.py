@@ -25,9 +25,8 @@ from multilift_control.cascade import RotorMixer
 from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_control.laws.layout import MIXER_SIZE
 from multilift_sim.formation_geometry import hanging_payload
-from multilift_sim.physics.layout import (EVENT_KIND, EVENT_ROTOR, EVENT_TICK, EVENT_UAV,
-                                          EVENT_VALUE, KIND_CABLE_RELEASE,
-                                          KIND_ROTOR_EFFECTIVENESS)
+from multilift_control.reactions import lets_go, reaction_of, reallocates
+from multilift_sim.physics.layout import EVENT_TICK, EVENT_UAV
 from multilift_sim.scenario import Scenario
 from multilift_sim.schedules import event_array
 
@@ -36,21 +35,29 @@ RELEASE_TRANSITION = 5.0  # [s] the formation takes to move to its new offsets
 
 
 def fault_mixers(scenario: Scenario) -> np.ndarray:
-    """(k, rotors, MIXER_SIZE): for each event row (`simulation.event_array`) of kind
-    rotor_effectiveness the mixer rows of its UAV after it (every earlier fault of that UAV
-    kept); zeros for the other kinds (unused). `rotors`: the most any UAV has."""
+    """(k, rotors, MIXER_SIZE): for each event row (`simulation.event_array`) whose reaction
+    reallocates a mixer (`reactions`: a rotor's effectiveness) the mixer rows of its UAV after
+    it (every earlier fault of that UAV kept); zeros for the others (unused). `rotors`: the
+    most any UAV has."""
     rows = event_array(scenario)
     rotors = max(u.vehicle.n_rotors for u in scenario.uavs)
     effectiveness = [np.ones(u.vehicle.n_rotors) for u in scenario.uavs]
     out = np.zeros((len(rows), rotors, MIXER_SIZE))
     for k, row in enumerate(rows):
-        if int(row[EVENT_KIND]) != KIND_ROTOR_EFFECTIVENESS:
+        if not reallocates(row):
             continue
-        uav = int(row[EVENT_UAV])
-        effectiveness[uav][int(row[EVENT_ROTOR])] = row[EVENT_VALUE]
+        uav = reaction_of(row).rotors(row, effectiveness)
         mixer = RotorMixer(scenario.uavs[uav].vehicle, effectiveness[uav]).rows
         out[k, :mixer.shape[0]] = mixer
     return out
+
+
+def mixer_uavs(scenario: Scenario) -> np.ndarray:
+    """(k,) int: for each event row the UAV (from 0) whose mixer it reallocates
+    (`fault_mixers[k]` its rows), -1 none."""
+    rows = event_array(scenario)
+    return np.array([int(row[EVENT_UAV]) if reallocates(row) else -1 for row in rows],
+                    dtype=np.int64)
 
 
 def _initial_targets(scenario: Scenario) -> tuple[VirtualConstraints | None, np.ndarray]:
@@ -75,8 +82,8 @@ def release_targets(scenario: Scenario) -> np.ndarray:
     holding = np.ones(scenario.n_uavs, dtype=bool)  # whose cables hold the payload
     lengths = [u.cable_length for u in scenario.uavs]
     for k, row in enumerate(rows):
-        uav = int(row[EVENT_UAV])
-        if int(row[EVENT_KIND]) == KIND_CABLE_RELEASE and uav > 0 and constraints.linear:
+        uav = lets_go(row)
+        if uav > 0 and constraints.linear:
             # offsets o_i = r_1 - r_i, three rows per follower (VirtualConstraints)
             offsets = np.vstack([np.zeros(3), targets.reshape(-1, 3)])
             positions = -offsets  # the nominal places relative to the leader
@@ -107,7 +114,7 @@ def target_schedule(scenario: Scenario) -> np.ndarray:
     _, previous = _initial_targets(scenario)
     ticks = max(1, int(round(RELEASE_TRANSITION * scenario.simulation.control_rate)))
     for k, row in enumerate(rows):
-        if int(row[EVENT_KIND]) != KIND_CABLE_RELEASE or np.array_equal(final[k], previous):
+        if lets_go(row) < 0 or np.array_equal(final[k], previous):
             continue
         for step in range(ticks):
             x = (step + 1) / ticks
@@ -120,17 +127,16 @@ def target_schedule(scenario: Scenario) -> np.ndarray:
 
 class FaultReallocation:
     """UAV `index`'s controller side of the faults: `at(tick, mixer, constraints)` writes the
-    mixer rows of every rotor_effectiveness event of this UAV, and a follower's formation
-    targets after every cable_release, up to `tick` into `mixer` (a RotorMixer) and
+    mixer rows of every event reallocating this UAV's mixer, and a follower's formation
+    targets after every release of a cable, up to `tick` into `mixer` (a RotorMixer) and
     `constraints` (its VirtualConstraints; None for the leader)."""
 
     def __init__(self, scenario: Scenario, index: int):
         rows = event_array(scenario)
-        mixers = fault_mixers(scenario)
+        mixers, uavs = fault_mixers(scenario), mixer_uavs(scenario)
         self._pending = []
         for k, row in enumerate(rows):
-            if (int(row[EVENT_KIND]) == KIND_ROTOR_EFFECTIVENESS
-                    and int(row[EVENT_UAV]) == index):
+            if uavs[k] == index:
                 self._pending.append((int(row[EVENT_TICK]), 'mixer', mixers[k]))
         if index > 0:
             self._pending += [(int(row[0]), 'targets', row[1:])

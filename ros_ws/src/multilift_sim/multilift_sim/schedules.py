@@ -11,10 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_DURATION, EVENT_END_TICK,
-                                          EVENT_KIND, EVENT_KINDS, EVENT_ROTOR, EVENT_TICK,
-                                          EVENT_TIME, EVENT_UAV, EVENT_VALUE, EVENT_VELOCITY,
-                                          MEASURED_COLUMNS)
+from multilift_sim.events import EVENT_KINDS, kind_index, moves_air
+from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_KIND, EVENT_ROTOR, EVENT_TICK,
+                                          EVENT_TIME, EVENT_UAV, MEASURED_COLUMNS)
 from multilift_sim.scenario import Scenario
 from multilift_sim.sensors import sensor_errors
 from multilift_sim.turbulence import dryden_series
@@ -29,18 +28,10 @@ def event_array(scenario: Scenario) -> np.ndarray:
     for k, event in enumerate(scenario.events):
         rows[k, EVENT_TICK] = math.ceil(event.time * rate - 1e-9)
         rows[k, EVENT_TIME] = event.time
-        rows[k, EVENT_KIND] = EVENT_KINDS.index(event.type)
+        rows[k, EVENT_KIND] = kind_index(event.type)
         rows[k, EVENT_UAV] = event.uav - 1
         rows[k, EVENT_ROTOR] = max(event.rotor - 1, 0)
-        if event.type == 'controller_silence':
-            rows[k, EVENT_VALUE] = event.duration
-            rows[k, EVENT_END_TICK] = math.ceil((event.time + event.duration) * rate - 1e-9)
-        elif event.type == 'gust':
-            rows[k, EVENT_VALUE] = math.sqrt(sum(v * v for v in event.velocity))
-            rows[k, EVENT_DURATION] = event.duration
-            rows[k, EVENT_VELOCITY:EVENT_VELOCITY + 3] = event.velocity
-        else:
-            rows[k, EVENT_VALUE] = event.effectiveness
+        EVENT_KINDS[event.type].pack(event, rows[k], rate)  # its own slots
     return rows
 
 
@@ -48,11 +39,11 @@ def wind_series(scenario: Scenario) -> np.ndarray:
     """The unsteady wind [m/s], world, of every control period of the run, (ticks + 1, 3), or
     (0, 3) where the wind is steady: tick k's is held over the period from it, added to the
     steady wind. The Dryden turbulence sampled at the tick (`turbulence.dryden_series`,
-    `wind.turbulence`) plus the gust events' 1-cosine profiles averaged over the period
-    (`gust_profile_mean`, docs/wind.md)."""
+    `wind.turbulence`) plus what each event that blows air gives over the period (its kind's
+    `unsteady_wind`: a gust's 1-cosine profile averaged over the period, docs/wind.md)."""
     sim = scenario.simulation
-    gusts = [e for e in scenario.events if e.type == 'gust']
-    if scenario.turbulence is None and not gusts:
+    blowing = [e for e in scenario.events if moves_air(e.type)]
+    if scenario.turbulence is None and not blowing:
         return np.zeros((0, 3))
     series = np.zeros((sim.tick_count + 1, 3))
     config = scenario.turbulence
@@ -61,23 +52,9 @@ def wind_series(scenario: Scenario) -> np.ndarray:
                                 config.length_scale, config.airspeed, scenario.wind,
                                 config.seed)
     starts = np.arange(sim.tick_count + 1) / sim.control_rate
-    for gust in gusts:
-        series += np.outer(gust_profile_mean(starts, 1.0 / sim.control_rate, gust.time,
-                                             gust.duration), gust.velocity)
+    for event in blowing:
+        series += EVENT_KINDS[event.type].unsteady_wind(event, starts, 1.0 / sim.control_rate)
     return series
-
-
-def gust_profile_mean(starts: np.ndarray, period: float, onset: float,
-                      duration: float) -> np.ndarray:
-    """The mean over each period [s, s + period] (starts (K,) [s]) of a 1-cosine gust's
-    profile p(t) = (1 - cos(2 pi (t - onset) / D)) / 2 for onset <= t <= onset + D, 0 outside
-    (the time form of seed Eq. 2.55's 1-cosine shape): its integral over the period's overlap
-    with the gust, in closed form, divided by the period."""
-    a = np.clip(starts, onset, onset + duration)
-    b = np.clip(starts + period, onset, onset + duration)
-    w = 2.0 * math.pi / duration
-    integral = 0.5 * (b - a) - (np.sin(w * (b - onset)) - np.sin(w * (a - onset))) / (2.0 * w)
-    return integral / period
 
 
 @dataclass(frozen=True)

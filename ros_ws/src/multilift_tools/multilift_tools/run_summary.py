@@ -129,26 +129,27 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
 
 
 def fault_lines(scenario, events: list[dict], t_end: float | None) -> list[str]:
-    """The summary's lines for the rotors that failed (the `rotor_effectiveness` events that
-    happened: the summary's first `len(events)` event rows) and the rotors their UAV's
-    reallocated mixer then pins at omega_min (live, no collective share:
-    `faults.fault_mixers`), each with how long [s]: neither counts as saturated."""
-    if not any(event['type'] == 'rotor_effectiveness' for event in events):
+    """The summary's lines for the rotors that failed (the events that happened, the summary's
+    first `len(events)` event rows, whose reaction reallocates a mixer:
+    `multilift_control.reactions`) and the rotors their UAV's reallocated mixer then pins at
+    omega_min (live, no collective share: `faults.fault_mixers`), each with how long [s]:
+    neither counts as saturated."""
+    if not events:
         return []
-    from multilift_control.faults import fault_mixers
+    from multilift_control.faults import fault_mixers, mixer_uavs
     from multilift_control.laws.layout import MIXER_COLLECTIVE, MIXER_WRENCH
-    from multilift_sim.physics.layout import (EVENT_KIND, EVENT_ROTOR, EVENT_TIME, EVENT_UAV,
-                                              EVENT_VALUE, KIND_ROTOR_EFFECTIVENESS)
+    from multilift_sim.physics.layout import EVENT_ROTOR, EVENT_TIME, EVENT_UAV, EVENT_VALUE
     from multilift_sim.schedules import event_array
 
     rows = event_array(scenario)[:len(events)]
-    if not any(int(row[EVENT_KIND]) == KIND_ROTOR_EFFECTIVENESS for row in rows):
+    reallocating = mixer_uavs(scenario)[:len(events)] >= 0
+    if not reallocating.any():
         return []
     mixers = fault_mixers(scenario)
     end = t_end if t_end is not None else scenario.simulation.duration
     lines = []
     for k, row in enumerate(rows):
-        if int(row[EVENT_KIND]) != KIND_ROTOR_EFFECTIVENESS:
+        if not reallocating[k]:
             continue
         uav, start = int(row[EVENT_UAV]) + 1, float(row[EVENT_TIME])
         lines.append(f'  uav{uav} rotor {int(row[EVENT_ROTOR]) + 1}    effectiveness '

@@ -16,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 
 from multilift_control.controllers import LEADER_CONTROLLERS, ConstantRotorSpeed, MissionLeader
-from multilift_control.faults import fault_mixers, target_schedule
+from multilift_control.faults import fault_mixers, mixer_uavs, target_schedule
 from multilift_control.formation import FormationFollower
 from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_MEMORY_SIZE,
                                            FOLLOWER_SIZE, FOLLOWER_TWO_ALPHA, REFERENCE_SIZE,
@@ -50,6 +50,7 @@ class ControlArrays(NamedTuple):
     leader_mode: np.ndarray       # (B,) int: MODE_*
     cascade: np.ndarray           # (B, n, CASCADE_SIZE): every UAV's cascade constants
     fault_mixers: np.ndarray      # (B, k, rotors, MIXER_SIZE): faults.fault_mixers
+    mixer_uavs: np.ndarray        # (B, k) int: the UAV each event's mixer is of (-1: none)
     target_schedule: np.ndarray   # (B, S, 1 + m): (tick, targets) rows, faults.target_schedule
     mission: np.ndarray           # (B, MISSION_SIZE)
     segments: np.ndarray          # (B, s, SEGMENT_SIZE)
@@ -154,7 +155,8 @@ def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
     arrays.update(
         leader_mode=LEADER_MODES.index(scenario.control.mode),
         cascade=np.stack([c.constants for c in cascades]),
-        fault_mixers=fault_mixers(scenario), target_schedule=target_schedule(scenario),
+        fault_mixers=fault_mixers(scenario), mixer_uavs=mixer_uavs(scenario),
+        target_schedule=target_schedule(scenario),
         mission=path.mission, segments=path.segments, mission_steps=path.steps,
         constant_speeds=np.asarray(constant.rotor_speeds, dtype=float),
         constant_saturated=np.asarray(constant.saturated, dtype=bool),

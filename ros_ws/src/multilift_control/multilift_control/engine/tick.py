@@ -20,7 +20,6 @@ from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UA
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
 from multilift_sim.physics import tick as physics
-from multilift_sim.physics.layout import EVENT_KIND, EVENT_UAV, KIND_ROTOR_EFFECTIVENESS
 from multilift_sim.physics.measurement import payload_position, payload_velocity
 from multilift_sim.statistics.accumulators import formation_error_add, tracking_add
 
@@ -81,12 +80,13 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
 @jit
 def tell_controllers(a, m, b, first):
     """The controllers told at once of the events of formation b from row `first` on (those
-    the physics' tick just applied): a rotor's fault reallocates its UAV's mixer
-    (`faults.fault_mixers`); a cable's release sends the formation's new offsets along
-    `faults.target_schedule`, whose rows take effect at their tick."""
+    the physics' tick just applied), as their kinds' reactions say (`multilift_control.
+    reactions`): a UAV's mixer reallocated (`faults.fault_mixers`, `faults.mixer_uavs`: a
+    rotor's fault); the formation's new offsets along `faults.target_schedule` (a cable's
+    release), whose rows take effect at their tick."""
     for k in range(first, m.next_event[b]):
-        if int(a.events[b, k, EVENT_KIND]) == KIND_ROTOR_EFFECTIVENESS:
-            m.mixers[b, int(a.events[b, k, EVENT_UAV])] = a.fault_mixers[b, k]
+        if a.mixer_uavs[b, k] >= 0:
+            m.mixers[b, a.mixer_uavs[b, k]] = a.fault_mixers[b, k]
     schedule = a.target_schedule[b]
     while m.next_target[b] < schedule.shape[0] and schedule[m.next_target[b], 0] <= m.tick[b]:
         m.targets[b, :] = schedule[m.next_target[b], 1:]

@@ -1,35 +1,33 @@
 """The scenario's events (`events:`, issue 21) applied to a formation's arrays at the control
 tick they fall on, before that tick's state is checked and sent: the state at the tick shows
 them (a released cable no longer taut) and the period from the tick on feels them. One
-function, which the engine's tick and FormationSimulator both call. Rows and kinds:
-`physics.layout` EVENT_*.
+function, which the engine's tick and FormationSimulator both call. Rows: `physics.layout`
+EVENT_*; what each kind does: its module of `multilift_sim.events` (the registry
+EVENT_KINDS), reached through `apply_event`, the dispatcher generated from the registry
+(`multilift_sim.events.compiled`).
 """
 import math
 
+from multilift_sim.events.compiled import dispatcher
 from multilift_sim.kernels import jit
-from multilift_sim.physics.layout import (EVENT_END_TICK, EVENT_KIND, EVENT_ROTOR, EVENT_TICK,
-                                          EVENT_UAV, EVENT_VALUE, KIND_CABLE_RELEASE,
-                                          KIND_CONTROLLER_SILENCE, KIND_ROTOR_EFFECTIVENESS)
+from multilift_sim.physics.layout import EVENT_KIND, EVENT_TICK
+
+# the registry's compiled dispatcher: apply_event(kind, row, tick, effectiveness, taut,
+# released, silent_until); rebound when the registry changes (events.compiled.refresh)
+apply_event = dispatcher()
 
 
 @jit
 def apply_events(events, next_event, tick, effectiveness, taut, released, silent_until):
     """Apply every event of `events` (k, EVENT_COLUMNS) from row `next_event` on whose tick is
-    at or before `tick`: a rotor's effectiveness (n, rotors) set; a cable released (released
-    (n,) bool set, its taut flag cleared: it no longer constrains, and a slack model never
-    snaps it taut again); a controller silenced (silent_until (n,) int: the first tick whose
-    command arrives again). Returns the row of the next event to come (k: none left)."""
+    at or before `tick`, each by its kind's `apply` (what it may change: the rotors'
+    effectiveness (n, rotors), taut (n,) bool, released (n,) bool: the cables let go of for
+    good, silent_until (n,) int: the first tick whose command arrives again). Returns the row
+    of the next event to come (k: none left)."""
     k = next_event
     while k < events.shape[0] and events[k, EVENT_TICK] <= tick:
-        kind = int(events[k, EVENT_KIND])
-        uav = int(events[k, EVENT_UAV])
-        if kind == KIND_ROTOR_EFFECTIVENESS:
-            effectiveness[uav, int(events[k, EVENT_ROTOR])] = events[k, EVENT_VALUE]
-        elif kind == KIND_CABLE_RELEASE:
-            released[uav] = True
-            taut[uav] = False
-        elif kind == KIND_CONTROLLER_SILENCE:
-            silent_until[uav] = max(silent_until[uav], int(events[k, EVENT_END_TICK]))
+        apply_event(int(events[k, EVENT_KIND]), events[k], tick, effectiveness, taut, released,
+                    silent_until)
         k += 1
     return k
 

@@ -62,17 +62,11 @@ ACTUATOR_RATE_LIMIT = 1     # the largest |d omega / dt| [rad/s^2]; inf: none
 ACTUATOR_COLUMNS = 2
 
 # -- an event of the scenario's `events:` (rows of (k, EVENT_COLUMNS) in time order;
-# physics.events) and the kinds it can be: the one registry, which scenario validation reads --
-EVENT_KINDS = ('rotor_effectiveness', 'cable_release', 'controller_silence', 'gust')
-KIND_ROTOR_EFFECTIVENESS = 0    # a rotor's thrust and moment scale by EVENT_VALUE from then on
-KIND_CABLE_RELEASE = 1          # UAV EVENT_UAV's cable lets go of the payload for good
-KIND_CONTROLLER_SILENCE = 2     # UAV EVENT_UAV's commands do not arrive until EVENT_END_TICK
-KIND_GUST = 3                   # a 1-cosine gust of the whole formation's air (EVENT_UAV -1),
-#                                 in the run's wind series (multilift_sim.wind_series)
+# physics.events); its kinds are registered parts, `multilift_sim.events.EVENT_KINDS` -------
 EVENT_TICK = 0              # the control tick it happens at (the first at or after its time)
 EVENT_TIME = 1              # the time the scenario gives [s]
-EVENT_KIND = 2              # KIND_*: its index in EVENT_KINDS
-EVENT_UAV = 3               # the UAV it concerns, from 0
+EVENT_KIND = 2              # its kind's index in multilift_sim.events.EVENT_KINDS
+EVENT_UAV = 3               # the UAV it concerns, from 0 (-1: none)
 EVENT_ROTOR = 4             # the rotor, from 0 (rotor_effectiveness; else 0)
 EVENT_VALUE = 5             # rotor_effectiveness: its new effectiveness; silence: seconds;
 #                             gust: its peak speed [m/s]

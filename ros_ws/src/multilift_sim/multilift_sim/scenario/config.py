@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, field
 
 from multilift_sim.disturbances import Gust
+from multilift_sim.events import moves_air
 from multilift_sim.formation_params import FormationParams
 from multilift_sim.formation_geometry import FORMATION_GEOMETRIES  # noqa: F401 (the registry)
 from multilift_sim.multirotor import MultirotorParams
@@ -131,15 +132,20 @@ class MissionConfig:
 @dataclass(frozen=True)
 class EventConfig:
     """One of the scenario's `events:` (issue 21), applied at the first control tick at or
-    after its time (physics.events)."""
+    after its time (physics.events). Its kind's module (multilift_sim.events) reads its keys
+    into these fields: the ones kinds share, and a kind's own numbers in `values`."""
     time: float                      # [s]
-    type: str                        # one of physics.layout.EVENT_KINDS
-    uav: int                         # the UAV it concerns, from 1 (1 = the leader); gust: 0
-    rotor: int = 0                   # rotor_effectiveness: the rotor, from 1; else 0
-    effectiveness: float = 1.0       # rotor_effectiveness: its share of thrust, in [0, 1]
-    duration: float = 0.0            # controller_silence: how long no command arrives [s];
-    #                                  gust: how long it blows [s]
-    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)  # gust: its peak [m/s], world
+    type: str                        # a name of multilift_sim.events.EVENT_KINDS
+    uav: int                         # the UAV it concerns, from 1 (1 = the leader); 0: none
+    rotor: int = 0                   # the rotor, from 1; 0: none
+    effectiveness: float = 1.0       # a rotor's share of thrust, in [0, 1]
+    duration: float = 0.0            # how long it lasts [s]
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)  # a velocity [m/s], world
+    values: tuple[tuple[str, float], ...] = ()  # a kind's own numbers by key
+
+    def value(self, key: str) -> float:
+        """The kind's own number `key` (of `values`)."""
+        return dict(self.values)[key]
 
 
 @dataclass(frozen=True)
@@ -194,10 +200,10 @@ class Scenario:
 
     @property
     def has_wind(self) -> bool:
-        """Whether the air moves everywhere (a steady wind, turbulence or a gust event:
-        /formation/wind carries it), beyond the seed's gusts at places."""
+        """Whether the air moves everywhere (a steady wind, turbulence or an event that blows
+        air: /formation/wind carries it), beyond the seed's gusts at places."""
         return (any(self.wind) or self.turbulence is not None
-                or any(e.type == 'gust' for e in self.events))
+                or any(moves_air(e.type) for e in self.events))
 
     def formation_params(self, baumgarte_alpha: float | None = None,
                          baumgarte_beta: float | None = None) -> FormationParams:

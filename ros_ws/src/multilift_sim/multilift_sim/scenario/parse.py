@@ -14,7 +14,8 @@ from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
 from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_rigid_body_inertia,
                                          solid_inertia)
-from multilift_sim.physics.layout import EVENT_KINDS, SENSED_QUANTITIES
+from multilift_sim.events import EVENT_KINDS
+from multilift_sim.physics.layout import SENSED_QUANTITIES
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
@@ -297,40 +298,14 @@ def _sensors(d: Section, sim: SimulationConfig) -> SensorConfig:
 
 def _events(top: Section, uavs: list[UavConfig], duration: float) -> tuple[EventConfig, ...]:
     """The `events:` list, validated (each key of its type, nothing else) and in time order."""
-    events = []
-    released: set[int] = set()
+    events: list[EventConfig] = []
     for k, entry in enumerate(top.sequence('events', [])):
         e = Section(entry, f'events[{k}]', top.where)
         time = e.number('time', ..., lambda v: 0 <= v < duration,
                         f'must be >= 0 and before the run\'s end ({duration:g} s)')
-        kind = e.text('type', choices=EVENT_KINDS)
-        if kind == 'gust':  # the whole formation's air: no UAV
-            velocity = e.vector('velocity')
-            if not any(velocity):
-                raise e.fail('velocity', list(velocity), 'must not be zero')
-            events.append(EventConfig(time=time, type=kind, uav=0, velocity=velocity,
-                                      duration=e.positive('duration')))
-            e.done()
-            continue
-        uav = e.raw('uav')
-        if isinstance(uav, bool) or not isinstance(uav, int) or not 1 <= uav <= len(uavs):
-            raise e.fail('uav', uav, f'must be a UAV from 1 to {len(uavs)}')
-        event = EventConfig(time=time, type=kind, uav=uav)
-        if kind == 'rotor_effectiveness':
-            rotors = uavs[uav - 1].vehicle.n_rotors
-            rotor = e.raw('rotor')
-            if isinstance(rotor, bool) or not isinstance(rotor, int) or not 1 <= rotor <= rotors:
-                raise e.fail('rotor', rotor, f'must be a rotor of uav{uav}, from 1 to {rotors}')
-            event = dataclasses.replace(event, rotor=rotor, effectiveness=e.number(
-                'effectiveness', ..., lambda v: 0 <= v <= 1, 'must be within [0, 1]'))
-        elif kind == 'controller_silence':
-            event = dataclasses.replace(event, duration=e.positive('duration'))
-        elif kind == 'cable_release':
-            if uav in released:
-                raise e.fail('uav', uav, 'has let go of its cable already')
-            released.add(uav)
-            if len(released) == len(uavs):
-                raise e.fail('uav', uav, 'is the last cable holding the payload')
+        kind = e.text('type', choices=tuple(EVENT_KINDS))
+        # its own keys, by its registered module (multilift_sim.events)
+        event = EventConfig(time=time, type=kind, **EVENT_KINDS[kind].parse(e, uavs, events))
         e.done()
         events.append(event)
     return tuple(sorted(events, key=lambda event: event.time))

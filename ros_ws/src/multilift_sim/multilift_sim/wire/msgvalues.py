@@ -11,10 +11,8 @@ from typing import Sequence
 
 import numpy as np
 
-from multilift_sim.physics.layout import (EVENT_DURATION, EVENT_KIND, EVENT_KINDS, EVENT_ROTOR,
-                                          EVENT_TIME, EVENT_UAV, EVENT_VALUE, EVENT_VELOCITY,
-                                          KIND_CONTROLLER_SILENCE, KIND_GUST,
-                                          KIND_ROTOR_EFFECTIVENESS, MEASURED_BODY_RATES,
+from multilift_sim.events import kind_at
+from multilift_sim.physics.layout import (EVENT_KIND, EVENT_TIME, MEASURED_BODY_RATES,
                                           MEASURED_EULER, MEASURED_POSITION, MEASURED_VELOCITY)
 
 
@@ -95,22 +93,8 @@ FormationEventValues = tuple[str, int, int, float, float, str]
 
 def formation_event(row: Sequence[float]) -> FormationEventValues:
     """A multilift_msgs/FormationEvent's (type, uav (from 1), rotor (from 1; 0: none), value,
-    scheduled_time [s], description) from an event row (physics.layout EVENT_*)."""
-    kind = int(row[EVENT_KIND])
-    uav = int(row[EVENT_UAV]) + 1
-    if kind == KIND_ROTOR_EFFECTIVENESS:
-        rotor, value = int(row[EVENT_ROTOR]) + 1, float(row[EVENT_VALUE])
-        text = f'uav{uav} rotor {rotor} at {100.0 * value:g} % of its thrust'
-    elif kind == KIND_CONTROLLER_SILENCE:
-        rotor, value = 0, float(row[EVENT_VALUE])
-        text = (f'uav{uav} controller silent for {value:g} s (the simulator holds its last '
-                'command)')
-    elif kind == KIND_GUST:  # the formation's air: no UAV
-        uav, rotor, value = 0, 0, float(row[EVENT_VALUE])
-        velocity = ', '.join(f'{v:g}' for v in row[EVENT_VELOCITY:EVENT_VELOCITY + 3])
-        text = (f'gust of {value:.3g} m/s ({velocity}) for {float(row[EVENT_DURATION]):g} s '
-                '(1-cosine)')
-    else:  # cable_release
-        rotor, value = 0, 0.0
-        text = f'uav{uav} releases its cable'
-    return EVENT_KINDS[kind], uav, rotor, value, float(row[EVENT_TIME]), text
+    scheduled_time [s], description) from an event row (physics.layout EVENT_*): what its
+    kind's module (multilift_sim.events) `describe`s."""
+    kind = kind_at(int(row[EVENT_KIND]))
+    uav, rotor, value, text = kind.describe(row)  # by its registered module
+    return kind.NAME, uav, rotor, value, float(row[EVENT_TIME]), text

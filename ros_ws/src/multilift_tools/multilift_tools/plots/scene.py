@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from multilift_sim.events import releases_cable
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.topics import EVENTS
 from multilift_tools.metrics import interp_rows
@@ -26,13 +27,14 @@ RIM_POINTS = 24  # points on a cylinder's rim
 
 def released_cables(run: Run) -> dict[int, float]:
     """{i: t}: UAV i's cable was released at t [s] (the first state showing it,
-    /formation/events of type cable_release); empty without such events."""
+    /formation/events of a kind that releases a cable: `multilift_sim.events.releases_cable`);
+    empty without such events."""
     if not run.has(EVENTS):
         return {}
     series = run.topic(EVENTS)
     out: dict[int, float] = {}
     for t, kind, uav in zip(series.t, series['type'], series['uav']):
-        if str(kind) == 'cable_release':
+        if releases_cable(str(kind)):
             out.setdefault(int(uav), float(t))
     return out
 

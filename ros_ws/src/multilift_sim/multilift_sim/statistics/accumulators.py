@@ -134,18 +134,22 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
         for i in range(n):
             if taut[i]:
                 held += 1
-        if held > 0:
-            uavs = np.empty((held, 3))
+        payload = state[UAV_COORDINATES * n:UAV_COORDINATES * n + 3]  # layout.payload_slot
+        if held == n:  # every cable holds it (no copy)
+            uavs = state[:UAV_COORDINATES * n].reshape((n, UAV_COORDINATES))
+            peak_rms_add(run, RUN_SWING, swing_at(uavs[:, POSITION:POSITION + 3], payload,
+                                                  reach))
+        elif held > 0:
+            held_uavs = np.empty((held, 3))
             reaches = np.empty(held)
             k = 0
             for i in range(n):
                 if taut[i]:
                     for axis in range(3):
-                        uavs[k, axis] = state[UAV_COORDINATES * i + POSITION + axis]
+                        held_uavs[k, axis] = state[UAV_COORDINATES * i + POSITION + axis]
                     reaches[k] = reach[i]
                     k += 1
-            payload = state[UAV_COORDINATES * n:UAV_COORDINATES * n + 3]  # layout.payload_slot
-            peak_rms_add(run, RUN_SWING, swing_at(uavs, payload, reaches))
+            peak_rms_add(run, RUN_SWING, swing_at(held_uavs, payload, reaches))
     run[RUN_SIMULATED_TIME] = t
     if peak > constraint_tolerance:
         return CHECK_G, worst

@@ -25,9 +25,7 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
     it is pinned at omega_min by the reallocation, not saturated."""
     n_rotors = mixer.shape[0]
     request = np.empty(n_rotors)
-    wanted = np.empty(n_rotors)  # the request before the shift [rad^2/s^2]
     saturated = np.zeros(n_rotors, dtype=np.bool_)
-    shares = np.zeros(n_rotors, dtype=np.bool_)  # live, with a collective share
     # np.argmax, np.argmin over the rotors with a collective share: the first of equals
     highest = lowest = -1
     for k in range(n_rotors):
@@ -38,18 +36,16 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
             live = live or mixer[k, MIXER_WRENCH + j] != 0.0
         if not live:
             request[k] = square_min
-            wanted[k] = square_min
             continue
         request[k] = total
-        wanted[k] = total
         if mixer[k, MIXER_COLLECTIVE] <= 0.0:
             continue
-        shares[k] = True
         if highest < 0 or total > request[highest]:
             highest = k
         if lowest < 0 or total < request[lowest]:
             lowest = k
     high, low = request[highest], request[lowest]
+    shift = 0.0
     if high > square_max or low < square_min:
         if high - low <= square_max - square_min:
             # shift along the collective direction until every rotor fits
@@ -58,14 +54,16 @@ def rotor_speeds(mixer, square_min, square_max, wrench):
             shift = -above if above > 0 else (below if below > 0 else 0.0)
             for k in range(n_rotors):
                 request[k] = request[k] + shift * mixer[k, MIXER_COLLECTIVE]
-    # held at a limit it was wanted beyond (after the shift: at the limit to rounding)
+    # a rotor a downward shift left at omega_max (an upward one at omega_min) was wanted
+    # beyond it: at the limit to rounding
     at_limit = 1e-12 * square_max
-    for k in range(n_rotors):
-        if shares[k]:
-            saturated[k] = ((wanted[k] > square_max and request[k] > square_max - at_limit)
-                            or (wanted[k] < square_min and request[k] < square_min + at_limit))
     for k in range(n_rotors):  # what does not fit (a no-op for a request within the range)
-        request[k] = min(max(request[k], square_min), square_max)
+        value = request[k]
+        if mixer[k, MIXER_COLLECTIVE] > 0.0:  # takes part (not failed, not pinned)
+            saturated[k] = (value > square_max or value < square_min
+                            or (shift < 0.0 and value > square_max - at_limit)
+                            or (shift > 0.0 and value < square_min + at_limit))
+        request[k] = min(max(value, square_min), square_max)
     return np.sqrt(request), saturated
 
 

@@ -258,7 +258,8 @@ def integrate_period(x, wrenches, uavs, gusts, formation, taut, dt, steps):
     later = np.empty(n)
     state = x.copy()
     projection_steps = int(formation[FORMATION_PROJECTION_STEPS])
-    masses = translational_masses(uavs, formation)
+    # M_t for the projection (none without it: no allocation in the common case)
+    masses = translational_masses(uavs, formation) if projection_steps > 0 else first
     for step in range(steps):
         rk4_step(state, wrenches, uavs, gusts, formation, taut, dt, state,
                  first if step == 0 else later, work, cables)

@@ -9,8 +9,8 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import (EULER, MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_QUATERNION,
-                                          ODOMETRY_ROTATION, PAYLOAD_COORDINATES, POSITION,
-                                          UAV_COORDINATES)
+                                          ODOMETRY_ROTATION, POSITION)
+from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
 
 
 @jit
@@ -19,9 +19,9 @@ def measured_states(x, n, out):
     slots are written) from the formation state x (2 (6n + 3),): position [m] and velocity
     [m/s] (world), ZYX Euler angles [rad] and the body rates omega = W(eta) eta_dot [rad/s]
     (Eq. 2.7, body FLU)."""
-    nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
+    nq = rates_slot(n)
     for i in range(n):
-        base = UAV_COORDINATES * i
+        base = uav_slot(i)
         for axis in range(3):
             out[i, MEASURED_POSITION + axis] = x[base + POSITION + axis]
             out[i, MEASURED_VELOCITY + axis] = x[nq + base + POSITION + axis]
@@ -43,7 +43,7 @@ def measured_states(x, n, out):
 def payload_position(x, n):
     """The payload's position r_p [m] (3,), world, in the formation state x of n UAVs (a view:
     what the snapshot carries and a leader's swing feedback reads, multilift_control.laws.swing)."""
-    start = UAV_COORDINATES * n
+    start = payload_slot(n)
     return x[start:start + 3]
 
 
@@ -51,7 +51,7 @@ def payload_position(x, n):
 def payload_velocity(x, n):
     """The payload's velocity v_p [m/s] (3,), world, in the formation state x of n UAVs (a view:
     what the snapshot carries and a leader's swing damping reads, multilift_control.laws.swing)."""
-    start = 2 * UAV_COORDINATES * n + PAYLOAD_COORDINATES
+    start = rates_slot(n) + payload_slot(n)
     return x[start:start + 3]
 
 

@@ -19,10 +19,11 @@ from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.layout import (CABLE_COLUMNS, EULER, FORMATION_WIND,
-                                          PAYLOAD_COORDINATES, STATUS_ATTITUDE, STATUS_FINISHED,
+                                          STATUS_ATTITUDE, STATUS_FINISHED,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
-                                          STATUS_OFF_RATE, STATUS_RUNNING, UAV_COORDINATES,
+                                          STATUS_OFF_RATE, STATUS_RUNNING,
                                           WRENCH_COLUMNS)
+from multilift_sim.physics.state_slots import rates_slot, uav_slot
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.sensors import sensed_states
 from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
@@ -61,7 +62,7 @@ def check(a, m, b):
         return
     if status == CHECK_ATTITUDE:  # the UAV in worst_cable, its pitch [rad] in worst_value
         m.status[b], m.worst_cable[b] = STATUS_ATTITUDE, cable
-        m.worst_value[b] = x[UAV_COORDINATES * cable + EULER + 1]
+        m.worst_value[b] = x[uav_slot(cable) + EULER + 1]
         return
     payload = 6 * a.uavs.shape[1]
     gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
@@ -150,7 +151,7 @@ def tension_at(a, m, b, speeds, tension):
     wrenches = np.empty((n, WRENCH_COLUMNS))
     rotor_wrenches(a.allocation[b], speeds, m.effectiveness[b], wrenches)
     x = m.state[b]
-    acc = np.empty(x.shape[0] - UAV_COORDINATES * n - PAYLOAD_COORDINATES)  # q_ddot (+ a body's)
+    acc = np.empty(x.shape[0] - rates_slot(n))  # q_ddot (+ a body's)
     multipliers = np.empty(n)
     solve(x, wrenches, a.uavs[b], a.gusts[b], period_formation(a, m, b), m.taut[b], acc,
           multipliers, np.empty((n, CABLE_COLUMNS)))

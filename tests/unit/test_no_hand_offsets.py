@@ -27,8 +27,8 @@ ALLOWED = {
 
 # (what it is, the pattern, a line it must catch)
 HAND_OFFSETS = (
-    ('a UAV block or q_f length by hand', r'\b(6|12)\s*\*\s*\(?\s*(n|i|n_uavs|k)\b',
-     'state[:, 6 * n:6 * n + 3]'),
+    ('a UAV block or q_f length by hand', r'(?<![\w.\-])(6|12)\s*\*\s*\(?\s*[A-Za-z_]',
+     'payload = 6 * a.uavs.shape[1]'),
     ('a UAV block by hand', r'\b(n|i|n_uavs)\s*\*\s*6\b', 'x[n*6]'),
     ('the block size multiplied by hand (layout.uav_slot, payload_slot)',
      r'\bUAV_COORDINATES\s*\*', 'x[UAV_COORDINATES * i + EULER]'),
@@ -60,6 +60,8 @@ def _hits() -> list[str]:
 def test_each_pattern_catches_its_example():
     for what, pattern, example in HAND_OFFSETS:
         assert re.search(pattern, example), what
+    assert not any(re.search(pattern, 'tolerance = 1e-6 * omega') for _, pattern, _ in
+                   HAND_OFFSETS)
 
 
 def test_no_hand_written_state_offset_under_ros_ws_src():

@@ -23,7 +23,7 @@ from multilift_sim.physics.layout import (CABLE_COLUMNS, EULER, FORMATION_WIND,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
                                           STATUS_OFF_RATE, STATUS_RUNNING,
                                           WRENCH_COLUMNS)
-from multilift_sim.physics.state_slots import rates_slot, uav_slot
+from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.sensors import sensed_states
 from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
@@ -64,7 +64,7 @@ def check(a, m, b):
         m.status[b], m.worst_cable[b] = STATUS_ATTITUDE, cable
         m.worst_value[b] = x[uav_slot(cable) + EULER + 1]
         return
-    payload = 6 * a.uavs.shape[1]
+    payload = payload_slot(a.uavs.shape[1])
     gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
     m.gust[b, 0], m.gust[b, 1], m.gust[b, 2] = gust_x, gust_y, gust_z
     if a.gusts.shape[1]:

@@ -126,13 +126,13 @@ class FormationSimulator:
         self.steps_per_tick = sim.physics_steps_per_tick
         self.dt = 1.0 / sim.physics_rate  # the physics step [s]
         self._rotor_counts = [u.vehicle.n_rotors for u in scenario.uavs]
-        self._steady_wind = np.array(scenario.wind, dtype=float)
         # the tension of the last integration (at the tick it started from)
         self.last_tension: np.ndarray | None = None
         self._tension = np.zeros((1, self.n))
         # the compiled functions, or their uncompiled run, as MULTILIFT_KERNEL says now
         self._advance = kernels.runnable(physics_tick.advance)
         self._measure = kernels.runnable(physics_tick.measure)
+        self._wind = kernels.runnable(physics_tick.period_wind)
         self._tension_at = kernels.runnable(physics_tick.tension_at)
         kernels.runnable(physics_tick.start)(self.arrays, self.memory, np.ones(1, dtype=bool))
         self.happened = range(0, int(self.memory.next_event[0]))
@@ -188,8 +188,9 @@ class FormationSimulator:
     def wind(self) -> np.ndarray:
         """The air's velocity everywhere over the period from the current tick [m/s], world:
         the steady wind plus the tick's unsteady wind (`schedules.wind_series`)."""
-        series = self.arrays.wind_series[0]
-        return self._steady_wind + (series[self.tick] if len(series) else 0.0)
+        wind = np.empty(3)
+        self._wind(self.arrays.formation[0], self.arrays.wind_series[0], self.tick, wind)
+        return wind
 
     def snapshot(self) -> Snapshot:
         """The formation at the current tick: every UAV's numbers from one call of

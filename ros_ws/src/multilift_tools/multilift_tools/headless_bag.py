@@ -30,6 +30,8 @@ from multilift_sim.bag import BagWriter
 from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.formulations import make_formulation
+from multilift_sim import kernels
+from multilift_sim.physics.tick import period_winds
 from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot, TickCables,
@@ -73,13 +75,12 @@ class EngineBag:
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
-        # /formation/wind by tick: the steady wind plus the unsteady wind series (or none)
+        # /formation/wind by tick (physics.tick.period_winds), where the air moves everywhere
         self._wind = None
         if scenario.has_wind:
-            steady = np.array(scenario.wind, dtype=float)
-            unsteady = arrays.wind_series[0]
-            self._wind = (steady + unsteady if len(unsteady)
-                          else np.tile(steady, (int(arrays.tick_count[0]) + 1, 1)))
+            self._wind = np.empty((int(arrays.tick_count[0]) + 1, 3))
+            kernels.runnable(period_winds)(arrays.formation[0], arrays.wind_series[0],
+                                           self._wind)
 
     def ticks(self, first: int, record: TickRecord, count: int) -> None:
         """Write ticks first .. first + count - 1 of formation 0 from `record`'s rows."""
@@ -173,9 +174,8 @@ class EngineBag:
                                  scenario.cable_model)
         model.taut[:] = memory.taut[0]  # released cables (events), slack ones
         model.effectiveness[:] = memory.effectiveness[0]
-        unsteady = engine.arrays.wind_series[0]
-        if len(unsteady):  # the wind at the last tick, as FormationSimulator holds it
-            model.set_wind(np.array(scenario.wind, dtype=float) + unsteady[tick])
+        if len(engine.arrays.wind_series[0]):  # the last tick's wind, as FormationSimulator's
+            model.set_wind(self._wind[tick])
         held = list(self._held.reshape(n, -1)) if self._held is not None else None
         tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),

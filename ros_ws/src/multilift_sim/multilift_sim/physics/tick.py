@@ -34,15 +34,36 @@ from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DO
 
 
 @jit
+def period_wind(formation, series, tick, out):
+    """The air's velocity everywhere over the period from `tick` [m/s], world, into out (3,):
+    the steady wind (a formation's scalars, FORMATION_WIND) plus the tick's unsteady wind
+    (series (ticks + 1, 3), `schedules.wind_series`; (0, 3): none, the steady wind as it is).
+    The one place the wind is composed: the physics (`period_formation`), the simulator's
+    `wind` and the bags' /formation/wind (`period_winds`) call it; a gust's 1-cosine field
+    adds to it at a point (formation_dae.air_velocity)."""
+    for j in range(3):
+        out[j] = formation[FORMATION_WIND + j]
+    if series.shape[0]:
+        for j in range(3):
+            out[j] += series[tick, j]
+
+
+@jit
+def period_winds(formation, series, out):
+    """`period_wind` of every tick into out (ticks + 1, 3) [m/s], world."""
+    for tick in range(out.shape[0]):
+        period_wind(formation, series, tick, out[tick])
+
+
+@jit
 def period_formation(a, m, b):
-    """Formation b's scalars (FORMATION_*) for the period from its current tick: the steady
-    wind plus the tick's unsteady wind (`schedules.wind_series`); the constants themselves
-    when the air is steady."""
+    """Formation b's scalars (FORMATION_*) for the period from its current tick, their wind
+    `period_wind`'s; the constants themselves when the air is steady."""
     formation = a.formation[b]
     if a.wind_series.shape[1]:
         formation = formation.copy()
-        for j in range(3):
-            formation[FORMATION_WIND + j] += a.wind_series[b, m.tick[b], j]
+        period_wind(a.formation[b], a.wind_series[b], m.tick[b],
+                    formation[FORMATION_WIND:FORMATION_WIND + 3])
     return formation
 
 

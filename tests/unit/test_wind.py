@@ -227,3 +227,26 @@ def test_the_wind_is_on_a_topic_where_the_air_moves_everywhere(tmp_path):
     assert np.array_equal(winds[:, 0], np.ones(201)) and np.array_equal(winds[:, 2],
                                                                         np.zeros(201))
     assert np.abs(winds[:, 1] - expected_y).max() < 1e-12 and winds[:, 1].max() > 2.99
+
+
+def test_the_wind_of_a_period_is_composed_in_one_place():
+    """physics.tick.period_wind (what the physics, FormationSimulator.wind and the bags'
+    /formation/wind read): the steady wind plus the tick's unsteady wind, compiled and not to
+    the bit; the steady wind as it is where the air is steady; `period_winds` every tick's."""
+    from multilift_sim import kernels
+    from multilift_sim.physics.layout import FORMATION_SCALARS, FORMATION_WIND
+    from multilift_sim.physics.tick import period_wind, period_winds
+
+    formation = np.zeros(FORMATION_SCALARS)
+    formation[FORMATION_WIND:FORMATION_WIND + 3] = WIND
+    series = np.random.default_rng(3).normal(size=(6, 3))
+    for function in (period_wind, kernels.uncompiled(period_wind)):
+        out = np.empty(3)
+        for tick in range(6):
+            function(formation, series, tick, out)
+            assert np.array_equal(out, np.array(WIND) + series[tick])
+        function(formation, np.zeros((0, 3)), 4, out)
+        assert tuple(out) == WIND
+    table = np.empty((6, 3))
+    period_winds(formation, series, table)
+    assert np.array_equal(table, np.array(WIND) + series)

@@ -37,6 +37,7 @@ from multilift_control.engine import Engine
 from multilift_control.laws.layout import (UAV_BODY_RATES, UAV_EULER, UAV_POSITION,
                                            UAV_VELOCITY)
 from multilift_learning.tasks import Targets, task, task_scenario
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario
 from multilift_sim.start import cable_reach
 from multilift_sim.statistics.swing import equilibrium_point
@@ -155,11 +156,9 @@ class FormationBatch:
     def observe(self) -> tuple[np.ndarray, dict]:
         """Observations (B, OBSERVATION_PER_UAV n + OBSERVATION_PAYLOAD) of the engine's
         formations, and the pieces the reward uses."""
-        n = self.n
-        state = self.engine.state
-        return self.observation_of(self.engine.measured(), state[:, 6 * n:6 * n + 3],
-                                   state[:, (6 * n + 3) + 6 * n:(6 * n + 3) + 6 * n + 3],
-                                   self.tension, self.engine.t)
+        state, layout = self.engine.state, StateLayout(self.n)
+        return self.observation_of(self.engine.measured(), layout.payload_position(state),
+                                   layout.payload_velocity(state), self.tension, self.engine.t)
 
     def observation_of(self, measured: np.ndarray, payload: np.ndarray,
                        payload_velocity: np.ndarray, tension: np.ndarray,

@@ -16,6 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from multilift_sim.physics.layout import POSITION, n_coordinates, payload_slot, uav_slot
+
 
 def cable_residuals(uav_positions: ArrayLike, payload_position: ArrayLike,
                     cable_lengths: ArrayLike) -> np.ndarray:
@@ -50,10 +52,11 @@ def constraint_jacobian(uav_positions: ArrayLike, payload_position: ArrayLike) -
     positions = np.asarray(uav_positions, dtype=float)
     n = positions.shape[0]
     offsets = np.asarray(payload_position, dtype=float) - positions
-    jacobian = np.zeros((n, 6 * n + 3))
+    jacobian = np.zeros((n, n_coordinates(n)))
     for i in range(n):
-        jacobian[i, 6 * i:6 * i + 3] = -2.0 * offsets[i]   # Eq. 2.66
-        jacobian[i, 6 * n:] = 2.0 * offsets[i]             # Eq. 2.67
+        r = uav_slot(i) + POSITION
+        jacobian[i, r:r + 3] = -2.0 * offsets[i]            # Eq. 2.66
+        jacobian[i, payload_slot(n):] = 2.0 * offsets[i]    # Eq. 2.67
     return jacobian
 
 

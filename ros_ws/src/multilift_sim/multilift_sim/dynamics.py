@@ -214,7 +214,7 @@ class FormationModel:
         payload, then its attitude block's rate)."""
         x = np.asarray(x, dtype=float)
         q_ddot, _ = self.accelerations(t, x, rotor_speeds)
-        return np.concatenate((x[self._nq:2 * self._nq], q_ddot))
+        return np.concatenate((self.layout.rates(x), q_ddot))
 
     def step(self, t: float, x: np.ndarray, rotor_speeds: Sequence[ArrayLike],
              dt: float) -> np.ndarray:

@@ -123,7 +123,10 @@ class StateLayout:
     and with a rigid payload its attitude after them (`physics.layout` PAYLOAD_ATTITUDE: the
     unit quaternion (w, x, y, z), payload frame -> world, and its body rates [rad/s]).
 
-    Each accessor returns a view (writable when x is a contiguous float array), not a copy.
+    Each accessor takes one state (size,) or a stack of them (..., size) (a batch, a run's
+    record) and returns a view (writable when x is a contiguous float array), not a copy; the
+    shapes below are one state's, a stack's have its leading axes first. The one place of these
+    offsets outside the compiled functions (which use physics.state_slots).
     """
 
     n_uavs: int
@@ -141,52 +144,63 @@ class StateLayout:
     @property
     def size(self) -> int:
         """Length of the state x: 2 (6n + 3), plus 7 with a rigid payload."""
-        return 2 * self.n_coordinates + (slots.PAYLOAD_ATTITUDE if self.rigid_payload else 0)
+        return slots.attitude_slot(self.n_uavs) + (
+            slots.PAYLOAD_ATTITUDE if self.rigid_payload else 0)
 
     def coordinates(self, x: np.ndarray) -> np.ndarray:
         """q_f, shape (6n + 3,)."""
-        return x[:self.n_coordinates]
+        return x[..., :self.n_coordinates]
 
     def rates(self, x: np.ndarray) -> np.ndarray:
         """q_f_dot, shape (6n + 3,)."""
-        return x[self.n_coordinates:2 * self.n_coordinates]
+        return x[..., self.n_coordinates:slots.attitude_slot(self.n_uavs)]
 
     def payload_quaternion(self, x: np.ndarray) -> np.ndarray:
         """A rigid payload's attitude, the unit quaternion (w, x, y, z), shape (4,)."""
-        base = 2 * self.n_coordinates + slots.PAYLOAD_QUATERNION
-        return x[base:base + 4]
+        base = slots.attitude_slot(self.n_uavs) + slots.PAYLOAD_QUATERNION
+        return x[..., base:base + 4]
 
     def payload_body_rates(self, x: np.ndarray) -> np.ndarray:
         """A rigid payload's angular velocity omega_p [rad/s], payload frame, shape (3,)."""
-        base = 2 * self.n_coordinates + slots.PAYLOAD_BODY_RATES
-        return x[base:base + 3]
+        base = slots.attitude_slot(self.n_uavs) + slots.PAYLOAD_BODY_RATES
+        return x[..., base:base + 3]
 
     def _uav_block(self, q: np.ndarray) -> np.ndarray:
-        return q[:slots.payload_slot(self.n_uavs)].reshape(self.n_uavs, slots.UAV_COORDINATES)
+        return q[..., :slots.payload_slot(self.n_uavs)].reshape(
+            q.shape[:-1] + (self.n_uavs, slots.UAV_COORDINATES))
+
+    def uav_coordinates(self, x: np.ndarray) -> np.ndarray:
+        """Every UAV's block of q_f, (r_i [m], eta_i [rad]) by the slots POSITION and EULER,
+        shape (n, 6)."""
+        return self._uav_block(self.coordinates(x))
+
+    def uav_rates(self, x: np.ndarray) -> np.ndarray:
+        """Every UAV's block of q_f_dot, (r_i_dot [m/s], eta_i_dot [rad/s]), shape (n, 6)."""
+        return self._uav_block(self.rates(x))
 
     def uav_positions(self, x: np.ndarray) -> np.ndarray:
         """UAV centres of mass r_i [m], world, shape (n, 3)."""
-        return self._uav_block(self.coordinates(x))[:, slots.POSITION:slots.POSITION + 3]
+        return self.uav_coordinates(x)[..., slots.POSITION:slots.POSITION + 3]
 
     def uav_euler(self, x: np.ndarray) -> np.ndarray:
         """UAV ZYX Euler angles eta_i (roll, pitch, yaw) [rad], shape (n, 3)."""
-        return self._uav_block(self.coordinates(x))[:, slots.EULER:slots.EULER + 3]
+        return self.uav_coordinates(x)[..., slots.EULER:slots.EULER + 3]
 
     def payload_position(self, x: np.ndarray) -> np.ndarray:
         """Payload position r_p [m], world, shape (3,)."""
-        return self.coordinates(x)[slots.payload_slot(self.n_uavs):]
+        return self.coordinates(x)[..., slots.payload_slot(self.n_uavs):]
 
     def uav_velocities(self, x: np.ndarray) -> np.ndarray:
         """UAV velocities [m/s], world, shape (n, 3)."""
-        return self._uav_block(self.rates(x))[:, slots.POSITION:slots.POSITION + 3]
+        return self.uav_rates(x)[..., slots.POSITION:slots.POSITION + 3]
 
     def uav_euler_rates(self, x: np.ndarray) -> np.ndarray:
         """UAV Euler angle rates eta_dot_i [rad/s], shape (n, 3)."""
-        return self._uav_block(self.rates(x))[:, slots.EULER:slots.EULER + 3]
+        return self.uav_rates(x)[..., slots.EULER:slots.EULER + 3]
 
     def payload_velocity(self, x: np.ndarray) -> np.ndarray:
         """Payload velocity [m/s], world, shape (3,)."""
-        return self.rates(x)[slots.payload_slot(self.n_uavs):]
+        return self.rates(x)[..., slots.payload_slot(self.n_uavs):]
 
     def pack(self, uav_positions: ArrayLike, uav_euler: ArrayLike, payload_position: ArrayLike,
              uav_velocities: ArrayLike | None = None, uav_euler_rates: ArrayLike | None = None,

@@ -7,8 +7,13 @@ unchanged, in the seed's z-down/FRD frame (see frames.py).
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import ArrayLike
+
+from multilift_sim import kernels
+from multilift_sim.physics.measurement import euler_quaternions, euler_rotations
 
 
 def _angles(eta: ArrayLike) -> np.ndarray:
@@ -22,23 +27,10 @@ def rotation_matrix(eta: ArrayLike) -> np.ndarray:
     """Rotation matrix ``R = Rz(psi) Ry(theta) Rx(phi)`` mapping body to world (seed Eq. 2.6).
 
     eta: Euler angles [rad], shape (..., 3). Returns shape (..., 3, 3); a body-frame vector
-    ``v_b`` is ``R @ v_b`` in the world frame. The numpy form for analysis and the tests' oracle;
-    the R (and quaternion) the simulator reports each tick is physics.measurement.odometry_states.
+    ``v_b`` is ``R @ v_b`` in the world frame. physics.measurement.euler_rotation over the stack:
+    the R the simulator reports each tick (odometry_states), written once.
     """
-    angles = _angles(eta)
-    s_phi, s_theta, s_psi = np.moveaxis(np.sin(angles), -1, 0)
-    c_phi, c_theta, c_psi = np.moveaxis(np.cos(angles), -1, 0)
-    rot = np.empty(angles.shape + (3,))
-    rot[..., 0, 0] = c_psi * c_theta
-    rot[..., 0, 1] = c_psi * s_theta * s_phi - s_psi * c_phi
-    rot[..., 0, 2] = c_psi * s_theta * c_phi + s_psi * s_phi
-    rot[..., 1, 0] = s_psi * c_theta
-    rot[..., 1, 1] = s_psi * s_theta * s_phi + c_psi * c_phi
-    rot[..., 1, 2] = s_psi * s_theta * c_phi - c_psi * s_phi
-    rot[..., 2, 0] = -s_theta
-    rot[..., 2, 1] = c_theta * s_phi
-    rot[..., 2, 2] = c_theta * c_phi
-    return rot
+    return _over_stack(euler_rotations, eta, (3, 3))
 
 
 def euler_rate_matrix(eta: ArrayLike) -> np.ndarray:
@@ -100,19 +92,25 @@ def quaternion_from_euler(eta: ArrayLike) -> np.ndarray:
     """Unit quaternion (x, y, z, w) of ``R = Rz(psi) Ry(theta) Rx(phi)`` (body -> world).
 
     eta: Euler angles (roll, pitch, yaw) [rad], shape (..., 3). Returns shape (..., 4), scalar
-    part last as geometry_msgs/Quaternion orders it. The numpy form (see `rotation_matrix` for
-    the per-tick one).
+    part last as geometry_msgs/Quaternion orders it. physics.measurement.euler_quaternion over
+    the stack (the odometry's quaternion, written once).
     """
-    half = 0.5 * _angles(eta)
-    s, c = np.sin(half), np.cos(half)
-    sr, sp, sy = s[..., 0], s[..., 1], s[..., 2]
-    cr, cp, cy = c[..., 0], c[..., 1], c[..., 2]
-    q = np.empty(half.shape[:-1] + (4,))
-    q[..., 0] = sr * cp * cy - cr * sp * sy
-    q[..., 1] = cr * sp * cy + sr * cp * sy
-    q[..., 2] = cr * cp * sy - sr * sp * cy
-    q[..., 3] = cr * cp * cy + sr * sp * sy
-    return q
+    return _over_stack(euler_quaternions, eta, (4,))
+
+
+@functools.cache
+def _kernel(function, mode: str):
+    return kernels.runnable(function, mode)
+
+
+def _over_stack(function, eta: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
+    """function(angles (m, 3), out (m, prod(shape))) (a physics.measurement kernel, compiled or
+    not as MULTILIFT_KERNEL says) over a stack of Euler angles (..., 3): shape (...,) + shape."""
+    angles = _angles(eta)
+    rows = np.ascontiguousarray(angles.reshape(-1, 3))
+    out = np.empty((rows.shape[0], int(np.prod(shape))))
+    _kernel(function, kernels.mode())(rows, out)
+    return out.reshape(angles.shape[:-1] + shape)
 
 
 def euler_from_quaternion(q: ArrayLike) -> np.ndarray:

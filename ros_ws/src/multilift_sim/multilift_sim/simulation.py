@@ -14,10 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from multilift_sim import kernels
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.formulations import make_formulation
 from multilift_sim.physics import tick as physics_tick
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
-                                          MEASURED_POSITION, MEASURED_VELOCITY,
+                                          MEASURED_POSITION, attitude_slot, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
                                           ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
 from multilift_sim.physics.measurement import odometry_states
@@ -84,10 +85,10 @@ def stop_message(status: int, cable: int, value: float, t: float, sim) -> str:
 def payload_attitude(state: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A rigid payload's (orientation (x, y, z, w), body rates [rad/s], R_p (3, 3) payload
     frame -> world) in a state of n UAVs (Snapshot.payload_attitude; the engine's bag too)."""
-    base = 2 * (6 * n + 3)
-    w, x, y, z = state[base:base + 4]
-    return (np.array([x, y, z, w]), state[base + 4:base + 7].copy(),
-            payload_rotation(state, base))
+    layout = StateLayout(n, rigid_payload=True)
+    w, x, y, z = layout.payload_quaternion(state)
+    return (np.array([x, y, z, w]), layout.payload_body_rates(state).copy(),
+            payload_rotation(state, attitude_slot(n)))
 
 
 @dataclass(frozen=True)
@@ -125,13 +126,13 @@ class FormationSimulator:
         self.steps_per_tick = sim.physics_steps_per_tick
         self.dt = 1.0 / sim.physics_rate  # the physics step [s]
         self._rotor_counts = [u.vehicle.n_rotors for u in scenario.uavs]
-        self._steady_wind = np.array(scenario.wind, dtype=float)
         # the tension of the last integration (at the tick it started from)
         self.last_tension: np.ndarray | None = None
         self._tension = np.zeros((1, self.n))
         # the compiled functions, or their uncompiled run, as MULTILIFT_KERNEL says now
         self._advance = kernels.runnable(physics_tick.advance)
         self._measure = kernels.runnable(physics_tick.measure)
+        self._wind = kernels.runnable(physics_tick.period_wind)
         self._tension_at = kernels.runnable(physics_tick.tension_at)
         kernels.runnable(physics_tick.start)(self.arrays, self.memory, np.ones(1, dtype=bool))
         self.happened = range(0, int(self.memory.next_event[0]))
@@ -187,16 +188,16 @@ class FormationSimulator:
     def wind(self) -> np.ndarray:
         """The air's velocity everywhere over the period from the current tick [m/s], world:
         the steady wind plus the tick's unsteady wind (`schedules.wind_series`)."""
-        series = self.arrays.wind_series[0]
-        return self._steady_wind + (series[self.tick] if len(series) else 0.0)
+        wind = np.empty(3)
+        self._wind(self.arrays.formation[0], self.arrays.wind_series[0], self.tick, wind)
+        return wind
 
     def snapshot(self) -> Snapshot:
         """The formation at the current tick: every UAV's numbers from one call of
         physics.measurement.odometry_states, viewed from a fresh array (none of the
         simulator's state), and what the controllers receive of them (with `sensors:`,
         physics.tick.measure; call it once a tick, or more: the same result)."""
-        n = self.n
-        nq = 6 * n + 3
+        n, layout = self.n, self.model.layout
         state = self.state
         rows = np.empty((1, n, ODOMETRY_COLUMNS))
         odometry_states(state.reshape(1, -1), n, rows)
@@ -212,8 +213,8 @@ class FormationSimulator:
             body_velocity=row[ODOMETRY_BODY_VELOCITY:ODOMETRY_BODY_VELOCITY + 3],
             orientation=row[ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4]) for row in odometry)
         attitude = payload_attitude(state, n) if self.model.layout.rigid_payload else None
-        return Snapshot(self.t_ns, uavs, state[6 * n:nq].copy(), state[nq + 6 * n:2 * nq].copy(),
-                        odometry, measured, attitude)
+        return Snapshot(self.t_ns, uavs, layout.payload_position(state).copy(),
+                        layout.payload_velocity(state).copy(), odometry, measured, attitude)
 
     # ------------------------------------------------------------------------- the cables
     def cable_state(self, rotor_speeds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray,

@@ -28,7 +28,10 @@ from multilift_control.headless import FlownRun, HeadlessRun, progress_ticker, r
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.formulations import make_formulation
+from multilift_sim import kernels
+from multilift_sim.physics.tick import period_winds
 from multilift_sim.physics.layout import EVENT_TICK
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot, TickCables,
@@ -72,13 +75,12 @@ class EngineBag:
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
-        # /formation/wind by tick: the steady wind plus the unsteady wind series (or none)
+        # /formation/wind by tick (physics.tick.period_winds), where the air moves everywhere
         self._wind = None
         if scenario.has_wind:
-            steady = np.array(scenario.wind, dtype=float)
-            unsteady = arrays.wind_series[0]
-            self._wind = (steady + unsteady if len(unsteady)
-                          else np.tile(steady, (int(arrays.tick_count[0]) + 1, 1)))
+            self._wind = np.empty((int(arrays.tick_count[0]) + 1, 3))
+            kernels.runnable(period_winds)(arrays.formation[0], arrays.wind_series[0],
+                                           self._wind)
 
     def ticks(self, first: int, record: TickRecord, count: int) -> None:
         """Write ticks first .. first + count - 1 of formation 0 from `record`'s rows."""
@@ -103,9 +105,10 @@ class EngineBag:
         self._held = flat[-1].copy()
         previous_count = flat.shape[1]
         odometry = odometry.tolist()
-        euler = states[:, :6 * n].reshape(count, n, 6)[..., 3:].tolist()
-        payload_position = states[:, 6 * n:6 * n + 3].tolist()
-        payload_velocity = states[:, 12 * n + 3:12 * n + 6]
+        layout = StateLayout(n)
+        euler = layout.uav_euler(states).tolist()
+        payload_position = layout.payload_position(states).tolist()
+        payload_velocity = layout.payload_velocity(states)
         poses = [None] * count
         orientations = [None] * count  # a rigid payload's, for the markers
         if self._rigid:  # its pose and its twist in its frame, as the per-object path packs
@@ -155,11 +158,12 @@ class EngineBag:
         state = memory.state[0]
         _, odometry = state_rows(state[None], n)
         odometry = odometry[0].tolist()
-        payload_position = state[6 * n:6 * n + 3].tolist()
+        layout = StateLayout(n)
+        payload_position = layout.payload_position(state).tolist()
         measured = measured_odometry(engine.measured()[:1])[0].tolist() if self._sensors \
             else None
         velocity, pose = payload_motion(payload_attitude(state, n) if self._rigid else None,
-                                        state[12 * n + 3:12 * n + 6])
+                                        layout.payload_velocity(state))
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
                                              velocity, memory.gust[0].tolist(), measured,
                                              None if self._wind is None
@@ -170,14 +174,13 @@ class EngineBag:
                                  scenario.cable_model)
         model.taut[:] = memory.taut[0]  # released cables (events), slack ones
         model.effectiveness[:] = memory.effectiveness[0]
-        unsteady = engine.arrays.wind_series[0]
-        if len(unsteady):  # the wind at the last tick, as FormationSimulator holds it
-            model.set_wind(np.array(scenario.wind, dtype=float) + unsteady[tick])
+        if len(engine.arrays.wind_series[0]):  # the last tick's wind, as FormationSimulator's
+            model.set_wind(self._wind[tick])
         held = list(self._held.reshape(n, -1)) if self._held is not None else None
         tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
-                        state[:6 * n].reshape(n, 6)[:, 3:].tolist(), payload_position,
+                        layout.uav_euler(state).tolist(), payload_position,
                         None if pose is None else pose[0])
 
     def _events_at(self, tick: int, t_ns: int) -> list:

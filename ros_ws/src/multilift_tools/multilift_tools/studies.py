@@ -25,6 +25,7 @@ import numpy as np
 from multilift_sim.analysis.equilibrium import scenario_equilibrium
 from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.frames import world_to_seed_euler, world_to_seed_vector
 from multilift_sim.nullspace import NullSpaceModel
 from multilift_sim.scenario import Scenario, ScenarioError, load
@@ -64,7 +65,9 @@ def reduced_swing(scenario: Scenario, times: np.ndarray) -> tuple[np.ndarray, np
     model = ReducedSingleLiftModel(uav.vehicle, scenario.payload.mass, uav.cable_length,
                                    scenario.simulation.gravity)
     x0 = initial_state(scenario)
-    start = rest_state(world_to_seed_vector(x0[0:3]), world_to_seed_euler(x0[3:6]),
+    layout = StateLayout(1)
+    start = rest_state(world_to_seed_vector(layout.uav_positions(x0)[0]),
+                       world_to_seed_euler(layout.uav_euler(x0)[0]),
                        scenario.payload.alpha, scenario.payload.beta)
     solution = model.simulate(start, scenario_equilibrium(scenario).rotor_speeds[0],
                               float(times[-1]), t_eval=times)
@@ -121,7 +124,7 @@ def baumgarte_study(out_dir: str | Path, duration: float = DEFAULT_DURATION,
     times = np.arange(steps + 1) * dt
     rotor_speeds = list(scenario_equilibrium(setup).rotor_speeds)
 
-    x0 = initial_state(setup)
+    x0, layout = initial_state(setup), StateLayout(1)
     uav_reference, payload_reference = reduced_swing(setup, times)
 
     models = [(f'Baumgarte alpha_f = {gain:g}',
@@ -135,8 +138,9 @@ def baumgarte_study(out_dir: str | Path, duration: float = DEFAULT_DURATION,
         residuals = np.array([abs(model.constraint_residuals(x)[0][0]) for x in states])
         runs.append(IntegratorRun(
             label=label, times=times, residuals=residuals,
-            uav_error=np.linalg.norm(states[:, 0:3] - uav_reference, axis=1),
-            payload_error=np.linalg.norm(states[:, 6:9] - payload_reference, axis=1),
+            uav_error=np.linalg.norm(layout.uav_positions(states)[:, 0] - uav_reference, axis=1),
+            payload_error=np.linalg.norm(layout.payload_position(states) - payload_reference,
+                                         axis=1),
             wall_per_second=wall / times[-1]))
 
     rows = [run.row() for run in runs]

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from multilift_control.engine import Engine
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario, load
 from multilift_sim.start import formation_start
 from multilift_sim.statistics import payload_swing
@@ -117,7 +118,7 @@ def fly(scenario: Scenario, feedbacks: tuple[dict, ...] = (TEXTBOOK, FEEDBACK)) 
         record = engine.new_record(ticks)
         engine.step(ticks, record)
         records.append(record)
-    n = scenario.n_uavs
+    layout = StateLayout(scenario.n_uavs)
     t = np.arange(ticks) / scenario.simulation.control_rate
     lengths = np.array([u.cable_length for u in scenario.uavs])
     rest = payload_rest_offset(scenario)
@@ -125,8 +126,7 @@ def fly(scenario: Scenario, feedbacks: tuple[dict, ...] = (TEXTBOOK, FEEDBACK)) 
     runs = []
     for record, law in zip(records, flown):
         x = record.states[:, 0]
-        uavs = np.stack([x[:, 6 * i:6 * i + 3] for i in range(n)], axis=1)
-        payload = x[:, 6 * n:6 * n + 3]
+        uavs, payload = layout.uav_positions(x), layout.payload_position(x)
         reference = record.reference[:, 0, :3]
         runs.append(LawRun(
             label=law_label(law.control), t=t, swing=payload_swing(uavs, payload, lengths),

@@ -173,14 +173,12 @@ class Engine:
     @property
     def positions(self) -> np.ndarray:
         """UAV positions (B, n, 3) [m], world."""
-        n = self.n_uavs
-        return self.memory.state[:, :6 * n].reshape(-1, n, 6)[:, :, :3]
+        return StateLayout(self.n_uavs).uav_positions(self.memory.state)
 
     @property
     def payload_positions(self) -> np.ndarray:
         """Payload positions (B, 3) [m], world."""
-        n = self.n_uavs
-        return self.memory.state[:, 6 * n:6 * n + 3]
+        return StateLayout(self.n_uavs).payload_position(self.memory.state)
 
     @property
     def running(self) -> np.ndarray:

@@ -15,6 +15,7 @@ from multilift_sim.constraints import cable_residuals, constraint_jacobian
 from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.multirotor import euler_mass_matrix
+from multilift_sim.physics.layout import EULER, POSITION, n_coordinates, payload_slot, uav_slot
 from multilift_sim.physics.rigid_payload import payload_rotation
 
 ROTATION_NAMES = ('rx_p', 'ry_p', 'rz_p')  # a rigid payload's rotation vector, payload frame
@@ -80,19 +81,26 @@ def coordinate_names(n_uavs: int, rigid_payload: bool = False) -> tuple[str, ...
     return tuple(names + ['x_p', 'y_p', 'z_p'] + (list(ROTATION_NAMES) if rigid_payload else []))
 
 
+def _columns(n: int, rigid_payload: bool) -> tuple[int, int, int]:
+    """The analysis' coordinates (coordinate_names): (their count, r_p's column, a rigid
+    payload's rotation vector's first column: q_f's length)."""
+    return (len(coordinate_names(n, rigid_payload)), payload_slot(n), n_coordinates(n))
+
+
 def mass_matrix(params: FormationParams, uav_euler: ArrayLike) -> np.ndarray:
     """Formation inertia M_f (Eq. 2.47): blocks m_i I, M_eta,i = W^T J W (Eq. 2.24), m_p I;
     a rigid payload's J_p = diag(J_xx, J_yy, J_zz) [kg m^2] (payload frame) after them."""
     n = params.n_uavs
     euler = np.asarray(uav_euler, dtype=float).reshape(n, 3)
-    size = 6 * n + (6 if params.rigid_payload else 3)
+    size, p, rotation = _columns(n, params.rigid_payload)
     mass = np.zeros((size, size))
     for i, uav in enumerate(params.uavs):
-        mass[6 * i:6 * i + 3, 6 * i:6 * i + 3] = uav.mass * np.eye(3)
-        mass[6 * i + 3:6 * i + 6, 6 * i + 3:6 * i + 6] = euler_mass_matrix(uav.inertia, euler[i])
-    mass[6 * n:6 * n + 3, 6 * n:6 * n + 3] = params.payload_mass * np.eye(3)
+        r, e = uav_slot(i) + POSITION, uav_slot(i) + EULER
+        mass[r:r + 3, r:r + 3] = uav.mass * np.eye(3)
+        mass[e:e + 3, e:e + 3] = euler_mass_matrix(uav.inertia, euler[i])
+    mass[p:p + 3, p:p + 3] = params.payload_mass * np.eye(3)
     if params.rigid_payload:
-        mass[6 * n + 3:, 6 * n + 3:] = np.diag(params.payload_inertia)
+        mass[rotation:, rotation:] = np.diag(params.payload_inertia)
     return mass
 
 
@@ -111,15 +119,17 @@ def formation_jacobian(params: FormationParams, x: np.ndarray) -> np.ndarray:
     rotation = _state_rotation(layout, x)
     euler = layout.uav_euler(x)
     offsets = cable_offsets(params, uavs, payload, rotation, euler)
-    jacobian = np.zeros((n, 6 * n + (6 if params.rigid_payload else 3)))
+    size, p, turn = _columns(n, params.rigid_payload)
+    jacobian = np.zeros((n, size))
     for i in range(n):
-        jacobian[i, 6 * i:6 * i + 3] = -2.0 * offsets[i]
-        jacobian[i, 6 * n:6 * n + 3] = 2.0 * offsets[i]
+        r, e = uav_slot(i) + POSITION, uav_slot(i) + EULER
+        jacobian[i, r:r + 3] = -2.0 * offsets[i]
+        jacobian[i, p:p + 3] = 2.0 * offsets[i]
         if attached:
-            jacobian[i, 6 * i + 3:6 * i + 6] = -2.0 * offsets[i] @ _attach_derivatives(
+            jacobian[i, e:e + 3] = -2.0 * offsets[i] @ _attach_derivatives(
                 euler[i], np.asarray(params.uav_attach_points[i], dtype=float))
     if params.rigid_payload:
-        jacobian[:, 6 * n + 3:] = 2.0 * cable_moments(params, offsets, rotation)
+        jacobian[:, turn:] = 2.0 * cable_moments(params, offsets, rotation)
     return jacobian
 
 
@@ -145,8 +155,8 @@ def displaced_state(layout: StateLayout, x: np.ndarray, dq: np.ndarray,
         return x + np.concatenate((dq, dq_dot))
     nq = layout.n_coordinates
     out = np.array(x, dtype=float)
-    out[:nq] += dq[:nq]
-    out[nq:2 * nq] += dq_dot[:nq]
+    layout.coordinates(out)[:] += dq[:nq]
+    layout.rates(out)[:] += dq_dot[:nq]
     theta = np.asarray(dq[nq:nq + 3], dtype=float)
     angle = float(np.linalg.norm(theta))
     w, v = layout.payload_quaternion(x)[0], layout.payload_quaternion(x)[1:]

@@ -18,7 +18,7 @@ from multilift_sim.analysis.equilibrium import Equilibrium, scenario_equilibrium
 from multilift_sim.analysis.modes import MODE_KINDS, mode_kind, motion_shares, real_shapes
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
-from multilift_sim.physics.layout import PAYLOAD_BODY_RATES, UAV_COORDINATES
+from multilift_sim.physics.layout import PAYLOAD_BODY_RATES, POSITION, payload_slot, uav_slot
 from multilift_sim.scenario import Scenario
 
 
@@ -32,7 +32,7 @@ def default_dependent_coordinates(jacobian: np.ndarray,
     column-pivoted QR of G over the free coordinates.
     """
     n = jacobian.shape[0]
-    altitudes = tuple(UAV_COORDINATES * i + 2 for i in range(n))
+    altitudes = tuple(uav_slot(i) + POSITION + 2 for i in range(n))
     rows = np.linalg.norm(jacobian, axis=1)                     # 2 l_i on the manifold
     if not held and np.min(np.abs(jacobian[np.arange(n), altitudes]) / rows) > 1e-3:
         return altitudes
@@ -145,7 +145,7 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
     x_e = np.asarray(equilibrium.state, dtype=float)
     jacobian = formation_jacobian(still, x_e)
     size = jacobian.shape[1]                     # 6n + 3, a rigid payload's 6n + 6
-    held = tuple(range(UAV_COORDINATES * params.n_uavs)) if hold_uavs else ()
+    held = tuple(range(payload_slot(params.n_uavs))) if hold_uavs else ()
     if basis == 'elimination':
         dependent = (default_dependent_coordinates(jacobian, held) if dependent is None
                      else tuple(dependent))
@@ -230,7 +230,7 @@ def mode_state(analysis: ModalAnalysis, mode: int, amplitude: float,
     x = displaced_state(layout, x, amplitude * analysis.shapes[mode].real, still)
     lengths = np.asarray(params.cable_lengths)
     free = np.ones(size, dtype=bool)
-    free[:UAV_COORDINATES * params.n_uavs] = not analysis.held_uavs
+    free[:payload_slot(params.n_uavs)] = not analysis.held_uavs
     for _ in range(iterations):
         residual = formation_residuals(params, x)
         if np.max(np.abs(residual) / lengths ** 2) < 1e-15:

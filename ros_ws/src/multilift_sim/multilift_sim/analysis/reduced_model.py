@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike
 from scipy.integrate import solve_ivp
 from scipy.optimize import OptimizeResult
 
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.frames import (seed_to_world_euler, seed_to_world_vector,
                                   world_to_seed_body_vector)
 from multilift_sim.kinematics import euler_rate_matrix, rotation_matrix
@@ -179,14 +180,12 @@ class ReducedSingleLiftModel:
         """The packed world-frame DAE state (length 18, docs/conventions.md) of a seed state."""
         state = np.asarray(state, dtype=float)
         q, q_dot = state[:N_COORDINATES], state[N_COORDINATES:]
-        x = np.empty(18)
-        x[0:3] = seed_to_world_vector(q[:3])
-        x[3:6] = seed_to_world_euler(q[3:6])
-        x[6:9] = seed_to_world_vector(self.payload_position(q))
-        x[9:12] = seed_to_world_vector(q_dot[:3])
-        x[12:15] = seed_to_world_euler(q_dot[3:6])
-        x[15:18] = seed_to_world_vector(self.payload_velocity(q, q_dot))
-        return x
+        return StateLayout(1).pack(
+            seed_to_world_vector(q[:3]), seed_to_world_euler(q[3:6]),
+            seed_to_world_vector(self.payload_position(q)),
+            uav_velocities=seed_to_world_vector(q_dot[:3]),
+            uav_euler_rates=seed_to_world_euler(q_dot[3:6]),
+            payload_velocity=seed_to_world_vector(self.payload_velocity(q, q_dot)))
 
 
 def rest_state(uav_position_seed: Sequence[float], eta_seed: Sequence[float], alpha: float,

@@ -29,8 +29,9 @@ from multilift_sim.physics.layout import (
     CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST,
     FORMATION_BETA_SQ, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
     FORMATION_PAYLOAD_MASS, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
-    FORMATION_TWO_ALPHA, PAYLOAD_COORDINATES, POSITION, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS,
+    FORMATION_TWO_ALPHA, POSITION, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
+from multilift_sim.physics.state_slots import attitude_slot, payload_slot, rates_slot, uav_slot
 
 
 @jit
@@ -103,13 +104,13 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     if formation[FORMATION_NULL_SPACE] != 0.0:  # the `nullspace` formulation (every cable taut)
         nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
         return
-    if x.shape[0] > 2 * (UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES):
+    if x.shape[0] > attitude_slot(uavs.shape[0]):
         # a rigid-body payload (its attitude after q_f_dot: physics.rigid_payload)
         rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
         return
     n = uavs.shape[0]
-    p = UAV_COORDINATES * n
-    nq = p + PAYLOAD_COORDINATES
+    p = payload_slot(n)
+    nq = rates_slot(n)
     px, py, pz = x[p], x[p + 1], x[p + 2]
     pvx, pvy, pvz = x[nq + p], x[nq + p + 1], x[nq + p + 2]
     drag_ax, drag_ay, drag_az = payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts,
@@ -118,7 +119,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     gravity = formation[FORMATION_GRAVITY]
     for i in range(n):
         length_sq = uavs[i, UAV_LENGTH_SQ]
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         rx, ry, rz = x[r], x[r + 1], x[r + 2]
         vx, vy, vz = x[nq + r], x[nq + r + 1], x[nq + r + 2]
         thrust_ax, thrust_ay, thrust_az = uav_free_motion(x, i, wrenches, uavs, formation, acc)
@@ -161,7 +162,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
             cables[i, CABLE_OFFSET + 2]
         multiplier = multipliers[i]
         pull = 2.0 * multiplier / uavs[i, UAV_MASS]
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         acc[r] = cables[i, CABLE_THRUST] + pull * dx
         acc[r + 1] = cables[i, CABLE_THRUST + 1] + pull * dy
         acc[r + 2] = cables[i, CABLE_THRUST + 2] + pull * dz - gravity
@@ -185,9 +186,10 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
     payload's attitude block after q_f_dot steps with the rest (its rate from `solve` at
     acc[6n + 3:]), its quaternion scaled back to unit length at the end."""
     n = uavs.shape[0]
-    nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
+    nq = rates_slot(n)
+    attitude = attitude_slot(n)
     size = x.shape[0]
-    extra = size - 2 * nq  # a rigid payload's attitude (physics.rigid_payload), or none
+    extra = size - attitude  # a rigid payload's attitude (physics.rigid_payload), or none
     half, sixth = 0.5 * h, h / 6.0
     k1, k2, k3, k4 = work[WORK_K1], work[WORK_K2], work[WORK_K3], work[WORK_K4]
     stage, acc = work[WORK_STAGE], work[WORK_ACC]
@@ -197,7 +199,7 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
         k1[j] = x[nq + j]
         k1[nq + j] = acc[j]
     for j in range(extra):
-        k1[2 * nq + j] = acc[nq + j]
+        k1[attitude + j] = acc[nq + j]
     for k in (WORK_K2, WORK_K3, WORK_K4):  # stage k from x + (h/2 k1, h/2 k2, h k3)
         step, previous = (h if k == WORK_K4 else half), work[k - 1]
         for j in range(size):
@@ -208,11 +210,11 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
             derivative[j] = stage[nq + j]
             derivative[nq + j] = acc[j]
         for j in range(extra):
-            derivative[2 * nq + j] = acc[nq + j]
+            derivative[attitude + j] = acc[nq + j]
     for j in range(size):
         out[j] = x[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
     if extra:
-        normalize_quaternion(out, 2 * nq)
+        normalize_quaternion(out, attitude)
 
 
 @jit
@@ -221,13 +223,13 @@ def residuals(x, uavs, g, g_dot):
     2 (r_p - r_i) . (v_p - v_i) [m^2/s] (Eq. 2.56) into g_dot (n,), at state x (with a rigid
     payload's attitude: its attach points', `rigid_payload.rigid_residuals`)."""
     n = uavs.shape[0]
-    p = UAV_COORDINATES * n
-    nq = p + PAYLOAD_COORDINATES
-    if x.shape[0] > 2 * nq:
+    p = payload_slot(n)
+    nq = rates_slot(n)
+    if x.shape[0] > attitude_slot(n):
         rigid_residuals(x, uavs, g, g_dot)
         return
     for i in range(n):
-        b = UAV_COORDINATES * i + POSITION
+        b = uav_slot(i) + POSITION
         dx = x[p] - x[b]
         dy = x[p + 1] - x[b + 1]
         dz = x[p + 2] - x[b + 2]

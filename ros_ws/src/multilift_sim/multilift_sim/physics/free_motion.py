@@ -11,9 +11,10 @@ import numpy as np
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import (
     EULER, FORMATION_DRAG, FORMATION_INV_PAYLOAD_MASS, FORMATION_WIND, GUST_CENTER,
-    GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, PAYLOAD_COORDINATES, POSITION,
-    UAV_ATTACH, UAV_COORDINATES, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_MASS, WRENCH_THRUST,
+    GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, POSITION,
+    UAV_ATTACH, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_MASS, WRENCH_THRUST,
     WRENCH_TORQUE)
+from multilift_sim.physics.state_slots import rates_slot, uav_slot
 
 
 @jit
@@ -85,10 +86,10 @@ def uav_free_motion(x, i, wrenches, uavs, formation, acc):
     its translational acceleration [m/s^2], world, from its thrust along R e_z (Eq. 2.6, 2.20)
     and its own drag in the steady wind, gravity excluded. Both formulations call it
     (`solve`, `physics.nullspace`)."""
-    nq = UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES
+    nq = rates_slot(uavs.shape[0])
     mass = uavs[i, UAV_MASS]
-    r = UAV_COORDINATES * i + POSITION
-    e = UAV_COORDINATES * i + EULER
+    r = uav_slot(i) + POSITION
+    e = uav_slot(i) + EULER
     phi, theta, psi = x[e], x[e + 1], x[e + 2]
     vx, vy, vz = x[nq + r], x[nq + r + 1], x[nq + r + 2]
     phi_dot, theta_dot, psi_dot = x[nq + e], x[nq + e + 1], x[nq + e + 2]
@@ -185,8 +186,8 @@ def uav_attach_motion(x, i, wrenches, uavs, out):
     into out (3, 3): its offset o = R_i a_i [m], rate o_dot = w x o [m/s] and acceleration
     without the cable R_i (omega_dot_0 x a_i) + w x (w x o) [m/s^2] (w = R_i omega_i; omega_dot_0
     from the rotor torque alone, `body_acceleration`); returns R_i (3, 3)."""
-    nq = UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES
-    e = UAV_COORDINATES * i + EULER
+    nq = rates_slot(uavs.shape[0])
+    e = uav_slot(i) + EULER
     phi, theta = x[e], x[e + 1]
     rotation = uav_rotation(phi, theta, x[e + 2])
     omega = body_rates(math.sin(phi), math.cos(phi), math.sin(theta), math.cos(theta),
@@ -235,7 +236,7 @@ def rotational_compliance(uavs, i, k0, k1, k2):
 def add_cable_torque(x, i, uavs, acc, pull, k0, k1, k2):
     """UAV i's eta_ddot in acc plus what the cable's moment pull k_i [N m] (pull = 2 lambda_i)
     adds: W^-1 J^-1 (pull k_i) (Eq. 2.8; the torque enters omega_dot linearly)."""
-    e = UAV_COORDINATES * i + EULER
+    e = uav_slot(i) + EULER
     s_phi, c_phi = math.sin(x[e]), math.cos(x[e])
     s_theta, c_theta = math.sin(x[e + 1]), math.cos(x[e + 1])
     w0 = pull * k0 * uavs[i, UAV_INV_INERTIA]

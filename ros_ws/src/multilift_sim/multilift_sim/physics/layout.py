@@ -23,6 +23,14 @@ EULER = 3                   # eta_i = (phi, theta, psi) [rad] within a UAV's blo
 PAYLOAD_COORDINATES = 3     # r_p [m]
 
 
+# The offsets below are plain functions, each written from the constants alone (no calls), so
+# that physics.state_slots compiles these same functions for the kernels (numba calls no plain
+# function); numpy code reads the state through formation_params.StateLayout's views.
+def uav_slot(i: int) -> int:
+    """Offset of UAV i's block (from 0) in q_f (and of its rates in q_f_dot)."""
+    return UAV_COORDINATES * i
+
+
 def payload_slot(n_uavs: int) -> int:
     """Offset of r_p in q_f (and of v_p in q_f_dot) for n UAVs."""
     return UAV_COORDINATES * n_uavs
@@ -31,6 +39,12 @@ def payload_slot(n_uavs: int) -> int:
 def n_coordinates(n_uavs: int) -> int:
     """Length of q_f: 6n + 3 (the rates q_f_dot start there in x)."""
     return UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES
+
+
+def attitude_slot(n_uavs: int) -> int:
+    """Offset of a rigid payload's attitude block (after q_f_dot): 2 (6n + 3), the length of a
+    point payload's state."""
+    return 2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
 
 
 # a rigid-body payload's attitude (issue 20; physics.rigid_payload), appended to x after

@@ -1,16 +1,17 @@
 """What the controllers measure of each UAV, from the formation state (seed Eq. 2.7), and the
 rest of what the simulator's messages carry of it (its attitude as R and as a quaternion, its
-body-frame velocity): the one run-time place of these equations (kinematics.rotation_matrix
-and .quaternion_from_euler, msgvalues.quaternion are the numpy and float forms the tests hold
-them to, and what plots and markers use)."""
+body-frame velocity): the one place of these equations (`euler_rotation`, `euler_quaternion`;
+kinematics.rotation_matrix and .quaternion_from_euler call them over stacks, msgvalues
+.quaternion runs the uncompiled form for one attitude; tests/unit/test_kinematics.py holds them
+to elementary rotations and scipy)."""
 import math
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import (EULER, MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_QUATERNION,
-                                          ODOMETRY_ROTATION, PAYLOAD_COORDINATES, POSITION,
-                                          UAV_COORDINATES)
+                                          ODOMETRY_ROTATION, POSITION)
+from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
 
 
 @jit
@@ -19,9 +20,9 @@ def measured_states(x, n, out):
     slots are written) from the formation state x (2 (6n + 3),): position [m] and velocity
     [m/s] (world), ZYX Euler angles [rad] and the body rates omega = W(eta) eta_dot [rad/s]
     (Eq. 2.7, body FLU)."""
-    nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
+    nq = rates_slot(n)
     for i in range(n):
-        base = UAV_COORDINATES * i
+        base = uav_slot(i)
         for axis in range(3):
             out[i, MEASURED_POSITION + axis] = x[base + POSITION + axis]
             out[i, MEASURED_VELOCITY + axis] = x[nq + base + POSITION + axis]
@@ -43,7 +44,7 @@ def measured_states(x, n, out):
 def payload_position(x, n):
     """The payload's position r_p [m] (3,), world, in the formation state x of n UAVs (a view:
     what the snapshot carries and a leader's swing feedback reads, multilift_control.laws.swing)."""
-    start = UAV_COORDINATES * n
+    start = payload_slot(n)
     return x[start:start + 3]
 
 
@@ -51,7 +52,7 @@ def payload_position(x, n):
 def payload_velocity(x, n):
     """The payload's velocity v_p [m/s] (3,), world, in the formation state x of n UAVs (a view:
     what the snapshot carries and a leader's swing damping reads, multilift_control.laws.swing)."""
-    start = 2 * UAV_COORDINATES * n + PAYLOAD_COORDINATES
+    start = rates_slot(n) + payload_slot(n)
     return x[start:start + 3]
 
 
@@ -79,19 +80,10 @@ def odometry_rows(out):
             phi = rows[i, MEASURED_EULER]
             theta = rows[i, MEASURED_EULER + 1]
             psi = rows[i, MEASURED_EULER + 2]
-            s_phi, c_phi = math.sin(phi), math.cos(phi)
-            s_th, c_th = math.sin(theta), math.cos(theta)
-            s_psi, c_psi = math.sin(psi), math.cos(psi)
             r = ODOMETRY_ROTATION
-            rows[i, r] = c_psi * c_th
-            rows[i, r + 1] = c_psi * s_th * s_phi - s_psi * c_phi
-            rows[i, r + 2] = c_psi * s_th * c_phi + s_psi * s_phi
-            rows[i, r + 3] = s_psi * c_th
-            rows[i, r + 4] = s_psi * s_th * s_phi + c_psi * c_phi
-            rows[i, r + 5] = s_psi * s_th * c_phi - c_psi * s_phi
-            rows[i, r + 6] = -s_th
-            rows[i, r + 7] = c_th * s_phi
-            rows[i, r + 8] = c_th * c_phi
+            (rows[i, r], rows[i, r + 1], rows[i, r + 2], rows[i, r + 3], rows[i, r + 4],
+             rows[i, r + 5], rows[i, r + 6], rows[i, r + 7],
+             rows[i, r + 8]) = euler_rotation(phi, theta, psi)
             vx = rows[i, MEASURED_VELOCITY]
             vy = rows[i, MEASURED_VELOCITY + 1]
             vz = rows[i, MEASURED_VELOCITY + 2]
@@ -99,11 +91,55 @@ def odometry_rows(out):
                 rows[i, ODOMETRY_BODY_VELOCITY + axis] = (
                     rows[i, r + axis] * vx + rows[i, r + 3 + axis] * vy
                     + rows[i, r + 6 + axis] * vz)
-            half_roll, half_pitch, half_yaw = 0.5 * phi, 0.5 * theta, 0.5 * psi
-            sr, cr = math.sin(half_roll), math.cos(half_roll)
-            sp, cp = math.sin(half_pitch), math.cos(half_pitch)
-            sy, cy = math.sin(half_yaw), math.cos(half_yaw)
-            rows[i, ODOMETRY_QUATERNION] = sr * cp * cy - cr * sp * sy
-            rows[i, ODOMETRY_QUATERNION + 1] = cr * sp * cy + sr * cp * sy
-            rows[i, ODOMETRY_QUATERNION + 2] = cr * cp * sy - sr * sp * cy
-            rows[i, ODOMETRY_QUATERNION + 3] = cr * cp * cy + sr * sp * sy
+            q = ODOMETRY_QUATERNION
+            (rows[i, q], rows[i, q + 1], rows[i, q + 2],
+             rows[i, q + 3]) = euler_quaternion(phi, theta, psi)
+
+
+@jit
+def euler_rotation(phi, theta, psi):
+    """R = Rz(psi) Ry(theta) Rx(phi), body -> world (seed Eq. 2.6), of ZYX Euler angles [rad],
+    row by row (9 floats): the one form of it the messages and the analysis use (`odometry_rows`,
+    `euler_rotations`: kinematics.rotation_matrix). The physics' own R (free_motion.uav_rotation,
+    thrust_direction) groups its third column's products differently (c_psi (s_theta c_phi)):
+    the same R to the last bit or so, kept apart so that every run flies to the same bits."""
+    s_phi, c_phi = math.sin(phi), math.cos(phi)
+    s_th, c_th = math.sin(theta), math.cos(theta)
+    s_psi, c_psi = math.sin(psi), math.cos(psi)
+    return (c_psi * c_th,
+            c_psi * s_th * s_phi - s_psi * c_phi,
+            c_psi * s_th * c_phi + s_psi * s_phi,
+            s_psi * c_th,
+            s_psi * s_th * s_phi + c_psi * c_phi,
+            s_psi * s_th * c_phi - c_psi * s_phi,
+            -s_th, c_th * s_phi, c_th * c_phi)
+
+
+@jit
+def euler_quaternion(phi, theta, psi):
+    """The unit quaternion (x, y, z, w) of R = Rz(psi) Ry(theta) Rx(phi) from the half angles of
+    ZYX Euler angles [rad], scalar last as geometry_msgs orders it: the one form of it
+    (`odometry_rows`; msgvalues.quaternion runs its uncompiled form, kinematics
+    .quaternion_from_euler `euler_quaternions`)."""
+    half_roll, half_pitch, half_yaw = 0.5 * phi, 0.5 * theta, 0.5 * psi
+    sr, cr = math.sin(half_roll), math.cos(half_roll)
+    sp, cp = math.sin(half_pitch), math.cos(half_pitch)
+    sy, cy = math.sin(half_yaw), math.cos(half_yaw)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+@jit
+def euler_rotations(angles, out):
+    """`euler_rotation` of each row of angles (m, 3) [rad] into out (m, 9)."""
+    for k in range(angles.shape[0]):
+        (out[k, 0], out[k, 1], out[k, 2], out[k, 3], out[k, 4], out[k, 5], out[k, 6], out[k, 7],
+         out[k, 8]) = euler_rotation(angles[k, 0], angles[k, 1], angles[k, 2])
+
+
+@jit
+def euler_quaternions(angles, out):
+    """`euler_quaternion` of each row of angles (m, 3) [rad] into out (m, 4)."""
+    for k in range(angles.shape[0]):
+        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = euler_quaternion(angles[k, 0], angles[k, 1],
+                                                                      angles[k, 2])

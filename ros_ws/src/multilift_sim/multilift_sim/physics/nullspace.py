@@ -27,8 +27,9 @@ import numpy as np
 from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import payload_force_per_mass, uav_free_motion
 from multilift_sim.physics.layout import (FORMATION_GRAVITY, FORMATION_PAYLOAD_MASS,
-                                          PAYLOAD_COORDINATES, POSITION, UAV_COORDINATES,
+                                          POSITION,
                                           UAV_LENGTH_SQ, UAV_MASS)
+from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
 
 
 @jit
@@ -148,10 +149,10 @@ def complete_q(a):
 def translational_jacobian(x, n, jacobian):
     """G_t (n, 3n + 3) of g_i = |r_p - r_i|^2 - l_i^2 (Eq. 2.65) at state x: row i is
     -2 d_i on r_i and +2 d_i on r_p, d_i = r_p - r_i."""
-    p = UAV_COORDINATES * n
+    p = payload_slot(n)
     jacobian[:, :] = 0.0
     for i in range(n):
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         for axis in range(3):
             d = x[p + axis] - x[r + axis]
             jacobian[i, 3 * i + axis] = -2.0 * d
@@ -176,8 +177,8 @@ def nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers):
     """q_ddot into acc (6n + 3,) and Lambda into multipliers (n,) [N/m] at state x by Eq.
     2.71-2.72 with Eq. 2.57 (every cable a constraint; see the module docstring)."""
     n = uavs.shape[0]
-    p = UAV_COORDINATES * n
-    nq = p + PAYLOAD_COORDINATES
+    p = payload_slot(n)
+    nq = rates_slot(n)
     m = 3 * n + 3
     gravity = formation[FORMATION_GRAVITY]
     masses = translational_masses(uavs, formation)
@@ -208,7 +209,7 @@ def nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers):
     for i in range(n):  # G_t a = -G_dot_t q_dot_t = -2 |d_i_dot|^2 (Eq. 2.57)
         for c in range(m):
             system[m - n + i, c] = jacobian[i, c]
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         rate_sq = 0.0
         for axis in range(3):
             rate = x[nq + p + axis] - x[nq + r + axis]
@@ -216,7 +217,7 @@ def nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers):
         rhs[m - n + i] = -2.0 * rate_sq
     accelerations = dense_solve(system, rhs)
     for i in range(n):
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         for axis in range(3):
             acc[r + axis] = accelerations[3 * i + axis]
     for axis in range(3):
@@ -235,15 +236,15 @@ def project(x, uavs, masses, tolerance, max_steps):
     M_t = diag(`masses`) (3n + 3,) [kg] (`translational_masses`). Only the translations move
     (the attitude columns of G are zero)."""
     n = uavs.shape[0]
-    p = UAV_COORDINATES * n
-    nq = p + PAYLOAD_COORDINATES
+    p = payload_slot(n)
+    nq = rates_slot(n)
     m = 3 * n + 3
     jacobian = np.empty((n, m))
     for _ in range(max_steps):
         residual = np.empty(n)
         inside = True
         for i in range(n):
-            r = UAV_COORDINATES * i + POSITION
+            r = uav_slot(i) + POSITION
             total = 0.0
             for axis in range(3):
                 d = x[p + axis] - x[r + axis]
@@ -262,7 +263,7 @@ def project(x, uavs, masses, tolerance, max_steps):
     weighted = jacobian / masses
     velocities = np.empty(m)
     for i in range(n):
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         for axis in range(3):
             velocities[3 * i + axis] = x[nq + r + axis]
     for axis in range(3):
@@ -275,9 +276,9 @@ def project(x, uavs, masses, tolerance, max_steps):
 @jit
 def _move_translations(x, n, offset, step):
     """x[offset + translations] -= step (3n + 3,): the UAVs' r_i (or rates), then r_p's."""
-    p = UAV_COORDINATES * n
+    p = payload_slot(n)
     for i in range(n):
-        r = offset + UAV_COORDINATES * i + POSITION
+        r = offset + uav_slot(i) + POSITION
         for axis in range(3):
             x[r + axis] -= step[3 * i + axis]
     for axis in range(3):

@@ -35,8 +35,9 @@ from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_ce
 from multilift_sim.physics.layout import (
     CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT, CABLE_RHS,
     CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_GRAVITY, FORMATION_PAYLOAD_INERTIA,
-    FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, PAYLOAD_BODY_RATES, PAYLOAD_COORDINATES,
-    PAYLOAD_QUATERNION, POSITION, UAV_COORDINATES, UAV_LENGTH_SQ, UAV_MASS, UAV_PAYLOAD_ATTACH)
+    FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, PAYLOAD_BODY_RATES,
+    PAYLOAD_QUATERNION, POSITION, UAV_LENGTH_SQ, UAV_MASS, UAV_PAYLOAD_ATTACH)
+from multilift_sim.physics.state_slots import attitude_slot, payload_slot, rates_slot, uav_slot
 from multilift_sim.physics.nullspace import dense_solve
 
 
@@ -64,9 +65,9 @@ def cable_geometry(x, uavs, i, rotation, omega_world, base, attach):
     `attach` (3, 3): UAV i's attach point's offset, rate and acceleration
     (`free_motion.uav_attach_motion`; zeros for its centre of mass)."""
     n = uavs.shape[0]
-    p = UAV_COORDINATES * n
-    nq = p + PAYLOAD_COORDINATES
-    r = UAV_COORDINATES * i + POSITION
+    p = payload_slot(n)
+    nq = rates_slot(n)
+    r = uav_slot(i) + POSITION
     b0, b1, b2 = (uavs[i, UAV_PAYLOAD_ATTACH], uavs[i, UAV_PAYLOAD_ATTACH + 1],
                   uavs[i, UAV_PAYLOAD_ATTACH + 2])
     e0 = rotation[0, 0] * b0 + rotation[0, 1] * b1 + rotation[0, 2] * b2
@@ -183,9 +184,9 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cab
     multipliers (n,) [N/m] at state x (see the module docstring); only `taut` cables pull.
     cables (n, CABLE_COLUMNS) scratch: each cable's row (`rigid_cable_row`; zeros when slack)."""
     n = uavs.shape[0]
-    p = UAV_COORDINATES * n
-    nq = p + PAYLOAD_COORDINATES
-    base = 2 * nq
+    p = payload_slot(n)
+    nq = rates_slot(n)
+    base = attitude_slot(n)
     gravity = formation[FORMATION_GRAVITY]
     payload_mass = formation[FORMATION_PAYLOAD_MASS]
     inertia = formation[FORMATION_PAYLOAD_INERTIA:FORMATION_PAYLOAD_INERTIA + 3]
@@ -233,7 +234,7 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cab
         lam = multipliers[i]
         d0, d1, d2 = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
             cables[i, CABLE_OFFSET + 2]
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         pull = 2.0 * lam / uavs[i, UAV_MASS]
         acc[r] = cables[i, CABLE_THRUST] + pull * d0
         acc[r + 1] = cables[i, CABLE_THRUST + 1] + pull * d1
@@ -265,7 +266,7 @@ def rigid_residuals(x, uavs, g, g_dot):
     """g_i = |d_i|^2 - l_i^2 [m^2] into g (n,) and g_dot_i = 2 d_i . d_i_dot [m^2/s] into
     g_dot (n,) at a state x with the payload's attitude."""
     n = uavs.shape[0]
-    base = 2 * (UAV_COORDINATES * n + PAYLOAD_COORDINATES)
+    base = attitude_slot(n)
     rotation = payload_rotation(x, base)
     w = world_rates(x, base, rotation)
     attach = np.zeros((3, 3))

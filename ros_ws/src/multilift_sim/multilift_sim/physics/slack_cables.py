@@ -18,10 +18,11 @@ from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_ce
 from multilift_sim.physics.layout import (
     CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT, CABLE_RHS,
     FORMATION_INV_PAYLOAD_MASS, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
-    PAYLOAD_BODY_RATES, PAYLOAD_COORDINATES, PAYLOAD_QUATERNION, POSITION, SLACK_CABLE_ROWS,
+    PAYLOAD_BODY_RATES, PAYLOAD_QUATERNION, POSITION, SLACK_CABLE_ROWS,
     SLACK_END, SLACK_EVENT, SLACK_FLAGS, SLACK_G_DOT_END, SLACK_G_END, SLACK_MULTIPLIERS,
-    SLACK_SNAPPING, SLACK_SOLUTION, SLACK_STATES, SLACK_TARGET, UAV_COORDINATES, UAV_LENGTH_SQ,
+    SLACK_SNAPPING, SLACK_SOLUTION, SLACK_STATES, SLACK_TARGET, UAV_LENGTH_SQ,
     UAV_MASS, WORK_ACC, WORK_ROWS, WRENCH_COLUMNS)
+from multilift_sim.physics.state_slots import attitude_slot, payload_slot, rates_slot, uav_slot
 from multilift_sim.physics.rigid_payload import (normalize_quaternion, payload_rotation,
                                                  quaternion_rate, rigid_cable_row,
                                                  rigid_multipliers, world_rates)
@@ -39,20 +40,20 @@ def mass_metric_solve(x, uavs, formation, taut, rhs, out, cables):
     points, k_i (CABLE_MOMENT, 0 at a UAV's centre) and with a rigid payload c_i
     (CABLE_PAYLOAD_MOMENT)."""
     n = uavs.shape[0]
-    p = UAV_COORDINATES * n
-    nq = p + PAYLOAD_COORDINATES
-    if x.shape[0] > 2 * nq:  # a rigid payload: the 6 x 6 Woodbury solve (physics.rigid_payload)
-        rotation = payload_rotation(x, 2 * nq)
-        w = world_rates(x, 2 * nq, rotation)
+    p = payload_slot(n)
+    attitude = attitude_slot(n)
+    if x.shape[0] > attitude:  # a rigid payload: the 6 x 6 Woodbury solve (physics.rigid_payload)
+        rotation = payload_rotation(x, attitude)
+        w = world_rates(x, attitude, rotation)
         attach = np.zeros((3, 3))
         still = np.zeros((n, WRENCH_COLUMNS))  # (the attach points' accelerations: unused)
         for i in range(n):
-            rigid_cable_row(x, uavs, i, still, rotation, w, 2 * nq, attach, cables)
+            rigid_cable_row(x, uavs, i, still, rotation, w, attitude, attach, cables)
             cables[i, CABLE_RHS] = rhs[i]
         rigid_multipliers(cables, formation, taut, out)
         return
     for i in range(n):
-        r = UAV_COORDINATES * i + POSITION
+        r = uav_slot(i) + POSITION
         dx, dy, dz = x[p] - x[r], x[p + 1] - x[r + 1], x[p + 2] - x[r + 2]
         k0 = k1 = k2 = 0.0
         if attached_off_centre(uavs, i):  # from the attach point r_i + R_i a_i
@@ -81,11 +82,10 @@ def move_along_cables(x, uavs, formation, z, start, cables):
     length: to first order, as the projection's Newton steps are), start = 6n + 3 the
     velocities [m/s] and rates [rad/s]."""
     n = uavs.shape[0]
-    nq = UAV_COORDINATES * n + PAYLOAD_COORDINATES
-    p = start + UAV_COORDINATES * n
+    p = start + payload_slot(n)
     inv_payload_mass = formation[FORMATION_INV_PAYLOAD_MASS]
     for i in range(n):
-        r = start + UAV_COORDINATES * i + POSITION
+        r = start + uav_slot(i) + POSITION
         for k in range(3):
             pull = 2.0 * z[i] * cables[i, CABLE_OFFSET + k]  # G^T z of this body
             x[r + k] += pull / uavs[i, UAV_MASS]
@@ -93,8 +93,8 @@ def move_along_cables(x, uavs, formation, z, start, cables):
         if attached_off_centre(uavs, i):  # the impulse's moment about UAV i's centre
             add_cable_torque(x, i, uavs, x[start:], 2.0 * z[i], cables[i, CABLE_MOMENT],
                              cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
-    if x.shape[0] > 2 * nq:  # a rigid payload's rotation
-        base = 2 * nq
+    if x.shape[0] > attitude_slot(n):  # a rigid payload's rotation
+        base = attitude_slot(n)
         turn0 = turn1 = turn2 = 0.0
         for i in range(n):
             turn0 += z[i] * cables[i, CABLE_PAYLOAD_MOMENT]
@@ -122,7 +122,7 @@ def snap_velocities(x, uavs, formation, taut, g, g_dot, impulses, cables):
     increased). Writes x; g, g_dot, impulses (n,) scratch."""
     residuals(x, uavs, g, g_dot)
     mass_metric_solve(x, uavs, formation, taut, g_dot, impulses, cables)
-    nq = UAV_COORDINATES * uavs.shape[0] + PAYLOAD_COORDINATES
+    nq = rates_slot(uavs.shape[0])
     move_along_cables(x, uavs, formation, impulses, nq, cables)
 
 

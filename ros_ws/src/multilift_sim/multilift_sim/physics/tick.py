@@ -19,10 +19,11 @@ from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.layout import (CABLE_COLUMNS, EULER, FORMATION_WIND,
-                                          PAYLOAD_COORDINATES, STATUS_ATTITUDE, STATUS_FINISHED,
+                                          STATUS_ATTITUDE, STATUS_FINISHED,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
-                                          STATUS_OFF_RATE, STATUS_RUNNING, UAV_COORDINATES,
+                                          STATUS_OFF_RATE, STATUS_RUNNING,
                                           WRENCH_COLUMNS)
+from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.sensors import sensed_states
 from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
@@ -33,15 +34,36 @@ from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DO
 
 
 @jit
+def period_wind(formation, series, tick, out):
+    """The air's velocity everywhere over the period from `tick` [m/s], world, into out (3,):
+    the steady wind (a formation's scalars, FORMATION_WIND) plus the tick's unsteady wind
+    (series (ticks + 1, 3), `schedules.wind_series`; (0, 3): none, the steady wind as it is).
+    The one place the wind is composed: the physics (`period_formation`), the simulator's
+    `wind` and the bags' /formation/wind (`period_winds`) call it; a gust's 1-cosine field
+    adds to it at a point (formation_dae.air_velocity)."""
+    for j in range(3):
+        out[j] = formation[FORMATION_WIND + j]
+    if series.shape[0]:
+        for j in range(3):
+            out[j] += series[tick, j]
+
+
+@jit
+def period_winds(formation, series, out):
+    """`period_wind` of every tick into out (ticks + 1, 3) [m/s], world."""
+    for tick in range(out.shape[0]):
+        period_wind(formation, series, tick, out[tick])
+
+
+@jit
 def period_formation(a, m, b):
-    """Formation b's scalars (FORMATION_*) for the period from its current tick: the steady
-    wind plus the tick's unsteady wind (`schedules.wind_series`); the constants themselves
-    when the air is steady."""
+    """Formation b's scalars (FORMATION_*) for the period from its current tick, their wind
+    `period_wind`'s; the constants themselves when the air is steady."""
     formation = a.formation[b]
     if a.wind_series.shape[1]:
         formation = formation.copy()
-        for j in range(3):
-            formation[FORMATION_WIND + j] += a.wind_series[b, m.tick[b], j]
+        period_wind(a.formation[b], a.wind_series[b], m.tick[b],
+                    formation[FORMATION_WIND:FORMATION_WIND + 3])
     return formation
 
 
@@ -61,9 +83,9 @@ def check(a, m, b):
         return
     if status == CHECK_ATTITUDE:  # the UAV in worst_cable, its pitch [rad] in worst_value
         m.status[b], m.worst_cable[b] = STATUS_ATTITUDE, cable
-        m.worst_value[b] = x[UAV_COORDINATES * cable + EULER + 1]
+        m.worst_value[b] = x[uav_slot(cable) + EULER + 1]
         return
-    payload = 6 * a.uavs.shape[1]
+    payload = payload_slot(a.uavs.shape[1])
     gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
     m.gust[b, 0], m.gust[b, 1], m.gust[b, 2] = gust_x, gust_y, gust_z
     if a.gusts.shape[1]:
@@ -150,7 +172,7 @@ def tension_at(a, m, b, speeds, tension):
     wrenches = np.empty((n, WRENCH_COLUMNS))
     rotor_wrenches(a.allocation[b], speeds, m.effectiveness[b], wrenches)
     x = m.state[b]
-    acc = np.empty(x.shape[0] - UAV_COORDINATES * n - PAYLOAD_COORDINATES)  # q_ddot (+ a body's)
+    acc = np.empty(x.shape[0] - rates_slot(n))  # q_ddot (+ a body's)
     multipliers = np.empty(n)
     solve(x, wrenches, a.uavs[b], a.gusts[b], period_formation(a, m, b), m.taut[b], acc,
           multipliers, np.empty((n, CABLE_COLUMNS)))

@@ -17,7 +17,6 @@ from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
 from multilift_sim.wire import msgvalues
-from multilift_sim.kinematics import quaternion_from_euler
 from multilift_sim.ros.common import WORLD_FRAME, fill_odometry, stamp_from_ns, uav_frame
 
 PAYLOAD_FRAME = 'payload'
@@ -54,8 +53,7 @@ def _transform(t_ns: int, child: str, position: Sequence[float],
 def transforms(t_ns: int, snapshot) -> TFMessage:
     """/tf of a simulation.Snapshot: world -> uav{i}/base_link (i from 1) and world -> payload
     (no rotation), the poses of the odometry published with it."""
-    frames = [_transform(t_ns, uav_frame(i + 1), uav.position,
-                         quaternion_from_euler(uav.euler))
+    frames = [_transform(t_ns, uav_frame(i + 1), uav.position, uav.orientation)
               for i, uav in enumerate(snapshot.uavs)]
     frames.append(_transform(t_ns, PAYLOAD_FRAME, snapshot.payload_position,
                              (0.0, 0.0, 0.0, 1.0)))

@@ -15,6 +15,7 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import EULER, POSITION, UAV_COORDINATES
+from multilift_sim.physics.state_slots import payload_slot, uav_slot
 from multilift_sim.statistics.layout import (
     CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS,
     FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ, PITCH_LIMIT,
@@ -115,7 +116,7 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
         if not math.isfinite(value):
             return CHECK_NON_FINITE, -1
     for i in range(g.shape[0]):  # cos(pitch) < cos(limit): beyond it on either side, or past 90
-        if math.cos(state[UAV_COORDINATES * i + EULER + 1]) < math.cos(PITCH_LIMIT):
+        if math.cos(state[uav_slot(i) + EULER + 1]) < math.cos(PITCH_LIMIT):
             return CHECK_ATTITUDE, i
     peak, worst, peak_rate, worst_rate = -1.0, -1, -1.0, -1
     for i in range(g.shape[0]):
@@ -134,9 +135,9 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
         for i in range(n):
             if taut[i]:
                 held += 1
-        payload = state[UAV_COORDINATES * n:UAV_COORDINATES * n + 3]  # layout.payload_slot
+        payload = state[payload_slot(n):payload_slot(n) + 3]
         if held == n:  # every cable holds it (no copy)
-            uavs = state[:UAV_COORDINATES * n].reshape((n, UAV_COORDINATES))
+            uavs = state[:payload_slot(n)].reshape((n, UAV_COORDINATES))
             peak_rms_add(run, RUN_SWING, swing_at(uavs[:, POSITION:POSITION + 3], payload,
                                                   reach))
         elif held > 0:
@@ -146,7 +147,7 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
             for i in range(n):
                 if taut[i]:
                     for axis in range(3):
-                        held_uavs[k, axis] = state[UAV_COORDINATES * i + POSITION + axis]
+                        held_uavs[k, axis] = state[uav_slot(i) + POSITION + axis]
                     reaches[k] = reach[i]
                     k += 1
             peak_rms_add(run, RUN_SWING, swing_at(held_uavs, payload, reaches))

@@ -6,17 +6,19 @@ reference the packed bytes are tested against. World frame, SI units.
 """
 from __future__ import annotations
 
-import math
 from typing import Sequence
 
 import numpy as np
 
 from multilift_sim.events import kind_at
+from multilift_sim.kernels import uncompiled
+from multilift_sim.physics.measurement import euler_quaternion
 from multilift_sim.physics.layout import (EVENT_KIND, EVENT_TIME, MEASURED_BODY_RATES,
                                           MEASURED_EULER, MEASURED_POSITION, MEASURED_VELOCITY)
 
 
 WORLD_FRAME = 'world'
+_euler_quaternion = uncompiled(euler_quaternion)  # `quaternion`: plain floats, no dispatch
 PAYLOAD_FRAME = 'payload'
 
 Vec3 = tuple[float, float, float]
@@ -38,16 +40,11 @@ def stamp(t_ns: int) -> tuple[int, int]:
 
 
 def quaternion(euler: Sequence[float]) -> Quat:
-    """(x, y, z, w) of ZYX Euler angles [rad]: kinematics.quaternion_from_euler's arithmetic in
-    plain floats (one attitude per message: numpy's per-call cost would be most of it), for the
-    markers (scene.py) and as the tests' oracle; a UAV's odometry quaternion is computed by
-    physics.measurement.odometry_states."""
-    roll, pitch, yaw = (0.5 * float(a) for a in euler)
-    sr, cr = math.sin(roll), math.cos(roll)
-    sp, cp = math.sin(pitch), math.cos(pitch)
-    sy, cy = math.sin(yaw), math.cos(yaw)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+    """(x, y, z, w) of ZYX Euler angles [rad], for the markers (scene.py): physics.measurement
+    .euler_quaternion (the odometry's), run uncompiled on plain floats (one attitude per
+    message: a compiled call's or numpy's per-call cost would be most of it)."""
+    roll, pitch, yaw = euler
+    return _euler_quaternion(float(roll), float(pitch), float(yaw))
 
 
 def vec3(values: Sequence[float]) -> Vec3:

@@ -14,6 +14,7 @@ from typing import Sequence
 import numpy as np
 
 from multilift_sim import kernels
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.wire import cdr, cdr_scene
 from multilift_sim.wire.msgvalues import (IDENTITY, PAYLOAD_FRAME, SNAPSHOT_BLOCKS, WORLD_FRAME,
                                           formation_event, formation_snapshot, uav_frame, vec3)
@@ -165,13 +166,13 @@ def state_rows(states: np.ndarray, n: int, measured: np.ndarray | None = None
     which `FormationSimulator.snapshot` calls too: the same bits tick by tick
     (tests/unit/test_headless_bag.py). The snapshot carries what the controllers received,
     `measured` (K, n, MEASURED_COLUMNS), where given (the engine's record), else the state's."""
-    k, nq = states.shape[0], 6 * n + 3
+    k, layout = states.shape[0], StateLayout(n)
     rows = np.empty((k, n, ODOMETRY_COLUMNS))
     odometry_states(np.ascontiguousarray(states), n, rows)
     received = rows if measured is None else measured
     snapshot = np.concatenate(
         [received[..., block:block + 3].reshape(k, 3 * n) for block in SNAPSHOT_BLOCKS]
-        + [states[:, 6 * n:nq], states[:, nq + 6 * n:2 * nq]], axis=1)
+        + [layout.payload_position(states), layout.payload_velocity(states)], axis=1)
     return snapshot, rows[..., ODOMETRY_NUMBERS]
 
 

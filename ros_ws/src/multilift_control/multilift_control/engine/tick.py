@@ -101,7 +101,10 @@ def advance_formation(a, m, b, speeds, saturated, tension):
     tension. The second half of a tick, whoever answered."""
     first = m.next_event[b]
     physics.advance(a, m, b, speeds, saturated, tension)
-    tell_controllers(a, m, b, first)
+    # only when there is something to tell: a call taking the batch's tuples counts every
+    # array's reference in and out (a microsecond a tick)
+    if m.next_event[b] > first or m.next_target[b] < a.target_schedule.shape[1]:
+        tell_controllers(a, m, b, first)
 
 
 @jit

@@ -56,14 +56,15 @@ def period_winds(formation, series, out):
 
 
 @jit
-def period_formation(a, m, b):
-    """Formation b's scalars (FORMATION_*) for the period from its current tick, their wind
-    `period_wind`'s; the constants themselves when the air is steady."""
-    formation = a.formation[b]
-    if a.wind_series.shape[1]:
-        formation = formation.copy()
-        period_wind(a.formation[b], a.wind_series[b], m.tick[b],
-                    formation[FORMATION_WIND:FORMATION_WIND + 3])
+def period_formation(constants, series, tick):
+    """A formation's scalars (FORMATION_*) for the period from `tick`, their wind
+    `period_wind`'s; the `constants` themselves when the air is steady (series (0, 3)).
+    (Arrays, not the batch's tuples: a call that takes those counts every array's
+    reference in and out, a microsecond a tick.)"""
+    if series.shape[0] == 0:
+        return constants
+    formation = constants.copy()
+    period_wind(constants, series, tick, formation[FORMATION_WIND:FORMATION_WIND + 3])
     return formation
 
 
@@ -112,9 +113,10 @@ def advance(a, m, b, speeds, saturated, tension):
     held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
                   m.held_saturated[b])
     run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
+    formation = period_formation(a.formation[b], a.wind_series[b], m.tick[b])
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
-        a.uavs[b], a.gusts[b], period_formation(a, m, b), m.taut[b], m.released[b], a.slack[b],
+        a.uavs[b], a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
         a.physics_dt[b], a.physics_steps[b])
     for i in range(n):
         tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
@@ -174,8 +176,9 @@ def tension_at(a, m, b, speeds, tension):
     x = m.state[b]
     acc = np.empty(x.shape[0] - rates_slot(n))  # q_ddot (+ a body's)
     multipliers = np.empty(n)
-    solve(x, wrenches, a.uavs[b], a.gusts[b], period_formation(a, m, b), m.taut[b], acc,
-          multipliers, np.empty((n, CABLE_COLUMNS)))
+    formation = period_formation(a.formation[b], a.wind_series[b], m.tick[b])
+    solve(x, wrenches, a.uavs[b], a.gusts[b], formation, m.taut[b], acc, multipliers,
+          np.empty((n, CABLE_COLUMNS)))
     for i in range(n):
         value = multipliers[i]
         if a.slack[b]:

@@ -536,8 +536,11 @@ def test_a_teardown_that_ends_leaves_no_warning():
 
 
 # -- our processes' Fast DDS profile (multilift_sim.ros.fastdds) ----------------------------------
+# what the probe process itself maps of /dev/shm (its own: a listing of /dev/shm would count
+# another test's participant that opened its files in between)
 SHM_PROBE = ('import os, rclpy; from std_msgs.msg import String\n'
-             'def shm(): return {f for f in os.listdir("/dev/shm") if "fastrtps" in f}\n'
+             'def shm(): return {line.split("/dev/shm/")[1].strip() for line in '
+             'open("/proc/self/maps") if "/dev/shm/" in line and "fastrtps" in line}\n'
              'before = shm()\n'
              'rclpy.init(); node = rclpy.create_node("profile_probe")\n'
              'pub = node.create_publisher(String, "/profile_probe", 10)\n'

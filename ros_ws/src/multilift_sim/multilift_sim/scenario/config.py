@@ -193,6 +193,7 @@ class Scenario:
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world
     turbulence: TurbulenceConfig | None = None
     sensors: SensorConfig | None = None  # None: the controllers read the exact state
+    parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
 
     @property
     def n_uavs(self) -> int:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 from typing import Any
 
 from multilift_sim.disturbances import Gust
@@ -15,6 +16,7 @@ from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
 from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_rigid_body_inertia,
                                          solid_inertia)
 from multilift_sim.events import EVENT_KINDS
+from multilift_sim.parts import PartsError, import_part, resolve_part
 from multilift_sim.physics.layout import SENSED_QUANTITIES
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
@@ -31,6 +33,7 @@ from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inerti
 
 def scenario_of(data: Any, where: str) -> Scenario:
     top = Section(data, '', where)
+    parts = _parts(top)  # first: the rest may name what they register
     name = top.text('name')
     description = top.text('description', '')
     top.text('frame', 'world', choices=('world',))
@@ -201,7 +204,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
                                               reference_filter_time=reference_filter_time),
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, events=events, wind=tuple(wind),
-                        turbulence=turbulence, sensors=sensors)
+                        turbulence=turbulence, sensors=sensors, parts=parts)
     _check_feasible(scenario)
     check_limits(scenario)
     # what only the engine's DAE (physics/) models: refused with another formulation
@@ -226,6 +229,24 @@ def scenario_of(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario
+
+
+def _parts(top: Section) -> tuple[str, ...]:
+    """`parts:` imported (multilift_sim.parts), as absolute paths: files relative to the
+    scenario file's folder (a scenario given as text: the working directory's)."""
+    source = Path(top.where)
+    base = source.parent if source.is_file() else Path.cwd()
+    paths = []
+    for entry in top.sequence('parts', []):
+        if not isinstance(entry, str):
+            raise top.fail('parts', entry, 'must be a list of Python file paths')
+        try:
+            path = resolve_part(entry, base)
+            import_part(path)
+        except PartsError as exc:
+            raise top.fail('parts', entry, str(exc)) from None
+        paths.append(str(path))
+    return tuple(paths)
 
 
 def _payload_feedback(c: Section, mode: str) -> dict[str, float]:

@@ -14,7 +14,7 @@ from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES,  # noqa:
                                            ControlConfig, EventConfig,
                                            FormationConfig, MissionConfig, MissionSegment,
                                            PayloadConfig, Scenario, ScenarioError, SensorConfig,
-                                           SimulationConfig, TurbulenceConfig, UavConfig)
+                                           SimulationConfig, UavConfig)
 from multilift_sim.scenario.files import (anchored, load, loads, resolve,  # noqa: F401
                                           scenario_dir)
 from multilift_sim.scenario.vehicle import (INERTIA_SOURCES, SEED_INERTIA,  # noqa: F401

@@ -26,6 +26,7 @@ STATISTIC_UNITS: dict[str, str] = {
     'max_abs_g_dot': 'm^2/s',         # largest |g_i_dot|
     'max_rotor_speed': 'rad/s',       # over every UAV's rotors
     'saturated_time': 's',            # summed over the UAVs
+    'least_thrust_margin': NO_UNIT,   # 1 - u_T / u_T,max, the least over the UAVs and ticks
     'min_tension': 'N',
     'max_tension': 'N',
     'payload_swing_max': 'm',         # horizontal, from the payload's rest place

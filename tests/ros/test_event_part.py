@@ -1,9 +1,9 @@
-"""An event kind defined in one test file flies through ROS (issue 31; the headless half and the
-compiled dispatcher: tests/unit/test_event_plugin.py). This file defines `rotors_scaled`: every
-rotor of a UAV at `factor` times its thrust from the event's tick. A scenario names this file
-under `parts:`; the processes of its runs import it and register the kind (the simulator node
-regenerates the tick's dispatcher with it). pytest's own import leaves the registry alone (the
-runs are other processes), so no other test of this worker sees the kind.
+"""An event kind defined in one test file flies through ROS (issue 31): the toy kind
+`rotor_scale` of tests/unit/test_event_plugin.py (every rotor of a UAV at `factor` times its
+thrust from the event's tick), which that file flies headless in-process, here through ROS and
+headless as processes. The scenario names that file under `parts:`; the runs' processes import
+it and register the kind (the simulator node regenerates the tick's dispatcher with it).
+pytest's own imports leave the registry alone, so no other test of this worker sees the kind.
 
 The check is worked out here, not read from the code: with every rotor of a single lift cut at
 EVENT_TIME, the centre of mass of UAV and payload falls freely, p0 + v0 t - g t^2 / 2.
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import os
 import subprocess
-import types
 from pathlib import Path
 
 import numpy as np
@@ -20,50 +19,19 @@ import pytest
 import yaml
 
 from multilift_sim import events
-from multilift_sim.events.keys import read_uav
-from multilift_sim.kernels import jit
-from multilift_sim.physics.layout import EVENT_UAV, EVENT_VALUE
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-@jit
-def apply_rotors_scaled(row, tick, effectiveness, taut, released, silent_until):
-    uav = int(row[EVENT_UAV])
-    for r in range(effectiveness.shape[1]):
-        effectiveness[uav, r] *= row[EVENT_VALUE]
-
-
-def _parse(e, uavs, earlier):
-    return dict(uav=read_uav(e, uavs), values=(('factor', e.number(
-        'factor', ..., lambda v: v >= 0, 'must be >= 0')),))
-
-
-def _pack(event, row, rate):
-    row[EVENT_VALUE] = event.value('factor')
-
-
-def _describe(row):
-    uav, value = int(row[EVENT_UAV]) + 1, float(row[EVENT_VALUE])
-    return uav, 0, value, f'uav{uav} rotors at {value:g} times their thrust'
-
-
-ROTORS_SCALED = types.SimpleNamespace(NAME='rotors_scaled', KEYS=('uav', 'factor'),
-                                      parse=_parse, pack=_pack, apply=apply_rotors_scaled,
-                                      describe=_describe)
-if __name__.startswith('multilift_parts_'):  # imported by a scenario's `parts:`
-    events.register(ROTORS_SCALED)
-
+PART = ROOT / 'tests' / 'unit' / 'test_event_plugin.py'
 EVENT_TIME, END, G = 2.5, 3.0, 9.81  # [s], [s], [m/s^2]
 
 
 def _scenario_file(folder: Path) -> Path:
     data = yaml.safe_load((ROOT / 'scenarios' / 'single_lift.yaml').read_text())
-    data['parts'] = [os.path.relpath(__file__, folder)]
+    data['parts'] = [os.path.relpath(PART, folder)]
     data['name'] = 'single_lift_rotors_cut'
     data['simulation']['duration'] = END
     data['payload']['drag_coefficient'] = 0.0  # gravity alone once the rotors are cut
-    data['events'] = [{'time': EVENT_TIME, 'type': 'rotors_scaled', 'uav': 1, 'factor': 0.0}]
+    data['events'] = [{'time': EVENT_TIME, 'type': 'rotor_scale', 'uav': 1, 'factor': 0.0}]
     path = folder / 'rotors_cut.yaml'
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return path
@@ -113,7 +81,7 @@ def test_the_runs_record_the_event(runs):
     path, bags = runs
     for mode in ('headless', 'ros'):
         summary = yaml.safe_load((bags[mode] / 'summary.json').read_text())
-        assert [e['type'] for e in summary['sim']['events']] == ['rotors_scaled'], mode
-    assert 'rotors_scaled' not in events.EVENT_KINDS  # pytest's import registered nothing
+        assert [e['type'] for e in summary['sim']['events']] == ['rotor_scale'], mode
+    assert 'rotor_scale' not in events.EVENT_KINDS  # pytest's import registered nothing
     assert np.abs(load_run(bags['ros']).payload_position()
                   - load_run(bags['headless']).payload_position()).max() < 1e-9

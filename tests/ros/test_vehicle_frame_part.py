@@ -14,7 +14,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import subprocess
 import types
 from pathlib import Path
 
@@ -66,14 +65,11 @@ def _hover_speeds(data: dict) -> np.ndarray:
 
 
 @pytest.mark.parametrize('mode', ['ros', 'headless'])
-def test_a_frame_defined_in_a_test_file_hovers_on_its_statics(tmp_path, ros_env, mode):
+def test_a_frame_defined_in_a_test_file_hovers_on_its_statics(tmp_path, multilift_run, mode):
     from multilift_tools.bagdata import load_run
     path = _scenario_file(tmp_path)
-    args = [str(ROOT / 'scripts' / 'multilift'), 'run', str(path), '--bag', str(tmp_path / 'bag')]
-    if mode == 'headless':
-        args.append('--headless')
-    out = subprocess.run(args, capture_output=True, text=True, timeout=600, env=ros_env)
-    assert out.returncode == 0, out.stderr[-2000:]
+    run = multilift_run(str(path), bag=tmp_path / 'bag', headless=mode == 'headless')
+    assert run.wait(timeout=600) == 0, run.output()[-2000:]
     speeds = load_run(tmp_path / 'bag').rotor_speeds(1)
     expected = _hover_speeds(yaml.safe_load(path.read_text()))
     assert not np.allclose(expected[0], expected[1], rtol=0.05)  # the frame matters

@@ -11,7 +11,6 @@ downwind by theta with tan(theta) = c_pd U^2 / (m_p g).
 from __future__ import annotations
 
 import os
-import subprocess
 import types
 from dataclasses import dataclass
 from pathlib import Path
@@ -68,16 +67,13 @@ def _scenario_file(folder: Path) -> Path:
 
 @pytest.mark.parametrize('mode', ['ros', 'headless'])
 def test_a_wind_model_defined_in_a_test_file_leans_the_cable_as_the_statics_say(
-        tmp_path, ros_env, mode):
+        tmp_path, multilift_run, mode):
     from multilift_tools.bagdata import load_run
     path = _scenario_file(tmp_path)
-    args = [str(ROOT / 'scripts' / 'multilift'), 'run', str(path), '--bag', str(tmp_path / 'bag')]
-    if mode == 'headless':
-        args.append('--headless')
-    out = subprocess.run(args, capture_output=True, text=True, timeout=600, env=ros_env)
-    assert out.returncode == 0, out.stderr[-2000:]
-    run = load_run(tmp_path / 'bag')
-    cable = run.payload_position()[-1] - run.uav_positions()[0][-1]  # UAV -> payload [m]
+    run = multilift_run(str(path), bag=tmp_path / 'bag', headless=mode == 'headless')
+    assert run.wait(timeout=600) == 0, run.output()[-2000:]
+    bag = load_run(tmp_path / 'bag')
+    cable = bag.payload_position()[-1] - bag.uav_positions()[0][-1]  # UAV -> payload [m]
     data = yaml.safe_load(path.read_text())
     drag, weight = data['payload']['drag_coefficient'] * SPEED ** 2, \
         data['payload']['mass'] * data['simulation']['gravity']

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 import yaml
 
-from conftest import SCENARIOS
 from multilift_control.headless import fly, run_headless
 from multilift_sim import events as event_kinds
 from multilift_sim import scenario as scenario_io
@@ -22,6 +21,8 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import EVENT_UAV, EVENT_VALUE
 
 ROOT = Path(__file__).resolve().parents[2]
+SCENARIOS = ROOT / 'scenarios'  # (not conftest's: the runs of tests/ros/test_event_part.py
+#                                  import this file as their scenario's part)
 
 
 # -- the toy kind: every rotor of a UAV at `factor` times its effectiveness ----------------
@@ -48,6 +49,13 @@ def _describe(row):
 
 ROTOR_SCALE = types.SimpleNamespace(NAME='rotor_scale', KEYS=('uav', 'factor'), parse=_parse,
                                     pack=_pack, apply=apply_rotor_scale, describe=_describe)
+
+
+def register_parts() -> None:
+    """Called by a scenario's `parts:` naming this file (tests/ros/test_event_part.py's runs),
+    not by pytest's import, so this test's process registers the kind only for its block."""
+    event_kinds.register(ROTOR_SCALE)
+
 
 G = 9.81
 EVENT_TIME, END = 2.5, 3.0  # [s]

@@ -5,8 +5,11 @@ headless loop, a sweep's workers) imports them before it validates the rest: a p
 one file flies headless and through ROS with no other file changed (docs/extending.md).
 
 An entry is a path to a `.py` file, relative to the scenario file's folder (or absolute). A
-file is imported once per process: a file already imported under another name (a test module
-pytest collected) is not imported again, so its registrations happen once.
+file is imported once per process, under its stem as pytest names a test module (numba's cache
+of a part's compiled function names its module, so every process must import it under one
+name), and its `register_parts()`, if it has one, called once: a file that registers at import
+registers wherever it is imported; a test file that must leave pytest's process as it was puts
+its registrations in `register_parts()`, which only a scenario's `parts:` calls.
 """
 from __future__ import annotations
 
@@ -15,6 +18,9 @@ import importlib.util
 import sys
 from pathlib import Path
 from types import ModuleType
+
+
+_registered: set[Path] = set()  # the files whose register_parts() this process called
 
 
 class PartsError(ValueError):
@@ -42,12 +48,21 @@ def _loaded(path: Path) -> ModuleType | None:
 
 
 def import_part(path: Path) -> ModuleType:
-    """Import the part file `path` (absolute) once in this process; returns its module."""
+    """Import the part file `path` (absolute) once in this process and call its
+    `register_parts()` once; returns its module."""
     module = _loaded(path)
-    if module is not None:
-        return module
-    digest = hashlib.sha256(str(path).encode()).hexdigest()[:12]
-    name = f'multilift_parts_{path.stem}_{digest}'
+    if module is None:
+        module = _import(path)
+    if path not in _registered:
+        _registered.add(path)
+        register = getattr(module, 'register_parts', None)
+        if register is not None:
+            register()
+    return module
+
+
+def _import(path: Path) -> ModuleType:
+    name = _module_name(path)
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
@@ -57,6 +72,20 @@ def import_part(path: Path) -> ModuleType:
         del sys.modules[name]
         raise PartsError(f'failed to import ({path}): {type(exc).__name__}: {exc}') from exc
     return module
+
+
+def _module_name(path: Path) -> str:
+    """The file's stem, as pytest names a test module (numba's cache of a compiled function
+    is kept by its file and names its module: every process must import a part under one
+    name), unless another module has that name; then one from the stem and the path."""
+    try:
+        taken = path.stem in sys.modules or importlib.util.find_spec(path.stem) is not None
+    except (ImportError, ValueError):
+        taken = True
+    if path.stem.isidentifier() and not taken:
+        return path.stem
+    digest = hashlib.sha256(str(path).encode()).hexdigest()[:12]
+    return f'multilift_parts_{path.stem}_{digest}'
 
 
 def import_parts(paths: tuple[str, ...]) -> None:

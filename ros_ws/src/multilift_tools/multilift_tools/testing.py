@@ -7,8 +7,8 @@ the test's environment (so `rclpy.init()` in the test and every process it start
 MULTILIFT_TEST_DOMAIN if set, else one drawn from the pid in 70-99.
 
 `multilift_run`: starts `multilift run SCENARIO [--external ...] [--bag ...]` in that domain and
-gives a `ScenarioRun` (`.wait()`, `.output()`, `.bag`); every run still going is stopped at the
-end of the test (the bag is closed)::
+gives a `ScenarioRun` (`.wait()`, `.output()`, `.bag`; `headless=True`: `run --headless`, no
+ROS graph); every run still going is stopped at the end of the test (the bag is closed)::
 
     def test_my_leader(multilift_run, tmp_path):
         run = multilift_run('single_lift', external='uav1', duration=2.0,
@@ -92,7 +92,8 @@ def multilift_run(multilift_domain, tmp_path):
 
     def start(scenario: str, external: str | list[str] | None = None,
               duration: float | None = None, bag: str | Path | None = None,
-              realtime: bool = False, startup_timeout: float | None = None) -> ScenarioRun:
+              realtime: bool = False, startup_timeout: float | None = None,
+              headless: bool = False) -> ScenarioRun:
         argv = [sys.executable, '-m', 'multilift_tools.cli', 'run', str(scenario)]
         if external:
             argv += ['--external', external if isinstance(external, str) else ','.join(external)]
@@ -102,6 +103,8 @@ def multilift_run(multilift_domain, tmp_path):
             argv += ['--bag', str(bag)]
         if realtime:
             argv.append('--realtime')
+        if headless:
+            argv.append('--headless')
         if startup_timeout is not None:
             argv += ['--startup-timeout', str(startup_timeout)]
         env = dict(os.environ, PYTHONUNBUFFERED='1')

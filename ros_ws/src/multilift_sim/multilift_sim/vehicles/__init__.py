@@ -12,14 +12,23 @@ A frame (a module, or any object, with these names) declares:
 """
 from __future__ import annotations
 
-import contextlib
-from typing import Any, Iterator
+from typing import Any
 
+from multilift_sim.registry import Registry
 from multilift_sim.vehicles import planar
 
-REQUIRED = ('NAME', 'SPINS', 'rotor_positions')
-VEHICLE_FRAMES: dict[str, Any] = {frame.NAME: frame for frame in planar.FRAMES}
+
+def _check_spins(frame: Any) -> None:
+    if len(frame.SPINS) < 4 or any(s not in (1, -1) for s in frame.SPINS):
+        raise ValueError(f'vehicle frame {frame.NAME!r}: SPINS {frame.SPINS!r} must be at least '
+                         f'4 entries of +1 or -1')
+
+
+VEHICLE_FRAMES = Registry('vehicle frame', ('NAME', 'SPINS', 'rotor_positions'), planar.FRAMES,
+                          check=_check_spins)
 SHIPPED = tuple(VEHICLE_FRAMES)
+register, unregister, registered = (VEHICLE_FRAMES.register, VEHICLE_FRAMES.unregister,
+                                    VEHICLE_FRAMES.registered)
 
 
 def frame_types() -> tuple[str, ...]:
@@ -34,33 +43,3 @@ def frame(name: str) -> Any:
     except KeyError:
         raise ValueError(f'unknown frame_type {name!r}; valid frame types are '
                          f'{", ".join(VEHICLE_FRAMES)}') from None
-
-
-def register(new: Any) -> None:
-    """Add a vehicle frame (an object with REQUIRED's names)."""
-    missing = [name for name in REQUIRED if not hasattr(new, name)]
-    if missing:
-        raise ValueError(f'vehicle frame {new!r} lacks {", ".join(missing)}')
-    if new.NAME in VEHICLE_FRAMES:
-        raise ValueError(f'vehicle frame {new.NAME!r} is registered already')
-    if len(new.SPINS) < 4 or any(s not in (1, -1) for s in new.SPINS):
-        raise ValueError(f'vehicle frame {new.NAME!r}: SPINS {new.SPINS!r} must be at least '
-                         f'4 entries of +1 or -1')
-    VEHICLE_FRAMES[new.NAME] = new
-
-
-def unregister(name: str) -> None:
-    """Remove frame `name` (one `register` added)."""
-    if name in SHIPPED:
-        raise ValueError(f'vehicle frame {name!r} ships with multilift_sim')
-    del VEHICLE_FRAMES[name]
-
-
-@contextlib.contextmanager
-def registered(new: Any) -> Iterator[Any]:
-    """`new` registered for the block (a test's toy frame)."""
-    register(new)
-    try:
-        yield new
-    finally:
-        unregister(new.NAME)

@@ -16,39 +16,20 @@ A model (a module, or any object, with these names) declares:
 """
 from __future__ import annotations
 
-import contextlib
 from types import ModuleType
-from typing import Any, Iterator
+from typing import Any
 
+from multilift_sim.registry import Registry
 from multilift_sim.wind import turbulence
 
-REQUIRED = ('NAME', 'UNITS', 'parse', 'series')
+
+def _check_name(model: Any) -> None:
+    if model.NAME == 'velocity':  # the steady wind's key
+        raise ValueError("wind model 'velocity' is wind.velocity's key")
+
+
 SHIPPED: tuple[ModuleType, ...] = (turbulence,)
-WIND_MODELS: dict[str, Any] = {model.NAME: model for model in SHIPPED}
-
-
-def register(model: Any) -> None:
-    """Add a wind model (an object with REQUIRED's names)."""
-    missing = [name for name in REQUIRED if not hasattr(model, name)]
-    if missing:
-        raise ValueError(f'wind model {model!r} lacks {", ".join(missing)}')
-    if model.NAME in WIND_MODELS or model.NAME == 'velocity':
-        raise ValueError(f'wind model {model.NAME!r} is registered already')
-    WIND_MODELS[model.NAME] = model
-
-
-def unregister(name: str) -> None:
-    """Remove model `name` (one `register` added)."""
-    if any(model.NAME == name for model in SHIPPED):
-        raise ValueError(f'wind model {name!r} ships with multilift_sim')
-    del WIND_MODELS[name]
-
-
-@contextlib.contextmanager
-def registered(model: Any) -> Iterator[Any]:
-    """`model` registered for the block (a test's toy model)."""
-    register(model)
-    try:
-        yield model
-    finally:
-        unregister(model.NAME)
+WIND_MODELS = Registry('wind model', ('NAME', 'UNITS', 'parse', 'series'), SHIPPED,
+                       check=_check_name)
+register, unregister, registered = (WIND_MODELS.register, WIND_MODELS.unregister,
+                                    WIND_MODELS.registered)

@@ -16,18 +16,31 @@ from multilift_control.engine import Engine
 from multilift_control.headless import run_headless
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
-from multilift_sim.physics.layout import MEASURED_COLUMNS, SENSED_BLOCKS, SENSED_QUANTITIES
-from multilift_sim.physics.sensors import sensed_states
-from multilift_sim.sensors import sensor_errors
+from multilift_sim.physics.layout import MEASURED_COLUMNS
+from multilift_sim.sensors import measured_state
+from multilift_sim.sensors.arrays import sensor_samples
+from multilift_sim.sensors.measured_state import BLOCKS, QUANTITIES
 from multilift_sim.simulation import FormationSimulator
 from multilift_sim.topics import scenario_topics
 from multilift_tools.headless_bag import _record_per_object, record_headless
 
 
-def _config(**keys) -> scenario_io.SensorConfig:
-    defaults = dict(noise=(0.0,) * 4, bias=(0.0,) * 4, rate=100.0, latency_ticks=0,
-                    dropout=0.0, seed=0)
-    return scenario_io.SensorConfig(**{**defaults, **keys})
+def _config(rate: float = 100.0, seed: int = 0, **keys) -> scenario_io.SensorConfig:
+    defaults = dict(noise=(0.0,) * 4, bias=(0.0,) * 4, latency_ticks=0, dropout=0.0)
+    settings = measured_state.MeasuredStateSettings(**{**defaults, **keys})
+    return scenario_io.SensorConfig(model=measured_state.NAME, rate=rate, seed=seed,
+                                    settings=settings)
+
+
+def sensor_errors(config: scenario_io.SensorConfig, n_uavs: int, tick_count: int,
+                  control_rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """(errors (S, n, MEASURED_COLUMNS), delivered (S, n)) of a run's samples, drawn as a run
+    draws them (sensors.arrays: numpy.random.default_rng(seed))."""
+    every = config.every(control_rate)
+    return measured_state.sample_errors(config.settings, n_uavs,
+                                        sensor_samples(tick_count, every),
+                                        every / control_rate,
+                                        np.random.default_rng(config.seed))
 
 
 def _with_sensors(name: str, duration: float, sensors: dict) -> scenario_io.Scenario:
@@ -41,7 +54,7 @@ def test_white_noise_has_the_configured_deviation_per_quantity():
     sigmas = (0.02, 0.05, 0.003, 0.01)
     errors, delivered = sensor_errors(_config(noise=sigmas, seed=4), 3, 20_000, 100.0)
     assert errors.shape == (20_001, 3, MEASURED_COLUMNS) and delivered.all()
-    for block, sigma in zip(SENSED_BLOCKS, sigmas):
+    for block, sigma in zip(BLOCKS, sigmas):
         values = errors[:, :, block:block + 3].ravel()  # 180,003 draws
         # the sample deviation within 1 % (its own standard error is 0.17 %), the mean ~0
         assert abs(values.std() / sigma - 1.0) < 0.01
@@ -99,8 +112,9 @@ def _oracle(exact: np.ndarray, errors: np.ndarray, delivered: np.ndarray, every:
 
 @pytest.mark.parametrize('every,latency', [(1, 0), (1, 3), (4, 0), (3, 5)])
 def test_delivery_follows_rate_latency_and_dropouts(every, latency):
-    """Both runs of sensed_states (compiled and its source) against the oracle above, tick by
-    tick, on exact states that change every tick; calling twice a tick changes nothing."""
+    """Both runs of the model's `measure` (compiled and its source), UAV by UAV, against the
+    oracle above, tick by tick, on exact states that change every tick; calling twice a tick
+    changes nothing."""
     rng = np.random.default_rng(1)
     ticks, n = 60, 2
     exact = rng.standard_normal((ticks, n, MEASURED_COLUMNS))
@@ -109,14 +123,19 @@ def test_delivery_follows_rate_latency_and_dropouts(every, latency):
     delivered = rng.random((samples, n)) > 0.3
     delivered[0] = False  # the first sample arrives anyway
     expected = _oracle(exact, errors, delivered, every, latency)
-    for function in (sensed_states, kernels.uncompiled(sensed_states)):
-        history = np.zeros((latency + 1, n, MEASURED_COLUMNS))
-        seen = np.full((n, MEASURED_COLUMNS), math.nan)
+    settings = _config(latency_ticks=latency).settings
+    constants = measured_state.constants(settings, every)
+    draws = np.empty((n, samples, measured_state.DRAW_COLUMNS))
+    draws[:, :, measured_state.DRAW_ERROR:MEASURED_COLUMNS] = errors.transpose(1, 0, 2)
+    draws[:, :, measured_state.DRAW_DELIVERED] = delivered.T
+    for function in (measured_state.measure, kernels.uncompiled(measured_state.measure)):
+        memory = np.repeat(measured_state.memory(settings)[np.newaxis], n, axis=0)
         for k in range(ticks):
             for _ in range(2):
-                states = exact[k].copy()
-                function(states, k, errors, delivered, every, latency, history, seen)
-                assert np.array_equal(states, expected[k]), (k, function)
+                for i in range(n):
+                    received = np.full(MEASURED_COLUMNS, -1.0)
+                    function(constants, draws[i], memory[i], k, exact[k, i].copy(), received)
+                    assert np.array_equal(received, expected[k, i]), (k, i, function)
 
 
 def test_the_controllers_see_the_state_latency_ticks_late():
@@ -151,9 +170,10 @@ def test_bad_sensors_name_key_and_rule(sensors, message):
 
 
 def test_every_quantity_has_its_keys_and_silent_sensors_change_nothing():
-    keys = {f'{q}_{kind}': 0.0 for q in SENSED_QUANTITIES for kind in ('noise', 'bias')}
+    keys = {f'{q}_{kind}': 0.0 for q in QUANTITIES for kind in ('noise', 'bias')}
     quiet = _with_sensors('twin_lift', 1.0, dict(keys, seed=3))
-    assert quiet.sensors.noise == (0.0,) * 4 and quiet.sensors.every(100.0) == 1
+    assert quiet.sensors.settings.noise == (0.0,) * 4 and quiet.sensors.every(100.0) == 1
+    assert quiet.sensors.model == 'measured_state'  # the default model
     plain = scenario_io.load('twin_lift').with_duration(1.0)
     assert plain.sensors is None
     a, b = Engine(quiet), Engine(plain)

@@ -39,18 +39,12 @@ def measure_offset(constants, draws, memory, tick, truth, received):
         received[MEASURED_POSITION + j] = truth[MEASURED_POSITION + j] + constants[OFFSET + j]
 
 
-def _parse(d):
-    return d.vector('offset', (0.0, 0.0, 0.0))
-
-
-def _constants(offset, every):
-    return np.array(offset)
-
-
 POSITION_OFFSET = types.SimpleNamespace(
-    NAME='position_offset', KEYS={'offset': 'm'}, parse=_parse, constants=_constants,
-    memory=lambda offset: np.zeros(0),
-    draws=lambda offset, n_uavs, samples, dt, rng: np.zeros((n_uavs, samples, 0)),
+    NAME='position_offset', KEYS={'offset': 'm'},
+    parse=lambda d: d.vector('offset', (0.0, 0.0, 0.0)),
+    constants=lambda offset, every: np.array(offset),
+    memory=lambda offset: np.zeros(0),           # it keeps nothing
+    draws=lambda offset, n_uavs, samples, dt, rng: np.zeros((n_uavs, samples, 0)),  # none
     measure=measure_offset)
 
 

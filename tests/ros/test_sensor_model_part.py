@@ -74,13 +74,17 @@ def test_a_model_defined_in_a_test_registers_compiles_and_flies_headless():
     from multilift_control.headless import fly, run_headless
     from multilift_sim import scenario as scenario_io
     from multilift_sim import sensors
+    from multilift_sim.part_plugins import import_parts
 
+    # this file's model as the run's processes import it (MULTILIFT_PARTS): the same module
+    # name, so a ROS run loads the tick compiled here from numba's cache
+    toy = import_parts(__file__).POSITION_OFFSET
     offset = {'model': 'position_offset', 'offset': list(D)}
     with pytest.raises(scenario_io.ScenarioError,
-                       match='sensors.model: position_offset must be one of measured_state'):
+                       match="sensors.model: 'position_offset' must be one of measured_state"):
         scenario_io.loads(_hover(1.0, offset))  # not a model before it registers
     shifted = fly(scenario_io.loads(_hover(SETTLED, start=-np.array(D))))
-    with sensors.registered(POSITION_OFFSET):
+    with sensors.registered(toy):
         with pytest.raises(scenario_io.ScenarioError, match=r'sensors\.offset: \[0\.1, 0\.2\] '
                            'must be a list of 3 numbers'):
             scenario_io.loads(_hover(1.0, dict(offset, offset=[0.1, 0.2])))

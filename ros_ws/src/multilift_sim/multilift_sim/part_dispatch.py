@@ -30,6 +30,7 @@ from types import ModuleType
 from typing import Any, Callable
 
 from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
+from multilift_sim.kernels import kernel_modules
 
 BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
 
@@ -53,12 +54,11 @@ class GeneratedDispatcher:
         return [_python(getattr(part, self.step)) for part in self.parts().values()]
 
     def digest(self) -> str:
-        """A digest of the registered parts: their names, order and sources (each step's name
-        and file; not its module's name, which a file loaded as a plugin changes:
-        `part_plugins`)."""
+        """A digest of the registered parts: their names, order and sources (each step's
+        module, name and file)."""
         digest = hashlib.sha256()
         for name, python in zip(self.parts(), self.steps()):
-            digest.update(f'{name}\0{python.__qualname__}\0'.encode())
+            digest.update(f'{name}\0{python.__module__}.{python.__qualname__}\0'.encode())
             digest.update(Path(inspect.getsourcefile(python)).read_bytes())
         return digest.hexdigest()[:16]
 
@@ -125,15 +125,20 @@ def cache_folder() -> Path:
 
 
 def refresh(dispatcher: GeneratedDispatcher) -> None:
-    """After `dispatcher`'s registry changed: numba's cache at its folder, and, once its caller
-    is loaded, the dispatcher regenerated and every loaded compiled function reaching the
-    caller to be compiled anew."""
+    """After `dispatcher`'s registry changed: numba's cache at its folder, the dispatcher
+    regenerated and every compiled function reaching its caller to be compiled anew. Every
+    kernel module is imported first (`kernels.kernel_modules`, of every multilift package:
+    the cache mechanism's, not an import of the layers above), so the functions that do not
+    reach the dispatcher keep the kernels' folder, which scripts/setup filled: a process that
+    registers a part compiles only the callers of its dispatcher, not every law."""
     try:
         from numba.core import config
         from numba.core.dispatcher import Dispatcher
     except ImportError:  # pragma: no cover - the uncompiled run reads the global each time
         config = Dispatcher = None
     if config is not None:
+        for name in kernel_modules():  # each at the kernels' folder before the folder moves
+            importlib.import_module(name)
         config.CACHE_DIR = str(cache_folder())
     module = sys.modules.get(dispatcher.caller_module)
     if module is None:

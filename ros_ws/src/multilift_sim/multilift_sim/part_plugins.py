@@ -4,9 +4,11 @@ separated by os.pathsep; each is imported once per process, a file as the module
 `multilift_parts_<its stem>`, and its `register_parts()` called (which registers its parts:
 `sensors.register`, `events.register`), before the process reads its first scenario
 (`scenario.scenario_of`). `multilift run` passes its environment to the simulator, the
-controllers and the recorder, so they all know the same parts; a part's compiled step is
-identified by its source, not by the module's name (`part_dispatch`), so a process loads what
-another compiled for the same registries from numba's cache."""
+controllers and the recorder, so they all know the same parts. numba's cached code names the
+modules of the functions it links, so a process loads from numba's cache what another compiled
+for the same registries only where the parts come from modules of the same names: a test that
+flies a part of its own file headless and through ROS registers the module `import_parts` gives
+(`multilift_parts_<stem>`), as the run's processes do."""
 from __future__ import annotations
 
 import importlib

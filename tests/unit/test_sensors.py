@@ -241,3 +241,48 @@ def test_a_sweep_can_sample_a_sensor_key_the_scenario_does_not_have():
     exact = campaign.run_one(source, base, [], duration=3.0)
     assert rows[0]['tracking_error_rms'] == exact['tracking_error_rms']
     assert rows[1]['tracking_error_rms'] != exact['tracking_error_rms']
+
+
+def test_the_shipped_model_is_named_in_its_own_module_only():
+    """`nothing else names a model` (issue 31): the shipped model's name as a string in one
+    source file, its module of multilift_sim/sensors/."""
+    import re
+    from pathlib import Path
+
+    from multilift_sim.sensors import SENSOR_MODELS, SHIPPED
+    sources = sorted((Path(__file__).resolve().parents[2] / 'ros_ws' / 'src').rglob('*.py'))
+    for model in SHIPPED:
+        pattern = re.compile(rf"""['"]{model.NAME}['"]""")
+        naming = [p.name for p in sources if pattern.search(p.read_text())]
+        assert naming == [f'{model.NAME}.py'], naming
+        assert SENSOR_MODELS[model.NAME] is model
+
+
+def test_sensors_of_a_formation_run_in_order_each_from_the_truth():
+    """sensed_states with two sensors (K = 2, both measured_state, rows padded to the wider):
+    each reads the true state, not the one before it's output, and the last one's output is
+    what the controllers receive; compiled and uncompiled alike."""
+    from multilift_sim.sensors.arrays import _padded
+    from multilift_sim.sensors.sensing import sensed_states
+
+    rng = np.random.default_rng(3)
+    n, ticks = 2, 12
+    exact = rng.standard_normal((ticks, n, MEASURED_COLUMNS))
+    late, noisy = _config(latency_ticks=2).settings, _config(noise=(0.1,) * 4).settings
+    draws = [measured_state.draws(s, n, ticks, 0.01, np.random.default_rng(k))
+             for k, s in enumerate((late, noisy))]
+    constants = _padded([measured_state.constants(s, 1) for s in (late, noisy)], (0,))
+    memory0 = _padded([np.repeat(measured_state.memory(s)[np.newaxis], n, axis=0)
+                       for s in (late, noisy)], (n, 0))
+    assert memory0.shape == (2, n, measured_state.DELAY_LINE + 3 * MEASURED_COLUMNS)
+    models = np.zeros(2, dtype=np.int64)
+    for function in (sensed_states, kernels.uncompiled(sensed_states)):
+        memory = memory0.copy()
+        for k in range(ticks):
+            states = exact[k].copy()
+            function(models, constants, _padded(draws, (n, 0, 0)), memory, k, states)
+            # the second sensor's: the true state now with its noise (not 2 ticks late)
+            np.testing.assert_array_equal(states, exact[k] + draws[1][:, k, :MEASURED_COLUMNS])
+            # the first one's, held in its memory: the state 2 ticks ago (tick 0's before)
+            held = memory[0, :, measured_state.HELD:measured_state.HELD + MEASURED_COLUMNS]
+            np.testing.assert_array_equal(held, exact[max(k - 2, 0)])

@@ -14,7 +14,8 @@ from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES,  # noqa:
                                            ControlConfig, EventConfig,
                                            FormationConfig, MissionConfig, MissionSegment,
                                            PayloadConfig, Scenario, ScenarioError, SensorConfig,
-                                           SimulationConfig, TurbulenceConfig, UavConfig)
-from multilift_sim.scenario.files import load, loads, resolve, scenario_dir  # noqa: F401
+                                           SimulationConfig, UavConfig)
+from multilift_sim.scenario.files import (anchored, load, loads, resolve,  # noqa: F401
+                                          scenario_dir)
 from multilift_sim.scenario.vehicle import (INERTIA_SOURCES, SEED_INERTIA,  # noqa: F401
                                             VEHICLE_KEYS)

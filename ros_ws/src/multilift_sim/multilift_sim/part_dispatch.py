@@ -126,7 +126,10 @@ def cache_folder() -> Path:
 
 def refresh(dispatcher: GeneratedDispatcher) -> None:
     """After `dispatcher`'s registry changed: numba's cache at its folder, the dispatcher
-    regenerated and every compiled function reaching its caller to be compiled anew. Every
+    regenerated and every compiled function reaching its caller, and each registered part's
+    step but the shipped ones', to be compiled anew there (a test file's step, imported by
+    pytest under one module name and by a run's `parts:` under another, is not loaded from a
+    cache the other filled: numba's cached code names its module). Every
     kernel module is imported first (`kernels.kernel_modules`, of every multilift package:
     the cache mechanism's, not an import of the layers above), so the functions that do not
     reach the dispatcher keep the kernels' folder, which scripts/setup filled: a process that
@@ -143,6 +146,13 @@ def refresh(dispatcher: GeneratedDispatcher) -> None:
     module = sys.modules.get(dispatcher.caller_module)
     if module is None:
         return
+    if Dispatcher is not None:  # a part's own step too: its cached code names its module
+        shipped = {id(getattr(part, dispatcher.step)) for part in dispatcher.shipped()}
+        for part in dispatcher.parts().values():
+            step = getattr(part, dispatcher.step)
+            if isinstance(step, Dispatcher) and id(step) not in shipped:
+                step.enable_caching()
+                step._reset_overloads()
     setattr(module, dispatcher.function, dispatcher.compiled())
     if Dispatcher is not None:
         for function in callers(getattr(module, dispatcher.caller), Dispatcher):

@@ -37,8 +37,9 @@ def wind_series(scenario: Scenario) -> np.ndarray:
     """The unsteady wind [m/s], world, of every control period of the run, (ticks + 1, 3), or
     (0, 3) where the wind is steady: tick k's is held over the period from it, added to the
     steady wind. Each wind model's samples at the ticks (`multilift_sim.wind`: the Dryden
-    turbulence of `wind.turbulence`, a part's) plus what each event that blows air gives over the period (its kind's
-    `unsteady_wind`: a gust's 1-cosine profile averaged over the period, docs/wind.md)."""
+    turbulence of `wind.turbulence`, a part's) plus what each event that blows air gives over
+    the period (its kind's `unsteady_wind`: a gust's 1-cosine profile averaged over the
+    period, docs/wind.md)."""
     sim = scenario.simulation
     blowing = [e for e in scenario.events if moves_air(e.type)]
     if not scenario.wind_models and not blowing:

@@ -17,7 +17,6 @@ from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
 from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_rigid_body_inertia,
                                          solid_inertia)
 from multilift_sim.events import EVENT_KINDS
-from multilift_sim.part_plugins import load_parts
 from multilift_sim.parts import PartsError, import_part, resolve_part
 from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
@@ -34,7 +33,6 @@ from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inerti
 
 
 def scenario_of(data: Any, where: str) -> Scenario:
-    load_parts()  # MULTILIFT_PARTS: parts of other files, registered before any is read
     top = Section(data, '', where)
     parts = _parts(top)  # first: the rest may name what they register
     name = top.text('name')

@@ -9,9 +9,9 @@ velocity [m, m/s] world, ZYX Euler angles [rad], body rates [rad/s] FLU; physics
 MEASURED_*) and the run's seeded random stream, what that UAV's controllers read, at its own
 rate (`rate`, a divisor of the control rate: a sample every `every` control ticks). A model's
 module declares:
-- `NAME`, the scenario's `sensors.model`, and `KEYS`, its keys besides the common `model`,
-  `rate` [Hz] and `seed` (read for every model by `scenario.parse`), each with its unit
-  (`units.unit_of`);
+- `NAME`, the scenario's `sensors.model`, and `UNITS`, its keys besides the common `model`,
+  `rate` [Hz] and `seed` (read for every model by `scenario.parse`), each -> its unit
+  (`units.unit_of`; a key two models share has one unit);
 - `parse(d) -> settings`: its keys read from `d` (the `sensors:` section's
   `scenario.reading.Section`: `d.non_negative`, `d.number`, `d.count`, `d.vector`, `d.fail` for
   a one-line error naming the key) as a frozen object, `scenario.SensorConfig.settings`;
@@ -33,7 +33,8 @@ What it adds to the messages: with any `sensors:` every /uav{i}/measured_odom ca
 controllers received, and the summary's `seeds` the section's `seed` (`topics`,
 `schedules.run_seeds`), whatever the model.
 
-`register` adds one (a test's toy model, at test time: `registered`); the compiled dispatcher
+`register` adds one (a test's toy model, at test time: `registered`; a file a scenario names
+under `parts:`, in every process that reads it: `multilift_sim.parts`); the compiled dispatcher
 follows (`compiled.refresh`).
 """
 from __future__ import annotations
@@ -47,7 +48,7 @@ from multilift_sim.sensors import measured_state
 SHIPPED: tuple[ModuleType, ...] = (measured_state,)
 SENSOR_MODELS: dict[str, ModuleType] = {model.NAME: model for model in SHIPPED}
 DEFAULT_MODEL = measured_state.NAME  # `sensors:` without `model:`
-REQUIRED = ('NAME', 'KEYS', 'parse', 'constants', 'memory', 'draws', 'measure')
+REQUIRED = ('NAME', 'UNITS', 'parse', 'constants', 'memory', 'draws', 'measure')
 COMMON_KEYS = {'model': '', 'rate': 'Hz', 'seed': ''}  # every model's, with their units
 
 
@@ -61,7 +62,7 @@ def key_units() -> dict[str, str]:
     key two models share has one unit)."""
     units = dict(COMMON_KEYS)
     for model in SENSOR_MODELS.values():
-        units.update(model.KEYS)
+        units.update(model.UNITS)
     return units
 
 
@@ -73,7 +74,7 @@ def register(model: ModuleType) -> None:
     if model.NAME in SENSOR_MODELS:
         raise ValueError(f'sensor model {model.NAME!r} is registered already')
     units = key_units()
-    clash = sorted(key for key, unit in model.KEYS.items()
+    clash = sorted(key for key, unit in model.UNITS.items()
                    if key in COMMON_KEYS or units.get(key, unit) != unit)
     if clash:
         raise ValueError(f'sensor model {model.NAME!r}: keys {clash} are common or another '

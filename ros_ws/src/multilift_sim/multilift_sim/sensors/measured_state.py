@@ -32,10 +32,10 @@ NAME = 'measured_state'
 # the measured quantities: each a block of 3 slots of the measured state, with its unit
 QUANTITIES = ('position', 'velocity', 'attitude', 'body_rate')
 BLOCKS = (MEASURED_POSITION, MEASURED_VELOCITY, MEASURED_EULER, MEASURED_BODY_RATES)
-UNITS = ('m', 'm/s', 'rad', 'rad/s')
-KEYS = {**{f'{q}_noise': u for q, u in zip(QUANTITIES, UNITS)},
-        **{f'{q}_bias': f'{u}/sqrt(s)' for q, u in zip(QUANTITIES, UNITS)},
-        'latency_ticks': '', 'dropout': ''}
+QUANTITY_UNITS = ('m', 'm/s', 'rad', 'rad/s')
+UNITS = {**{f'{q}_noise': u for q, u in zip(QUANTITIES, QUANTITY_UNITS)},  # its keys' units
+         **{f'{q}_bias': f'{u}/sqrt(s)' for q, u in zip(QUANTITIES, QUANTITY_UNITS)},
+         'latency_ticks': '', 'dropout': ''}
 
 # -- its constants row (`constants`) ----------------------------------------------------------
 EVERY = 0               # control ticks between two samples

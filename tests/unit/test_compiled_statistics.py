@@ -193,7 +193,8 @@ def test_the_classes_read_their_arrays():
     assert (stats.min_tension, stats.max_tension, stats.max_gust_speed) == (1.5, 4.0, 0.4)
     assert list(stats.as_dict()) == [
         'n_uavs', 'max_abs_constraint', 'max_abs_constraint_rate', 'max_rotor_speed',
-        'saturated_time', 'least_thrust_margin', 'min_tension', 'max_tension', 'simulated_time', 'max_gust_speed',
+        'saturated_time', 'least_thrust_margin', 'min_tension', 'max_tension', 'simulated_time',
+        'max_gust_speed',
         'slack_time', 'max_payload_swing', 'rms_payload_swing', 'swing_from', 'compressed_time']
     tracking = TrackingStatistics()
     for error in (3.0, 4.0):

@@ -1,8 +1,8 @@
 """Dryden turbulence (MIL-F-8785C; MIL-HDBK-1797 §B.4.8.2), the continuous von Karman
 approximation of the military specifications, as a seeded series of wind velocities at the
-control rate (issue 21 item 3): the wind model `wind.turbulence` (multilift_sim.wind's registry). No ROS,
-no numba: the series is drawn once per run, before it flies, and the physics holds each sample
-over its control period (docs/wind.md).
+control rate (issue 21 item 3): the wind model `wind.turbulence` (multilift_sim.wind's
+registry). No ROS, no numba: the series is drawn once per run, before it flies, and the
+physics holds each sample over its control period (docs/wind.md).
 
 With airspeed V (the speed at which the frozen turbulence field passes the formation), length
 scales L and intensities sigma, the one-sided spectra of the three components, over the

@@ -16,18 +16,31 @@ from multilift_control.engine import Engine
 from multilift_control.headless import run_headless
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
-from multilift_sim.physics.layout import MEASURED_COLUMNS, SENSED_BLOCKS, SENSED_QUANTITIES
-from multilift_sim.physics.sensors import sensed_states
-from multilift_sim.sensors import sensor_errors
+from multilift_sim.physics.layout import MEASURED_COLUMNS
+from multilift_sim.sensors import measured_state
+from multilift_sim.sensors.arrays import sensor_samples
+from multilift_sim.sensors.measured_state import BLOCKS, QUANTITIES
 from multilift_sim.simulation import FormationSimulator
 from multilift_sim.topics import scenario_topics
 from multilift_tools.headless_bag import _record_per_object, record_headless
 
 
-def _config(**keys) -> scenario_io.SensorConfig:
-    defaults = dict(noise=(0.0,) * 4, bias=(0.0,) * 4, rate=100.0, latency_ticks=0,
-                    dropout=0.0, seed=0)
-    return scenario_io.SensorConfig(**{**defaults, **keys})
+def _config(rate: float = 100.0, seed: int = 0, **keys) -> scenario_io.SensorConfig:
+    defaults = dict(noise=(0.0,) * 4, bias=(0.0,) * 4, latency_ticks=0, dropout=0.0)
+    settings = measured_state.MeasuredStateSettings(**{**defaults, **keys})
+    return scenario_io.SensorConfig(model=measured_state.NAME, rate=rate, seed=seed,
+                                    settings=settings)
+
+
+def sensor_errors(config: scenario_io.SensorConfig, n_uavs: int, tick_count: int,
+                  control_rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """(errors (S, n, MEASURED_COLUMNS), delivered (S, n)) of a run's samples, drawn as a run
+    draws them (sensors.arrays: numpy.random.default_rng(seed))."""
+    every = config.every(control_rate)
+    return measured_state.sample_errors(config.settings, n_uavs,
+                                        sensor_samples(tick_count, every),
+                                        every / control_rate,
+                                        np.random.default_rng(config.seed))
 
 
 def _with_sensors(name: str, duration: float, sensors: dict) -> scenario_io.Scenario:
@@ -41,7 +54,7 @@ def test_white_noise_has_the_configured_deviation_per_quantity():
     sigmas = (0.02, 0.05, 0.003, 0.01)
     errors, delivered = sensor_errors(_config(noise=sigmas, seed=4), 3, 20_000, 100.0)
     assert errors.shape == (20_001, 3, MEASURED_COLUMNS) and delivered.all()
-    for block, sigma in zip(SENSED_BLOCKS, sigmas):
+    for block, sigma in zip(BLOCKS, sigmas):
         values = errors[:, :, block:block + 3].ravel()  # 180,003 draws
         # the sample deviation within 1 % (its own standard error is 0.17 %), the mean ~0
         assert abs(values.std() / sigma - 1.0) < 0.01
@@ -99,8 +112,9 @@ def _oracle(exact: np.ndarray, errors: np.ndarray, delivered: np.ndarray, every:
 
 @pytest.mark.parametrize('every,latency', [(1, 0), (1, 3), (4, 0), (3, 5)])
 def test_delivery_follows_rate_latency_and_dropouts(every, latency):
-    """Both runs of sensed_states (compiled and its source) against the oracle above, tick by
-    tick, on exact states that change every tick; calling twice a tick changes nothing."""
+    """Both runs of the model's `measure` (compiled and its source), UAV by UAV, against the
+    oracle above, tick by tick, on exact states that change every tick; calling twice a tick
+    changes nothing."""
     rng = np.random.default_rng(1)
     ticks, n = 60, 2
     exact = rng.standard_normal((ticks, n, MEASURED_COLUMNS))
@@ -109,14 +123,19 @@ def test_delivery_follows_rate_latency_and_dropouts(every, latency):
     delivered = rng.random((samples, n)) > 0.3
     delivered[0] = False  # the first sample arrives anyway
     expected = _oracle(exact, errors, delivered, every, latency)
-    for function in (sensed_states, kernels.uncompiled(sensed_states)):
-        history = np.zeros((latency + 1, n, MEASURED_COLUMNS))
-        seen = np.full((n, MEASURED_COLUMNS), math.nan)
+    settings = _config(latency_ticks=latency).settings
+    constants = measured_state.constants(settings, every)
+    draws = np.empty((n, samples, measured_state.DRAW_COLUMNS))
+    draws[:, :, measured_state.DRAW_ERROR:MEASURED_COLUMNS] = errors.transpose(1, 0, 2)
+    draws[:, :, measured_state.DRAW_DELIVERED] = delivered.T
+    for function in (measured_state.measure, kernels.uncompiled(measured_state.measure)):
+        memory = np.repeat(measured_state.memory(settings)[np.newaxis], n, axis=0)
         for k in range(ticks):
             for _ in range(2):
-                states = exact[k].copy()
-                function(states, k, errors, delivered, every, latency, history, seen)
-                assert np.array_equal(states, expected[k]), (k, function)
+                for i in range(n):
+                    received = np.full(MEASURED_COLUMNS, -1.0)
+                    function(constants, draws[i], memory[i], k, exact[k, i].copy(), received)
+                    assert np.array_equal(received, expected[k, i]), (k, i, function)
 
 
 def test_the_controllers_see_the_state_latency_ticks_late():
@@ -151,9 +170,10 @@ def test_bad_sensors_name_key_and_rule(sensors, message):
 
 
 def test_every_quantity_has_its_keys_and_silent_sensors_change_nothing():
-    keys = {f'{q}_{kind}': 0.0 for q in SENSED_QUANTITIES for kind in ('noise', 'bias')}
+    keys = {f'{q}_{kind}': 0.0 for q in QUANTITIES for kind in ('noise', 'bias')}
     quiet = _with_sensors('twin_lift', 1.0, dict(keys, seed=3))
-    assert quiet.sensors.noise == (0.0,) * 4 and quiet.sensors.every(100.0) == 1
+    assert quiet.sensors.settings.noise == (0.0,) * 4 and quiet.sensors.every(100.0) == 1
+    assert quiet.sensors.model == 'measured_state'  # the default model
     plain = scenario_io.load('twin_lift').with_duration(1.0)
     assert plain.sensors is None
     a, b = Engine(quiet), Engine(plain)
@@ -221,3 +241,48 @@ def test_a_sweep_can_sample_a_sensor_key_the_scenario_does_not_have():
     exact = campaign.run_one(source, base, [], duration=3.0)
     assert rows[0]['tracking_error_rms'] == exact['tracking_error_rms']
     assert rows[1]['tracking_error_rms'] != exact['tracking_error_rms']
+
+
+def test_the_shipped_model_is_named_in_its_own_module_only():
+    """`nothing else names a model` (issue 31): the shipped model's name as a string in one
+    source file, its module of multilift_sim/sensors/."""
+    import re
+    from pathlib import Path
+
+    from multilift_sim.sensors import SENSOR_MODELS, SHIPPED
+    sources = sorted((Path(__file__).resolve().parents[2] / 'ros_ws' / 'src').rglob('*.py'))
+    for model in SHIPPED:
+        pattern = re.compile(rf"""['"]{model.NAME}['"]""")
+        naming = [p.name for p in sources if pattern.search(p.read_text())]
+        assert naming == [f'{model.NAME}.py'], naming
+        assert SENSOR_MODELS[model.NAME] is model
+
+
+def test_sensors_of_a_formation_run_in_order_each_from_the_truth():
+    """sensed_states with two sensors (K = 2, both measured_state, rows padded to the wider):
+    each reads the true state, not the one before it's output, and the last one's output is
+    what the controllers receive; compiled and uncompiled alike."""
+    from multilift_sim.sensors.arrays import _padded
+    from multilift_sim.sensors.sensing import sensed_states
+
+    rng = np.random.default_rng(3)
+    n, ticks = 2, 12
+    exact = rng.standard_normal((ticks, n, MEASURED_COLUMNS))
+    late, noisy = _config(latency_ticks=2).settings, _config(noise=(0.1,) * 4).settings
+    draws = [measured_state.draws(s, n, ticks, 0.01, np.random.default_rng(k))
+             for k, s in enumerate((late, noisy))]
+    constants = _padded([measured_state.constants(s, 1) for s in (late, noisy)], (0,))
+    memory0 = _padded([np.repeat(measured_state.memory(s)[np.newaxis], n, axis=0)
+                       for s in (late, noisy)], (n, 0))
+    assert memory0.shape == (2, n, measured_state.DELAY_LINE + 3 * MEASURED_COLUMNS)
+    models = np.zeros(2, dtype=np.int64)
+    for function in (sensed_states, kernels.uncompiled(sensed_states)):
+        memory = memory0.copy()
+        for k in range(ticks):
+            states = exact[k].copy()
+            function(models, constants, _padded(draws, (n, 0, 0)), memory, k, states)
+            # the second sensor's: the true state now with its noise (not 2 ticks late)
+            np.testing.assert_array_equal(states, exact[k] + draws[1][:, k, :MEASURED_COLUMNS])
+            # the first one's, held in its memory: the state 2 ticks ago (tick 0's before)
+            held = memory[0, :, measured_state.HELD:measured_state.HELD + MEASURED_COLUMNS]
+            np.testing.assert_array_equal(held, exact[max(k - 2, 0)])

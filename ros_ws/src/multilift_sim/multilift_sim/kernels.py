@@ -28,18 +28,32 @@ from typing import Any, Callable
 # the subpackages of numba kernels, in any multilift_* package (physics and statistics here,
 # the laws and the engine's tick above): numba compiles a kernel together with the kernels it
 # calls from other files, but checks a cached kernel against its own file only
-KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine', 'events')
+KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine', 'events', 'sensors')
 CACHE_ROOT = (Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache')
               / 'multilift' / 'numba')
+
+
+def _packages() -> dict[str, Path]:
+    """The first multilift_* package of each name on sys.path (found, not imported)."""
+    packages: dict[str, Path] = {}
+    for entry in sys.path:
+        for init in Path(entry or '.').glob('multilift_*/__init__.py'):
+            packages.setdefault(init.parent.name, init.parent)
+    return packages
+
+
+def kernel_modules() -> list[str]:
+    """The names of every module of the kernels' subpackages (KERNEL_FOLDERS of every
+    multilift_* package), found, not imported."""
+    return [f'{name}.{folder}.{path.stem}' for name, package in sorted(_packages().items())
+            for folder in KERNEL_FOLDERS for path in sorted((package / folder).glob('*.py'))
+            if path.stem != '__init__']
 
 
 def _sources_digest() -> str:
     """A digest of the kernels' sources: every KERNEL_FOLDERS subpackage of the first
     multilift_* package of each name on sys.path (found, not imported)."""
-    packages: dict[str, Path] = {}
-    for entry in sys.path:
-        for init in Path(entry or '.').glob('multilift_*/__init__.py'):
-            packages.setdefault(init.parent.name, init.parent)
+    packages = _packages()
     digest = hashlib.sha256()
     for name in sorted(packages):
         for folder in KERNEL_FOLDERS:

@@ -1,21 +1,19 @@
 """What a run schedules or draws before it flies, from its scenario (and its seeds): its events
 as rows at their ticks (`event_array`, physics.layout EVENT_*), the unsteady wind of every
-control period (`wind_series`: Dryden turbulence and gust events, docs/wind.md), its sensors'
-errors and delivery (`sensor_arrays`, docs/sensors.md), and how a summary records them
-(`event_records`, `run_seeds`). The engine and `FormationSimulator` both build their arrays
-here, so both paths fly the same schedule."""
+control period (`wind_series`: Dryden turbulence and gust events, docs/wind.md), and how a
+summary records them (`event_records`, `run_seeds`); its sensors' draws: `sensors.arrays`
+(docs/sensors.md). The engine and `FormationSimulator` both build their arrays here, so both
+paths fly the same schedule."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from multilift_sim.events import EVENT_KINDS, kind_index, moves_air
 from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_KIND, EVENT_ROTOR, EVENT_TICK,
-                                          EVENT_TIME, EVENT_UAV, MEASURED_COLUMNS)
+                                          EVENT_TIME, EVENT_UAV)
 from multilift_sim.scenario import Scenario
-from multilift_sim.sensors import sensor_errors
 from multilift_sim.wind import WIND_MODELS
 from multilift_sim.wire.msgvalues import formation_event
 
@@ -54,39 +52,6 @@ def wind_series(scenario: Scenario) -> np.ndarray:
     for event in blowing:
         series += EVENT_KINDS[event.type].unsteady_wind(event, starts, 1.0 / sim.control_rate)
     return series
-
-
-@dataclass(frozen=True)
-class SensorArrays:
-    """A run's sensors as `physics.sensors.sensed_states` reads them (`sensors:`): every
-    sample's errors and arrivals (`sensors.sensor_errors`), ticks between samples and from a
-    sample to its arrival. Without sensors, no samples."""
-    errors: np.ndarray       # (S, n, MEASURED_COLUMNS) [the slots' units]
-    delivered: np.ndarray    # (S, n) bool
-    every: int               # control ticks between two samples
-    latency: int             # control ticks from a sample to its arrival
-
-    @property
-    def on(self) -> bool:
-        return len(self.errors) > 0
-
-    def memory(self) -> tuple[np.ndarray, np.ndarray]:
-        """Fresh (history (latency + 1, n, MEASURED_COLUMNS), seen (n, MEASURED_COLUMNS):
-        NaN, nothing received yet) for a run's start."""
-        n = self.errors.shape[1]
-        return (np.zeros((self.latency + 1, n, MEASURED_COLUMNS)),
-                np.full((n, MEASURED_COLUMNS), math.nan))
-
-
-def sensor_arrays(scenario: Scenario) -> SensorArrays:
-    """The scenario's `sensors:` as arrays (none without them)."""
-    config, sim, n = scenario.sensors, scenario.simulation, scenario.n_uavs
-    if config is None:
-        return SensorArrays(np.zeros((0, n, MEASURED_COLUMNS)), np.zeros((0, n), dtype=bool),
-                            1, 0)
-    errors, delivered = sensor_errors(config, n, sim.tick_count, sim.control_rate)
-    return SensorArrays(errors, delivered, config.every(sim.control_rate),
-                        config.latency_ticks)
 
 
 def run_seeds(scenario: Scenario) -> dict[str, int]:

@@ -56,7 +56,7 @@ class Snapshot:
     payload_velocity: np.ndarray  # world [m/s]
     odometry: np.ndarray  # every UAV's row (n, ODOMETRY_COLUMNS), physics.layout ODOMETRY_*
     # what the controllers receive of every UAV (n, MEASURED_COLUMNS): the odometry's
-    # MEASURED_* slots, or with `sensors:` their measurement (physics.sensors)
+    # MEASURED_* slots, or with `sensors:` their measurement (multilift_sim.sensors)
     measured: np.ndarray
     # a rigid payload's (orientation (x, y, z, w), body rates [rad/s], R_p (3, 3) payload frame
     # -> world); None for a point payload

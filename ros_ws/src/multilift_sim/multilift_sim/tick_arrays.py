@@ -19,7 +19,8 @@ from multilift_sim.formulations import Formulation, make_formulation
 from multilift_sim.physics.layout import (STATUS_ATTITUDE, STATUS_NOT_FINITE,
                                           STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
 from multilift_sim.scenario import Scenario
-from multilift_sim.schedules import event_array, sensor_arrays, wind_series
+from multilift_sim.schedules import event_array, wind_series
+from multilift_sim.sensors.arrays import sensor_arrays
 from multilift_sim.start import cable_reach, initial_state, swing_sampling
 from multilift_sim.statistics import RunStatistics
 from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
@@ -40,11 +41,10 @@ class PhysicsArrays(NamedTuple):
     events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
     wind_series: np.ndarray       # (B, ticks + 1 or 0, 3): the unsteady wind by tick [m/s]
     state_size: np.ndarray        # (B,) int: the state's length (a rigid payload adds its attitude)
-    # what the controllers receive (`sensors:`; schedules.SensorArrays, physics.sensors)
-    sensor_errors: np.ndarray     # (B, S or 0, n, MEASURED_COLUMNS): each sample's error
-    sensor_delivered: np.ndarray  # (B, S or 0, n) bool: whether the sample arrives
-    sensor_every: np.ndarray      # (B,) int: control ticks between two samples
-    sensor_latency: np.ndarray    # (B,) int: control ticks from a sample to its arrival
+    # what the controllers receive (`sensors:`; K sensors, 0: none; sensors.arrays)
+    sensor_models: np.ndarray     # (B, K) int: each sensor's model (index in SENSOR_MODELS)
+    sensor_constants: np.ndarray  # (B, K, C): each one's constants row (its model's slots)
+    sensor_draws: np.ndarray      # (B, K, n, S, D): every sample's draws, by UAV
     # time and Algorithm 1's tolerances
     physics_dt: np.ndarray        # (B,) [s]
     physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
@@ -73,8 +73,7 @@ class PhysicsMemory(NamedTuple):
     g: np.ndarray                 # (B, n): g at the current tick [m^2]
     g_dot: np.ndarray             # (B, n): g_dot at the current tick [m^2/s]
     gust: np.ndarray              # (B, 3): the air velocity at the payload [m/s], world
-    sensor_history: np.ndarray    # (B, latency + 1, n, MEASURED_COLUMNS): the last exact states
-    sensor_seen: np.ndarray       # (B, n, MEASURED_COLUMNS): what the controllers hold (NaN: none)
+    sensor_memory: np.ndarray     # (B, K, n, M): each sensor's memory of each UAV
     run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
 
 
@@ -89,7 +88,6 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
                                  scenario.cable_model)
     uavs, gusts, formation, allocation, actuators = model.physics_constants()
     sensors = sensor_arrays(scenario)
-    sensor_history, sensor_seen = sensors.memory()
     state = initial_state(scenario)
     rotors = allocation.shape[::2]  # (n, the largest rotor count)
     arrays = dict(
@@ -98,8 +96,8 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
         slack=scenario.cable_model == 'slack', events=event_array(scenario),
         wind_series=wind_series(scenario), state_size=state.size,
-        sensor_errors=sensors.errors, sensor_delivered=sensors.delivered,
-        sensor_every=sensors.every, sensor_latency=sensors.latency,
+        sensor_models=sensors.models, sensor_constants=sensors.constants,
+        sensor_draws=sensors.draws,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),
@@ -110,7 +108,7 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         silent_until=np.zeros(n, dtype=np.int64), held=np.full(rotors, math.nan),
         held_saturated=np.zeros(rotors, dtype=bool), tick=0, status=STATUS_RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n), gust=np.zeros(3),
-        sensor_history=sensor_history, sensor_seen=sensor_seen, run=RunStatistics(n).run)
+        sensor_memory=sensors.memory, run=RunStatistics(n).run)
     return arrays, memory
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import re
 
+from multilift_sim.sensors import key_units
 from multilift_sim.wind import WIND_MODELS
 
 NO_UNIT = ''
@@ -57,8 +58,6 @@ VEHICLE_UNITS: dict[str, str] = {
 GAINS = {'position_gains.kp': '1/s^2', 'position_gains.kd': '1/s', 'position_gains.ki': '1/s^3',
          'attitude_gains.kp': '1/s^2', 'attitude_gains.kd': '1/s'}
 
-SENSED = {'position': 'm', 'velocity': 'm/s', 'attitude': 'rad', 'body_rate': 'rad/s'}
-
 # scenario keys (the YAML's, `scenario.parse`), list indices as []
 SCENARIO_UNITS: dict[str, str] = {
     # lists of mappings set whole (`--set gusts=[]`): no one unit
@@ -81,10 +80,6 @@ SCENARIO_UNITS: dict[str, str] = {
     'gusts[].center': 'm', 'gusts[].direction': NO_UNIT, 'gusts[].gradient_distance': 'm',
     'gusts[].reference_speed': 'm/s',
     'wind.velocity': 'm/s',  # a wind model's keys: its UNITS (multilift_sim.wind)
-    **{f'sensors.{q}_noise': u for q, u in SENSED.items()},
-    **{f'sensors.{q}_bias': f'{u}/sqrt(s)' for q, u in SENSED.items()},
-    'sensors.rate': 'Hz', 'sensors.latency_ticks': NO_UNIT, 'sensors.dropout': NO_UNIT,
-    'sensors.seed': NO_UNIT,
     'formation.n': NO_UNIT, 'formation.geometry': NO_UNIT, 'formation.offsets': 'm',
     'formation.distance': 'm', 'formation.half_angle_deg': 'deg', 'formation.alpha_vc': '1/s',
     'formation.beta_vc': '1/s',
@@ -117,6 +112,9 @@ def unit_of(name: str) -> str:
     key = _INDEX.sub('[]', name)
     if key in UNITS:
         return UNITS[key]
+    section, _, sensor_key = key.partition('.')
+    if section == 'sensors' and sensor_key in key_units():  # the registered models' keys
+        return key_units()[sensor_key]
     if key.endswith('[]') and key[:-2] in UNITS:    # one component of a vector key
         return UNITS[key[:-2]]
     model = _WIND_KEY.match(key)

@@ -10,7 +10,8 @@ named (numba freezes these module-level integers into the compiled code).
 - a gust's row (GUST_*, seed Eq. 2.55);
 - the formation's scalars (FORMATION_*);
 - the scratch of a solve per cable (CABLE_*) and of an RK4 step (WORK_*);
-- a UAV's measured state (MEASURED_*; the sensors' quantities SENSED_*) and its odometry row
+- a UAV's measured state (MEASURED_*: what a sensor model measures, multilift_sim.sensors) and
+  its odometry row
   (ODOMETRY_*: the measured state, then its attitude and body-frame velocity as the messages
   carry them).
 """
@@ -151,13 +152,6 @@ MEASURED_VELOCITY = 3       # r_i_dot [m/s], world (3)
 MEASURED_EULER = 6          # eta_i = (roll, pitch, yaw) [rad] (3)
 MEASURED_BODY_RATES = 9     # omega_i = W(eta_i) eta_i_dot [rad/s], body FLU (3)
 MEASURED_COLUMNS = 12
-
-# -- the sensors' measured quantities (`sensors:`, issue 21; physics.sensors): each a block of 3
-# of the measured state, the one registry, whose names scenario validation reads
-# (`sensors.{name}_noise`, `sensors.{name}_bias`) and whose units the docs give ----------------
-SENSED_QUANTITIES = ('position', 'velocity', 'attitude', 'body_rate')
-SENSED_BLOCKS = (MEASURED_POSITION, MEASURED_VELOCITY, MEASURED_EULER, MEASURED_BODY_RATES)
-SENSED_UNITS = ('m', 'm/s', 'rad', 'rad/s')
 
 # -- a UAV's odometry: its measured state (the MEASURED_* slots), then the rest of what its
 # messages carry (/formation/snapshot, /uav{i}/odom, /tf), one row of (n, ODOMETRY_COLUMNS) ---

@@ -25,7 +25,7 @@ from multilift_sim.physics.layout import (CABLE_COLUMNS, EULER, FORMATION_WIND,
                                           WRENCH_COLUMNS)
 from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
 from multilift_sim.physics.measurement import measured_states
-from multilift_sim.physics.sensors import sensed_states
+from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
                                                    run_add_thrust_margin,
                                                    run_add_gust_speed, run_add_slack,
@@ -157,14 +157,13 @@ def start(a, m, which):
 @jit
 def measure(a, m, b, states):
     """What formation b's controllers receive of its UAVs at its current tick, into states
-    (n, MEASURED_COLUMNS): the measured states (seed Eq. 2.7), with `sensors:` as its sensors
-    deliver them (`physics.sensors.sensed_states`; the same result however often it is
+    (n, MEASURED_COLUMNS): the measured states (seed Eq. 2.7), with `sensors:` as its sensor
+    models deliver them (`sensors.sensing.sensed_states`; the same result however often it is
     called at one tick)."""
     measured_states(m.state[b], states.shape[0], states)
-    if a.sensor_errors.shape[1]:
-        sensed_states(states, m.tick[b], a.sensor_errors[b], a.sensor_delivered[b],
-                      a.sensor_every[b], a.sensor_latency[b], m.sensor_history[b],
-                      m.sensor_seen[b])
+    if a.sensor_models.shape[1]:
+        sensed_states(a.sensor_models[b], a.sensor_constants[b], a.sensor_draws[b],
+                      m.sensor_memory[b], m.tick[b], states)
 
 
 @jit

@@ -151,15 +151,12 @@ class EventConfig:
 
 @dataclass(frozen=True)
 class SensorConfig:
-    """What the controllers receive of each UAV (`sensors:`, multilift_sim.sensors,
-    docs/sensors.md): per quantity of SENSED_QUANTITIES (position [m], velocity [m/s],
-    attitude [rad], body_rate [rad/s]) its white noise and bias random walk."""
-    noise: tuple[float, ...]         # standard deviation of the white noise [unit]
-    bias: tuple[float, ...]          # intensity of the bias random walk [unit / sqrt(s)]
+    """What the controllers receive of each UAV (`sensors:`, docs/sensors.md): a sensor model
+    of multilift_sim.sensors.SENSOR_MODELS with its keys."""
+    model: str                       # its name in SENSOR_MODELS (`sensors.model`)
     rate: float                      # samples per second [Hz]; divides control_rate
-    latency_ticks: int               # control ticks from a sample to its arrival
-    dropout: float                   # probability a sample is lost, in [0, 1)
-    seed: int                        # of the errors (a run's seed)
+    seed: int                        # of its draws (a run's seed)
+    settings: Any                    # its own keys, as its model's `parse` read them
 
     def every(self, control_rate: float) -> int:
         """Control ticks between two samples."""

@@ -18,7 +18,7 @@ from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_
                                          solid_inertia)
 from multilift_sim.events import EVENT_KINDS
 from multilift_sim.parts import PartsError, import_part, resolve_part
-from multilift_sim.physics.layout import SENSED_QUANTITIES
+from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
 from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
@@ -295,11 +295,10 @@ def _rigid_body(p: Section, payload: PayloadConfig, n: int) -> PayloadConfig:
 
 
 def _sensors(d: Section, sim: SimulationConfig) -> SensorConfig:
-    """The `sensors:` section, validated: per quantity `{name}_noise` and `{name}_bias`
-    (default 0), the rate (default the control rate, which it must divide), the latency in
-    ticks, the dropout probability and the seed."""
-    noise = tuple(d.non_negative(f'{q}_noise', 0.0) for q in SENSED_QUANTITIES)
-    bias = tuple(d.non_negative(f'{q}_bias', 0.0) for q in SENSED_QUANTITIES)
+    """The `sensors:` section, validated: its model (default DEFAULT_MODEL, one of the
+    registry's), the rate (default the control rate, which it must divide) and the seed, which
+    every model has, then the model's own keys (its `parse`), nothing else."""
+    model = d.text('model', DEFAULT_MODEL, choices=tuple(SENSOR_MODELS))
     control_rate = sim.control_rate
     rate = d.number('rate', control_rate, lambda v: 0 < v <= control_rate,
                     f'must be > 0 and <= simulation.control_rate ({control_rate:g})')
@@ -307,11 +306,8 @@ def _sensors(d: Section, sim: SimulationConfig) -> SensorConfig:
     if abs(ratio - round(ratio)) > 1e-9:
         raise d.fail('rate', rate, f'must divide simulation.control_rate ({control_rate:g}) '
                      'into a whole number of ticks')
-    config = SensorConfig(noise=noise, bias=bias, rate=rate,
-                          latency_ticks=d.count('latency_ticks', 0),
-                          dropout=d.number('dropout', 0.0, lambda v: 0 <= v < 1,
-                                           'must be within [0, 1)'),
-                          seed=d.count('seed', 0))
+    config = SensorConfig(model=model, rate=rate, seed=d.count('seed', 0),
+                          settings=SENSOR_MODELS[model].parse(d))
     d.done()
     return config
 

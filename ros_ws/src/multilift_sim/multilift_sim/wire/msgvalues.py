@@ -77,7 +77,7 @@ def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | N
     rotor speeds applied up to it (None at t = 0): (position, velocity, euler, body_rates)
     3 per UAV, what the controllers receive (its `measured` rows), payload position and
     velocity, previous rotor speeds UAV by UAV (empty at t = 0)."""
-    measured = snapshot.measured  # what the controllers receive (physics.sensors)
+    measured = snapshot.measured  # what the controllers receive (multilift_sim.sensors)
     previous = (np.concatenate(previous_rotor_speeds).astype(float)
                 if previous_rotor_speeds is not None else np.empty(0))
     return tuple(measured[:, block:block + 3].reshape(-1) for block in SNAPSHOT_BLOCKS) + (

@@ -9,42 +9,27 @@ A compiled caller links the code of what it calls, and numba checks a cached fun
 its own file only. With the shipped kinds (their sources are in the kernels' digest,
 `kernels.KERNEL_FOLDERS`) the cache folder is the kernels'; with other kinds registered (a
 test's toy kind) `refresh` points numba's cache at a folder of that registry
-(`kinds-<digest>` inside the kernels' one), so no cached caller of another registry is loaded
+(`parts-<digest>` inside the kernels' one), so no cached caller of another registry is loaded
 and none is written where the shipped registry's code lives, and it recompiles every loaded
-compiled function that reaches `apply_event` (`callers`), lazily at its next call.
+compiled function that reaches `apply_event`, lazily at its next call (`multilift_sim.parts`:
+what every registry with a compiled dispatcher shares).
 """
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import inspect
-import os
 import sys
 from pathlib import Path
-from types import ModuleType
-from typing import Any, Callable
+from typing import Callable
 
 from multilift_sim import events as registry
-from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
+from multilift_sim import parts
 
 ARGUMENTS = 'row, tick, effectiveness, taut, released, silent_until'
 EVENTS_MODULE = 'multilift_sim.physics.events'  # the caller: apply_events
-BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
-_dispatchers: dict[str, ModuleType] = {}
-
-
-def _python(function: Callable) -> Callable:
-    return getattr(function, 'py_func', function)
 
 
 def kinds_digest() -> str:
     """A digest of the registered kinds: their names, order and sources (each apply's file)."""
-    digest = hashlib.sha256()
-    for name, kind in registry.EVENT_KINDS.items():
-        python = _python(kind.apply)
-        digest.update(f'{name}\0{python.__module__}.{python.__name__}\0'.encode())
-        digest.update(Path(inspect.getsourcefile(python)).read_bytes())
-    return digest.hexdigest()[:16]
+    return parts.source_digest({name: kind.apply for name, kind in registry.EVENT_KINDS.items()})
 
 
 def dispatcher_source() -> str:
@@ -53,7 +38,7 @@ def dispatcher_source() -> str:
              f'{", ".join(registry.EVENT_KINDS)}: do not edit."""',
              'from multilift_sim.kernels import jit']
     for index, kind in enumerate(registry.EVENT_KINDS.values()):
-        python = _python(kind.apply)
+        python = parts.python(kind.apply)
         lines.append(f'from {python.__module__} import {python.__name__} as apply_{index}')
     lines += ['', '', '@jit', f'def apply_event(kind, {ARGUMENTS}):',
               '    """The event of kind `kind` (its index in the registry) applied."""']
@@ -65,22 +50,8 @@ def dispatcher_source() -> str:
 
 def dispatcher() -> Callable:
     """The registry's compiled `apply_event`, its file written once per digest."""
-    digest = kinds_digest()
-    if digest not in _dispatchers:
-        path = BASE_CACHE / 'events' / f'apply_event_{digest}.py'
-        source = dispatcher_source()
-        if not path.exists() or path.read_text() != source:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            partial = path.with_suffix(f'.{os.getpid()}.tmp')
-            partial.write_text(source)
-            os.replace(partial, path)  # whole, for a process importing it at the same time
-        name = f'multilift_events_dispatch_{digest}'
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-        _dispatchers[digest] = module
-    return _dispatchers[digest].apply_event
+    return parts.generated_module('events', f'apply_event_{kinds_digest()}',
+                                  dispatcher_source()).apply_event
 
 
 def shipped() -> bool:
@@ -88,59 +59,25 @@ def shipped() -> bool:
     return tuple(registry.EVENT_KINDS.values()) == registry.SHIPPED
 
 
+class _Registry:
+    shipped = staticmethod(shipped)
+    digest = staticmethod(kinds_digest)
+
+
+parts.DISPATCHED['events'] = _Registry()
+
+
 def cache_folder() -> Path:
-    """numba's cache folder for the registry as it is (see the module docstring)."""
-    return BASE_CACHE if shipped() else BASE_CACHE / f'kinds-{kinds_digest()}'
+    """numba's cache folder for the registries as they are (`parts.cache_folder`)."""
+    return parts.cache_folder()
 
 
 def refresh() -> None:
     """After the registry changed: numba's cache at its folder, and, once the physics' events
     are loaded, their dispatcher regenerated and every loaded caller to be compiled anew."""
-    try:
-        from numba.core import config
-        from numba.core.dispatcher import Dispatcher
-    except ImportError:  # pragma: no cover - the uncompiled run reads the global each time
-        config = Dispatcher = None
-    if config is not None:
-        config.CACHE_DIR = str(cache_folder())
     events = sys.modules.get(EVENTS_MODULE)
     if events is None:
+        parts.point_cache()
         return
     events.apply_event = dispatcher()
-    if Dispatcher is not None:
-        for function in callers(events.apply_events, Dispatcher):
-            function.enable_caching()  # at the registry's folder
-            function._reset_overloads()
-
-
-def callers(target: Any, kind: type) -> list[Any]:
-    """`target` and every compiled function (a `kind` of dispatcher) of a loaded multilift
-    module that calls it, directly or through others (by a global name, or a module's
-    attribute)."""
-    functions = []
-    for name, module in list(sys.modules.items()):
-        if name.startswith('multilift_') and module is not None:
-            functions += [value for value in vars(module).values() if isinstance(value, kind)]
-    reached = {id(target): target}
-    grew = True
-    while grew:
-        grew = False
-        for function in functions:
-            if id(function) in reached:
-                continue
-            if any(id(value) in reached for value in _referenced(function)):
-                reached[id(function)] = function
-                grew = True
-    return list(reached.values())
-
-
-def _referenced(function: Any) -> list[Any]:
-    python = _python(function)
-    names = python.__code__.co_names
-    found = []
-    for name in names:
-        value = python.__globals__.get(name)
-        found.append(value)
-        if isinstance(value, ModuleType):
-            found += [getattr(value, other, None) for other in names]
-    return found
+    parts.recompile_callers([events.apply_events])

@@ -76,17 +76,22 @@ def prune_cache(days: float = 7.0) -> list[Path]:
     return stale
 
 
-def jit(function: Callable) -> Callable:
+def jit(function: Callable | None = None, *, inline: bool = False) -> Callable:
     """The decorator of every kernel (physics, statistics, the laws, the engine's tick):
     numba's njit with its on-disk cache and IEEE arithmetic in the source's order (no
     fastmath), or the function itself where numba does not import (then only its uncompiled
-    run exists)."""
+    run exists). `@jit(inline=True)`: numba inlines it into its compiled callers (its IR, the
+    same arithmetic), which spares a call that passes a batch's tuples of arrays (each array's
+    reference counted in and out)."""
+    if function is None:
+        return lambda f: jit(f, inline=inline)
     try:
         _import_numba_quietly()
         import numba
     except ImportError:  # pragma: no cover - numba is a dependency; the pure run still works
         return function
-    return numba.njit(cache=True, fastmath=False, nogil=True)(function)
+    return numba.njit(cache=True, fastmath=False, nogil=True,
+                      inline='always' if inline else 'never')(function)
 
 
 def mode() -> str:

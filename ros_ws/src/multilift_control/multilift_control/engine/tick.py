@@ -30,7 +30,7 @@ leader_answer = controllers.dispatchers().leader_answer
 followers_answer = controllers.dispatchers().followers_answer
 
 
-@jit
+@jit(inline=True)  # into formation_tick: no call passing the batch's tuples
 def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
                      errors, rates):
     """Every controller's answer to formation b's measured `states` (n, UAV_STATE_SIZE) at t
@@ -82,7 +82,7 @@ def tell_controllers(a, m, b, first):
         m.next_target[b] += 1
 
 
-@jit
+@jit(inline=True)  # into formation_tick and run_commanded
 def advance_formation(a, m, b, speeds, saturated, tension):
     """Formation b under rotor `speeds` (n, rotors) [rad/s] commanded over the control period
     (`multilift_sim.physics.tick.advance`: the physics' half, the one implementation), then

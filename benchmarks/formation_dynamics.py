@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from multilift_sim.disturbances import Gust
+from multilift_sim.wind.gusts import Gust
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams
 from multilift_sim.multirotor import MultirotorParams

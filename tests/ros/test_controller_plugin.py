@@ -1,15 +1,15 @@
 """A leader and a follower controller are registered parts (issue 31): a toy leader (holds a
 fixed position, a PD on thrust) and a toy follower (holds its start offset to the leader, a
-PD) defined in this file only, registered at test time, compile into the one tick
-(multilift_control.controllers.compiled) and fly headless (the engine's `fly`, the
-per-object `run_headless`: to the bit) and through ROS (`multilift run`: the simulator node,
-our leader and follower nodes, each process registering them through MULTILIFT_PARTS), to
-the headless bag's trajectories to 1e-9 m. Held to what statics says, not read from the code:
-the formation climbs to the held place and the payload settles where its two taut cables hang
-it below the UAVs.
+PD) defined in this file only. A scenario names this file under `parts:`; the processes that
+read it import the file and register the two (pytest's own import leaves its worker's
+registries alone): they compile into the one tick (multilift_control.controllers.compiled)
+and fly headless (the engine's `fly`, the per-object `run_headless`: to the bit) and through
+ROS (`multilift run`: the simulator node, our leader and follower nodes), to the headless
+bag's trajectories to 1e-9 m. Held to what statics says, not read from the code: the
+formation climbs to the held place, each UAV pulled inward by its cable as a PD leaves it, and
+the payload settles where its two taut cables hang it below the UAVs.
 
-This module is imported by those processes (`register_toys`): it imports no test helper at
-module level."""
+The run's processes import this module: it imports no test helper at module level."""
 from __future__ import annotations
 
 import math
@@ -130,8 +130,7 @@ OFFSET_FOLLOWER = types.SimpleNamespace(
     shared=offset_shared, answer=offset_answer)
 
 
-def register_toys() -> None:
-    """MULTILIFT_PARTS' entry: the two toys registered for the rest of the process."""
+if __name__.startswith('multilift_parts_'):  # imported by a scenario's `parts:`
     controllers.register_leader(HOLD_LEADER)
     controllers.register_follower(OFFSET_FOLLOWER)
 
@@ -143,8 +142,10 @@ GAIN = 4.0         # kp [1/s^2] and kd [1/s] of both toys
 G = 9.81           # the scenario's gravity [m/s^2]
 
 
-def _toy_yaml(path: Path, gains=(GAIN, GAIN)) -> Path:
+def _toy_yaml(path: Path, gains=(GAIN, GAIN), parts: bool = True) -> Path:
     data = yaml.safe_load((ROOT / 'scenarios' / 'twin_lift.yaml').read_text())
+    if parts:
+        data['parts'] = [os.path.relpath(__file__, path.parent)]
     data['simulation']['duration'] = DURATION
     data['payload']['swing_deg'] = 0.0
     data.pop('gusts')
@@ -166,22 +167,38 @@ def _equilibrium_error(scenario, state: np.ndarray) -> np.ndarray:
     return payload - hanging
 
 
+# fly and run_headless in a process that imports this file through the scenario's parts:
+HEADLESS = """
+import json, sys
+from multilift_control.headless import fly, run_headless
+from multilift_sim import scenario
+toy = scenario.load(sys.argv[1])
+flown, objects = fly(toy), run_headless(toy)
+print(json.dumps([flown.engine.state[0].tolist(), objects.simulator.state.tolist(),
+                  flown.summary()['follower2'], objects.summary()['follower2']]))
+"""
+
+
 def test_a_leader_and_a_follower_defined_here_fly_headless(tmp_path):
-    from multilift_control.headless import fly, run_headless
-    path = _toy_yaml(tmp_path / 'toy.yaml')
+    import json
+    bare = _toy_yaml(tmp_path / 'bare.yaml', parts=False)
     with pytest.raises(scenario_io.ScenarioError, match='control.mode.*must be one of'):
-        scenario_io.load(str(path))  # not a controller before it registers
+        scenario_io.load(str(bare))  # not a controller before it registers
     with controllers.registered(HOLD_LEADER, OFFSET_FOLLOWER):
         with pytest.raises(scenario_io.ScenarioError, match=r'hold_gains.*must be > 0'):
-            scenario_io.load(str(_toy_yaml(tmp_path / 'bad.yaml', gains=(4.0, -1.0))))
-        scenario = scenario_io.load(str(path))
-        engine_run, object_run = fly(scenario), run_headless(scenario)
-        state = engine_run.engine.state[0].copy()
-        summaries = engine_run.summary(), object_run.summary()
+            scenario_io.load(str(_toy_yaml(tmp_path / 'bad.yaml', gains=(GAIN, -1.0),
+                                           parts=False)))
+        scenario = scenario_io.load(str(bare))
     with pytest.raises(scenario_io.ScenarioError, match='control.mode.*must be one of'):
-        scenario_io.load(str(path))  # gone again
-    np.testing.assert_array_equal(state, object_run.simulator.state)  # both paths, to the bit
-    assert summaries[0]['follower2'] == summaries[1]['follower2']
+        scenario_io.load(str(bare))  # gone again
+    assert 'toy_hold' not in controllers.LEADER_CONTROLLERS  # pytest's import registered none
+    out = subprocess.run([sys.executable, '-c', HEADLESS, str(_toy_yaml(tmp_path / 'toy.yaml'))],
+                         capture_output=True, text=True, timeout=1200)
+    assert out.returncode == 0, out.stderr[-3000:]
+    state, object_state, *summaries = json.loads(out.stdout.splitlines()[-1])
+    state = np.array(state)
+    np.testing.assert_array_equal(state, object_state)  # both paths, to the bit
+    assert summaries[0] == summaries[1]
     start, payload_start = formation_start(scenario)
     # at rest each cable pulls its UAV inward by T_h = (m_p g / 2) (d / 2) / h (d the UAVs'
     # distance, h the payload's depth below them), which a PD without an integral leaves as a
@@ -202,19 +219,15 @@ def test_a_leader_and_a_follower_defined_here_fly_headless(tmp_path):
     assert state[14] - payload_start[2] > 0.9 * CLIMB
 
 
-def test_the_toys_fly_through_ros_as_headless(multilift_run, tmp_path, monkeypatch):
+def test_the_toys_fly_through_ros_as_headless(multilift_run, tmp_path):
     from multilift_tools.bagdata import load_run
     path = _toy_yaml(tmp_path / 'toy.yaml')
-    parts = f'{__file__}:register_toys'
     bags = tmp_path / 'ros', tmp_path / 'headless'
-    with monkeypatch.context() as patch:  # the run's processes only, not this one
-        patch.setenv('MULTILIFT_PARTS', parts)
-        run = multilift_run(str(path), bag=bags[0], startup_timeout=600)
+    run = multilift_run(str(path), bag=bags[0], startup_timeout=600)
     assert run.wait(timeout=1200) == 0, run.output()
     headless = subprocess.run([sys.executable, '-m', 'multilift_tools.cli', 'run', str(path),
                                '--headless', '--bag', str(bags[1])], capture_output=True,
-                              text=True, timeout=1200,
-                              env=dict(os.environ, MULTILIFT_PARTS=parts))
+                              text=True, timeout=1200)
     assert headless.returncode == 0, headless.stderr[-2000:]
     ros, flown = (load_run(bag) for bag in bags)
     assert np.array_equal(ros.t, flown.t)

@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from conftest import ROOT, SCENARIOS, next_domain, raw_messages, wait_for, wait_until_simulated
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
-from multilift_sim.allocation import FRAME_TYPES
+from multilift_sim.vehicles import SHIPPED as FRAME_TYPES
 from multilift_sim.simulation import FormationSimulator, SimulationStopped
 
 MULTILIFT = str(ROOT / 'scripts' / 'multilift')

@@ -5,9 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from multilift_sim.allocation import (FRAME_TYPES, Allocator, allocation_matrix,
+from multilift_sim.allocation import (Allocator, allocation_matrix,
                                       rotor_positions, rotor_spin_directions)
 from multilift_sim.multirotor import MultirotorParams
+from multilift_sim.vehicles import SHIPPED as FRAME_TYPES
 
 # Table 4.2 vehicle
 ARM, K_T, K_D, W_MAX = 0.2, 1.83e-6, 1.85e-7, 2100.0

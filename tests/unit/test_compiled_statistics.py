@@ -152,7 +152,7 @@ def test_the_check_compiled_and_uncompiled_agree(n):
     state[:6 * n].reshape(n, 6)[:, 3:] = rng.normal(0.0, 0.3, (n, 3))  # attitudes a UAV flies
     state[6 * n:6 * n + 3] = uavs.mean(axis=0) - [0.0, 0.0, 1.0]
     seen = set()
-    for tick in range(80):
+    for tick in range(160):
         run = _accumulators(rng, n)
         g = rng.normal(0.0, 2e-3 if tick % 2 else 1e-4, n)
         g_dot = rng.normal(0.0, 1e-2, n)
@@ -189,10 +189,11 @@ def test_the_classes_read_their_arrays():
     assert stats.max_rotor_speed == [1600.0, 2100.0]
     assert stats.saturated_time == [0.0, 0.01 + 0.01]
     assert stats.slack_time == [0.0, 0.01]
+    assert stats.least_thrust_margin == [None, None]  # no allocation given: add_commands alone
     assert (stats.min_tension, stats.max_tension, stats.max_gust_speed) == (1.5, 4.0, 0.4)
     assert list(stats.as_dict()) == [
         'n_uavs', 'max_abs_constraint', 'max_abs_constraint_rate', 'max_rotor_speed',
-        'saturated_time', 'min_tension', 'max_tension', 'simulated_time', 'max_gust_speed',
+        'saturated_time', 'least_thrust_margin', 'min_tension', 'max_tension', 'simulated_time', 'max_gust_speed',
         'slack_time', 'max_payload_swing', 'rms_payload_swing', 'swing_from', 'compressed_time']
     tracking = TrackingStatistics()
     for error in (3.0, 4.0):

@@ -9,7 +9,7 @@ import pytest
 
 from multilift_sim.constraints import (cable_residual_rates, cable_residuals,
                                        constraint_jacobian, constraint_jacobian_rate_term)
-from multilift_sim.disturbances import Gust, gust_velocity, payload_drag
+from multilift_sim.wind.gusts import Gust, gust_velocity, payload_drag
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.kinematics import euler_rate_matrix, rotation_matrix

@@ -14,7 +14,7 @@ from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
 from multilift_sim.analysis.equilibrium import scenario_equilibrium
 from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
-from multilift_sim.disturbances import Gust
+from multilift_sim.wind.gusts import Gust
 from multilift_sim.dynamics import FormationModel, initial_state_single_lift
 from multilift_sim.formulations import make_formulation
 from multilift_sim.nullspace import NullSpaceModel

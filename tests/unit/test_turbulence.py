@@ -1,4 +1,4 @@
-"""Dryden turbulence (multilift_sim.turbulence): the series against the specification's form
+"""Dryden turbulence (multilift_sim.wind.turbulence): the series against the specification's form
 (MIL-F-8785C): variances sigma^2, the autocorrelations sigma^2 e^(-V tau / L) (u) and
 sigma^2 e^(-V tau / L) (1 - V tau / (2 L)) (v, w), the one-sided spectra in bands; seeded; the
 u axis along the mean wind."""
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.signal import welch
 
-from multilift_sim.turbulence import dryden_series, dryden_spectrum
+from multilift_sim.wind.turbulence import dryden_series, dryden_spectrum
 
 DT = 0.01                       # [s], a 100 Hz control loop
 SIGMA = (1.0, 0.8, 0.5)         # [m/s]

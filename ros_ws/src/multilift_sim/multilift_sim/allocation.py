@@ -1,65 +1,35 @@
-"""Rotor layout and control allocation of planar multirotors (seed Eq. 2.9-2.15).
-
-The allocation matrix is built from the geometry of seed Eq. 2.11-2.13 with the rotor numbering
-and spin directions of docs/conventions.md, not copied from the seed's Table 2.1 (whose print is
-garbled). Everything is in the FLU body frame: thrust along +z_b, ``u = (u_T [N], tau_x, tau_y,
+"""Control allocation of a multirotor (seed Eq. 2.9-2.15) from its frame's rotor positions and
+spins (the registered frames of `multilift_sim.vehicles`: the seed's planar ones and any part).
+Everything is in the FLU body frame: thrust along +z_b, ``u = (u_T [N], tau_x, tau_y,
 tau_z [N m])``.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-# frame type -> (number of rotors, arm angle offset xi_c [rad]); "+" has xi_c = 0, "x" pi/n_r.
-_FRAMES: dict[str, tuple[int, float]] = {
-    'quad_plus': (4, 0.0),
-    'quad_x': (4, math.pi / 4),
-    'hexa_plus': (6, 0.0),
-    'hexa_x': (6, math.pi / 6),
-    'octo_plus': (8, 0.0),
-    'octo_x': (8, math.pi / 8),
-}
-FRAME_TYPES: tuple[str, ...] = tuple(_FRAMES)
-
-
-def _frame(frame_type: str) -> tuple[int, float]:
-    try:
-        return _FRAMES[frame_type]
-    except KeyError:
-        raise ValueError(f'unknown frame_type {frame_type!r}; valid frame types are '
-                         f'{", ".join(FRAME_TYPES)}') from None
+from multilift_sim import vehicles
 
 
 def rotor_count(frame_type: str) -> int:
-    """Number of rotors n_r of a frame type (ValueError for an unknown type)."""
-    return _frame(frame_type)[0]
+    """Number of rotors n_r of a registered frame (ValueError for an unknown one)."""
+    return len(vehicles.frame(frame_type).SPINS)
 
 
 def rotor_positions(frame_type: str, arm_length: float) -> np.ndarray:
-    """Rotor hub positions in the FLU body frame [m], shape (n_r, 3).
-
-    Rotor k (k = 1..n_r, row k-1) sits at arm angle ``xi_k = 2 pi (k-1)/n_r + xi_c`` measured
-    clockwise seen from above, at ``l_r (cos xi_k, -sin xi_k, 0)``. Departure from the print:
-    seed Eq. 2.11 writes ``2 pi i / n_r``, which would put rotor 1 a full spacing past the front;
-    we use ``k - 1`` so rotor 1 is the front ("+") or front-right ("x") one, as in the
-    conventions and the Q+ row of seed Table 2.1.
-    """
-    n_rotors, offset = _frame(frame_type)
-    arm_angle = 2.0 * np.pi * np.arange(n_rotors) / n_rotors + offset
-    return arm_length * np.stack(
-        [np.cos(arm_angle), -np.sin(arm_angle), np.zeros(n_rotors)], axis=1)
+    """Rotor hub positions [m], body FLU, (n_r, 3), of a registered frame
+    (`multilift_sim.vehicles`)."""
+    return np.asarray(vehicles.frame(frame_type).rotor_positions(arm_length), dtype=float)
 
 
 def rotor_spin_directions(frame_type: str) -> np.ndarray:
-    """+1 for a rotor spinning clockwise seen from above (odd k), -1 counter-clockwise (even k).
+    """+1 for a rotor spinning clockwise seen from above, -1 counter-clockwise (n_r,).
 
     A clockwise rotor's reaction (drag) moment on the body is ``+k_D omega^2`` about body +z.
     """
-    n_rotors, _ = _frame(frame_type)
-    return np.where(np.arange(n_rotors) % 2 == 0, 1.0, -1.0)
+    return np.asarray(vehicles.frame(frame_type).SPINS, dtype=float)
 
 
 def allocation_matrix(frame_type: str, arm_length: float, thrust_coefficient: float,

@@ -26,7 +26,7 @@ multilift_sim.physics.formation_dae):
 
 Forces: UAV i gets thrust ``u_T R(eta_i) e_z`` and gravity ``-m_i g e_z``, and body torque tau
 enters as ``W^T tau``; the payload gets gravity and the air-relative quadratic drag of
-disturbances.py (gusts included). Rotor speeds are held constant over each RK4 step; with
+wind/gusts.py (gusts included). Rotor speeds are held constant over each RK4 step; with
 lagging rotors (`vehicle.motor_time_constant`, `motor_rate_limit`) each step holds the speed
 whose square is the step's mean of omega^2 (multilift_sim.physics.actuators).
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from multilift_sim.disturbances import Gust
+from multilift_sim.wind.gusts import Gust
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (

@@ -34,7 +34,7 @@ class MultirotorParams:
 
     mass: float                          # m [kg]
     inertia: tuple[float, float, float]  # principal moments (I_xx, I_yy, I_zz) [kg m^2], body
-    frame_type: str                      # one of allocation.FRAME_TYPES
+    frame_type: str                      # a registered frame (multilift_sim.vehicles)
     arm_length: float                    # l_r [m]
     thrust_coefficient: float            # k_T [N s^2/rad^2]
     moment_coefficient: float            # k_D [N m s^2/rad^2]

@@ -1,15 +1,19 @@
-"""What every registry of parts shares (issue 31): where parts outside this package come from,
-and how a registry's compiled dispatcher reaches the one tick.
+"""Parts a scenario brings along (`parts:`, issue 31): Python files that register parts of any
+kind (a vehicle frame, an event kind, ...) in their kind's registry when imported. A scenario
+names them, so every process that reads the scenario (the simulator and controller nodes, the
+headless loop, a sweep's workers) imports them before it validates the rest: a part defined in
+one file flies headless and through ROS with no other file changed (docs/extending.md).
 
-Discovery (`load`): a registry whose parts live in a higher layer (the leader and follower
-controllers' laws are multilift_control's, their names are what this package's scenario
-validation reads) is filled by importing the modules the `multilift.parts` entry point group
-names (multilift_control's setup.py names `multilift_control.controllers`), and those of
-MULTILIFT_PARTS: `path/to/file.py:function` or `package.module:function` entries separated by
-commas, each imported and its function called once per process (a test's toy parts,
-registered in every process of a ROS run: the simulator, the controller nodes, the recorder).
-The static imports still go one way (tests/unit/test_architecture.py): a lower layer finds
-parts by name at run time, as pytest finds its plugins.
+An entry is a path to a `.py` file, relative to the scenario file's folder (or absolute). A
+file is imported once per process: a file already imported under another name (a test module
+pytest collected) is not imported again, so its registrations happen once.
+
+Shipped parts of a higher layer (the leader and follower controllers are multilift_control's;
+their names are what this package's scenario validation reads) are found through the
+`multilift.parts` entry point group (`load`: multilift_control's setup.py names
+`multilift_control.controllers`). The static imports still go one way
+(tests/unit/test_architecture.py): a lower layer finds parts by name at run time, as pytest
+finds its plugins.
 
 Compiled dispatch: numba cannot call a function picked from a Python registry at run time, so
 a registry writes a dispatcher's source from its parts (one branch per part) to a file under
@@ -23,7 +27,6 @@ is compiled anew (`recompile_callers`).
 from __future__ import annotations
 
 import hashlib
-import importlib
 import importlib.metadata
 import importlib.util
 import inspect
@@ -36,45 +39,65 @@ from typing import Any, Callable, Protocol
 from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
 
 ENTRY_POINTS = 'multilift.parts'
-VARIABLE = 'MULTILIFT_PARTS'
 BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
-_loaded: set[str] = set()
+_entries: set[str] = set()
+
+
+class PartsError(ValueError):
+    """A `parts:` entry that is no file or fails to import (the message says why; the caller
+    names the entry)."""
+
+
+def resolve_part(entry: str, base: Path) -> Path:
+    """The file of a `parts:` entry, relative to `base` (the scenario's folder)."""
+    path = Path(entry).expanduser()
+    if not path.is_absolute():
+        path = base / path
+    path = path.resolve()
+    if path.suffix != '.py' or not path.is_file():
+        raise PartsError(f'is no Python file (looked for {path})')
+    return path
+
+
+def _loaded(path: Path) -> ModuleType | None:
+    for module in list(sys.modules.values()):
+        file = getattr(module, '__file__', None)
+        if file and Path(file).resolve() == path:
+            return module
+    return None
+
+
+def import_part(path: Path) -> ModuleType:
+    """Import the part file `path` (absolute) once in this process; returns its module."""
+    module = _loaded(path)
+    if module is not None:
+        return module
+    digest = hashlib.sha256(str(path).encode()).hexdigest()[:12]
+    name = f'multilift_parts_{path.stem}_{digest}'
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:
+        del sys.modules[name]
+        raise PartsError(f'failed to import ({path}): {type(exc).__name__}: {exc}') from exc
+    return module
+
+
+def import_parts(paths: tuple[str, ...]) -> None:
+    """Import each part file of a scenario (its `Scenario.parts`, absolute paths) once."""
+    for path in paths:
+        import_part(Path(path))
 
 
 def load() -> None:
-    """Import the parts of the `multilift.parts` entry points and of MULTILIFT_PARTS (each
-    entry once per process; see the module docstring)."""
+    """Import the shipped parts of the `multilift.parts` entry points (each once per
+    process)."""
     for entry in importlib.metadata.entry_points(group=ENTRY_POINTS):
-        if entry.value not in _loaded:
-            _loaded.add(entry.value)
+        if entry.value not in _entries:
+            _entries.add(entry.value)
             entry.load()
-    for entry in filter(None, os.environ.get(VARIABLE, '').split(',')):
-        if entry not in _loaded:
-            _loaded.add(entry)
-            where, _, function = entry.rpartition(':')
-            if not where:
-                raise ValueError(f'{VARIABLE}: {entry!r} is not module:function or '
-                                 f'path.py:function')
-            getattr(_imported(where), function)()
-
-
-def _imported(where: str) -> ModuleType:
-    """Module `where` (a dotted name, or a file imported under its stem, the name pytest gives
-    a test file: numba's cache of its compiled functions names their module)."""
-    if not where.endswith('.py'):
-        return importlib.import_module(where)
-    name = Path(where).stem
-    loaded = sys.modules.get(name)
-    if loaded is not None and Path(getattr(loaded, '__file__', '')).resolve() != \
-            Path(where).resolve():
-        raise ValueError(f'{VARIABLE}: {where} would be module {name}, which is '
-                         f'{loaded.__file__}')
-    if loaded is None:
-        spec = importlib.util.spec_from_file_location(name, where)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return sys.modules[name]
 
 
 class Dispatched(Protocol):

@@ -16,7 +16,7 @@ from multilift_sim.physics.layout import (EVENT_COLUMNS, EVENT_KIND, EVENT_ROTOR
                                           EVENT_TIME, EVENT_UAV, MEASURED_COLUMNS)
 from multilift_sim.scenario import Scenario
 from multilift_sim.sensors import sensor_errors
-from multilift_sim.turbulence import dryden_series
+from multilift_sim.wind import WIND_MODELS
 from multilift_sim.wire.msgvalues import formation_event
 
 
@@ -38,19 +38,17 @@ def event_array(scenario: Scenario) -> np.ndarray:
 def wind_series(scenario: Scenario) -> np.ndarray:
     """The unsteady wind [m/s], world, of every control period of the run, (ticks + 1, 3), or
     (0, 3) where the wind is steady: tick k's is held over the period from it, added to the
-    steady wind. The Dryden turbulence sampled at the tick (`turbulence.dryden_series`,
-    `wind.turbulence`) plus what each event that blows air gives over the period (its kind's
+    steady wind. Each wind model's samples at the ticks (`multilift_sim.wind`: the Dryden
+    turbulence of `wind.turbulence`, a part's) plus what each event that blows air gives over the period (its kind's
     `unsteady_wind`: a gust's 1-cosine profile averaged over the period, docs/wind.md)."""
     sim = scenario.simulation
     blowing = [e for e in scenario.events if moves_air(e.type)]
-    if scenario.turbulence is None and not blowing:
+    if not scenario.wind_models and not blowing:
         return np.zeros((0, 3))
     series = np.zeros((sim.tick_count + 1, 3))
-    config = scenario.turbulence
-    if config is not None:
-        series += dryden_series(sim.tick_count + 1, 1.0 / sim.control_rate, config.intensity,
-                                config.length_scale, config.airspeed, scenario.wind,
-                                config.seed)
+    for name, config in scenario.wind_models:
+        series += WIND_MODELS[name].series(config, scenario, sim.tick_count + 1,
+                                           1.0 / sim.control_rate)
     starts = np.arange(sim.tick_count + 1) / sim.control_rate
     for event in blowing:
         series += EVENT_KINDS[event.type].unsteady_wind(event, starts, 1.0 / sim.control_rate)
@@ -91,13 +89,14 @@ def sensor_arrays(scenario: Scenario) -> SensorArrays:
 
 
 def run_seeds(scenario: Scenario) -> dict[str, int]:
-    """The seeds a run's random draws come from, by what they draw (`sensors`, `turbulence`),
+    """The seeds a run's random draws come from, by what they draw (`sensors`, a wind model's),
     as its summary records them: none where it draws nothing."""
     seeds = {}
     if scenario.sensors is not None:
         seeds['sensors'] = scenario.sensors.seed
-    if scenario.turbulence is not None:
-        seeds['turbulence'] = scenario.turbulence.seed
+    for name, config in scenario.wind_models:
+        if hasattr(WIND_MODELS[name], 'seed'):
+            seeds[name] = WIND_MODELS[name].seed(config)
     return seeds
 
 

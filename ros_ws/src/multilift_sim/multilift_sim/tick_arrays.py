@@ -34,6 +34,7 @@ class PhysicsArrays(NamedTuple):
     allocation: np.ndarray        # (B, n, 4, rotors): wrench per omega^2 (seed Eq. 2.14),
     #                               a UAV with fewer rotors padded with zero columns
     actuators: np.ndarray         # (B, n, ACTUATOR_COLUMNS): each UAV's rotor lag and rate limit
+    rotor_speed_max: np.ndarray   # (B, n) [rad/s]: each UAV's rotors' largest speed
     cable_lengths: np.ndarray     # (B, n) [m]
     slack: np.ndarray             # (B,) bool: cable_model slack (else rigid)
     events: np.ndarray            # (B, k, EVENT_COLUMNS): the scenario's events in time order
@@ -93,6 +94,7 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
     rotors = allocation.shape[::2]  # (n, the largest rotor count)
     arrays = dict(
         uavs=uavs, gusts=gusts, formation=formation, allocation=allocation, actuators=actuators,
+        rotor_speed_max=np.array([u.vehicle.rotor_speed_max for u in scenario.uavs]),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
         slack=scenario.cable_model == 'slack', events=event_array(scenario),
         wind_series=wind_series(scenario), state_size=state.size,

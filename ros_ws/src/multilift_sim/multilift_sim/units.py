@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import re
 
+from multilift_sim.wind import WIND_MODELS
+
 NO_UNIT = ''
 
 # the sweep table's columns other than the parameters, in the order of the table
@@ -24,6 +26,7 @@ STATISTIC_UNITS: dict[str, str] = {
     'max_abs_g_dot': 'm^2/s',         # largest |g_i_dot|
     'max_rotor_speed': 'rad/s',       # over every UAV's rotors
     'saturated_time': 's',            # summed over the UAVs
+    'least_thrust_margin': NO_UNIT,   # 1 - u_T / u_T,max, the least over the UAVs and ticks
     'min_tension': 'N',
     'max_tension': 'N',
     'payload_swing_max': 'm',         # horizontal, from the payload's rest place
@@ -77,9 +80,7 @@ SCENARIO_UNITS: dict[str, str] = {
     'payload.attach_points': 'm',
     'gusts[].center': 'm', 'gusts[].direction': NO_UNIT, 'gusts[].gradient_distance': 'm',
     'gusts[].reference_speed': 'm/s',
-    'wind.velocity': 'm/s', 'wind.turbulence.intensity': 'm/s',
-    'wind.turbulence.length_scale': 'm', 'wind.turbulence.airspeed': 'm/s',
-    'wind.turbulence.seed': NO_UNIT,
+    'wind.velocity': 'm/s',  # a wind model's keys: its UNITS (multilift_sim.wind)
     **{f'sensors.{q}_noise': u for q, u in SENSED.items()},
     **{f'sensors.{q}_bias': f'{u}/sqrt(s)' for q, u in SENSED.items()},
     'sensors.rate': 'Hz', 'sensors.latency_ticks': NO_UNIT, 'sensors.dropout': NO_UNIT,
@@ -106,6 +107,7 @@ SCENARIO_UNITS: dict[str, str] = {
 UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS}
 
 _INDEX = re.compile(r'\[\d+\]')
+_WIND_KEY = re.compile(r'^wind\.(\w+)\.(\w+)(?:\[\])?$')  # wind.<model>.<key>
 # a statistic of one UAV, cable or follower: uav2_saturated_time, cable1.slack_time, ...
 _PER_PART = re.compile(r'^(?:uav|cable|follower)\d+[._](.+)$')
 
@@ -118,6 +120,10 @@ def unit_of(name: str) -> str:
         return UNITS[key]
     if key.endswith('[]') and key[:-2] in UNITS:    # one component of a vector key
         return UNITS[key[:-2]]
+    model = _WIND_KEY.match(key)
+    if model and model.group(1) in WIND_MODELS and model.group(2) in \
+            WIND_MODELS[model.group(1)].UNITS:
+        return WIND_MODELS[model.group(1)].UNITS[model.group(2)]
     part = _PER_PART.match(name)
     if part and _INDEX.sub('', part.group(1)) in STATISTIC_UNITS:
         return STATISTIC_UNITS[_INDEX.sub('', part.group(1))]

@@ -6,6 +6,7 @@
     multilift topic list | echo TOPIC [--once] | info TOPIC
     multilift plot BAG [--out DIR] | animate BAG [--out FILE.gif] | compare BAG_A BAG_B
     multilift modal SCENARIO [--out DIR] [--hold-uavs]
+    multilift loads SCENARIO [--json FILE]
     multilift study baumgarte|swing_feedback [--out DIR]
     multilift bag info|play|reindex DIR | foxglove [--port P] | sweep | reproduce
 
@@ -39,6 +40,9 @@ DELEGATED = {
                 'seed Fig. 4.15-4.17 comparisons of two bags'),
     'modal': ('multilift_tools.modal_cli', 'modal_main',
               'eigenvalues and pendulum periods at the static equilibrium (seed §2.8)'),
+    'loads': ('multilift_tools.loads_cli', 'loads_main',
+              "each cable's tension and each UAV's thrust margin, at hover and over the mission "
+              '(statics of Eq. 2.73)'),
     'study': ('multilift_tools.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
     'bag': ('multilift_tools.bags.command', 'bag_main',
             'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),

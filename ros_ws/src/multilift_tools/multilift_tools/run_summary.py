@@ -70,10 +70,14 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
                      f'(tolerance {tol:g})')
         lines.append(f'  max |g_dot|      {sim["max_abs_constraint_rate"]:.3g} '
                      f'{unit_of("max_abs_g_dot")}')
-        for i, (w, s) in enumerate(zip(sim['max_rotor_speed'], sim['saturated_time'])):
+        margins = sim.get('least_thrust_margin') or [None] * len(sim['max_rotor_speed'])
+        for i, (w, s, margin) in enumerate(zip(sim['max_rotor_speed'], sim['saturated_time'],
+                                               margins)):
             limit = scenario.uavs[i].vehicle.rotor_speed_max
+            left = '' if margin is None else f', thrust margin least {100 * margin:.1f} %'
             lines.append(f'  uav{i + 1} rotors      max {w:.1f} {unit_of("max_rotor_speed")} '
-                         f'(limit {limit:g}), saturated {s:.2f} {unit_of("saturated_time")}')
+                         f'(limit {limit:g}), saturated {s:.2f} {unit_of("saturated_time")}'
+                         f'{left}')
         lines.extend(fault_lines(scenario, sim.get('events', []), sim.get('simulated_time')))
         lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} '
                      f'{unit_of("max_tension")}')

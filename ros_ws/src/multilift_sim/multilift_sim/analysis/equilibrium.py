@@ -70,31 +70,9 @@ def static_equilibrium(params: FormationParams, uav_positions: ArrayLike,
         raise ValueError(f'cable {worst + 1}: |d_i|^2 differs from l_i^2 by a fraction '
                          f'{residual[worst]:.3g}: not on the constraint manifold (Eq. 2.42)')
     offsets = cable_offsets(params, uavs, payload, rotation)          # d_i, (n, 3)
-    weight = np.array([0.0, 0.0, params.payload_mass * params.gravity])
-    if params.rigid_payload:
-        # payload rows, force and moment: 2 [D^T; C^T] Lambda = (-m_p g e_z, 0), least-norm
-        moments = cable_moments(params, offsets, rotation)
-        rows = 2.0 * np.vstack((offsets.T, moments.T))
-        multipliers, *_ = np.linalg.lstsq(rows, np.concatenate((-weight, np.zeros(3))),
-                                          rcond=None)
-        miss = rows @ multipliers + np.concatenate((weight, np.zeros(3)))
-        arm = max(1e-3, float(np.abs(params.payload_attach_points).max()))
-        if float(np.linalg.norm(miss[3:])) > tolerance * weight[2] * arm:
-            raise ValueError(f'the body cannot hang at rest in this attitude: its cables leave '
-                             f'{np.linalg.norm(miss[3:]):.3g} N m of moment unbalanced '
-                             '(docs/rigid_payload.md)')
-        miss = float(np.linalg.norm(miss[:3]))
-    else:
-        # payload rows: (2 D^T) Lambda = -m_p g e_z, least-norm when indeterminate (n >= 4)
-        multipliers, *_ = np.linalg.lstsq(2.0 * offsets.T, -weight, rcond=None)
-        miss = float(np.linalg.norm(2.0 * offsets.T @ multipliers + weight))
-    if miss > tolerance * weight[2]:
-        raise ValueError(f'the payload cannot hang at rest at {payload.tolist()} m: its cables '
-                         f'leave {miss:.3g} N of its weight unbalanced (Eq. 2.73)')
-    for i, multiplier in enumerate(multipliers):
-        if multiplier <= 0.0:
-            raise ValueError(f'cable {i + 1}: the equilibrium multiplier is {multiplier:.3g} '
-                             'N/m: the cable would be slack or in compression')
+    multipliers = payload_multipliers(
+        params, offsets, rotation, np.array([0.0, 0.0, params.payload_mass * params.gravity]),
+        tolerance, payload)
     euler = np.zeros((n, 3))
     rotor_speeds = []
     wrenches = np.zeros((n, 4))
@@ -158,3 +136,41 @@ def scenario_equilibrium(scenario: Scenario) -> Equilibrium:
     uavs, payload = scenario_configuration(scenario)
     return static_equilibrium(scenario.formation_params(0.0, 0.0), uavs, payload,
                               [u.yaw for u in scenario.uavs])
+
+
+def payload_multipliers(params: FormationParams, offsets: np.ndarray,
+                        rotation: np.ndarray | None, load: np.ndarray,
+                        tolerance: float = 1e-9, payload: ArrayLike | None = None) -> np.ndarray:
+    """Lambda (n,) [N/m] of the payload's rows of Eq. 2.73: the cables (offsets d_i (n, 3) [m],
+    world) hold the payload against `load` [N], world, the force its support must give (at
+    rest its weight m_p g e_z; moving at acceleration a, m_p (g e_z + a) less its drag), a
+    rigid body (attitude `rotation`) also with no moment. Least-norm where indeterminate
+    (n >= 4). Raises ValueError when the cables leave part of the load (or a moment)
+    unbalanced, or one would be slack or in compression."""
+    weight = float(np.linalg.norm(load))
+    where = '' if payload is None else f' at {np.asarray(payload).tolist()} m'
+    if params.rigid_payload:
+        # force and moment rows: 2 [D^T; C^T] Lambda = (-load, 0), least-norm
+        moments = cable_moments(params, offsets, rotation)
+        rows = 2.0 * np.vstack((offsets.T, moments.T))
+        multipliers, *_ = np.linalg.lstsq(rows, np.concatenate((-load, np.zeros(3))),
+                                          rcond=None)
+        miss = rows @ multipliers + np.concatenate((load, np.zeros(3)))
+        arm = max(1e-3, float(np.abs(params.payload_attach_points).max()))
+        if float(np.linalg.norm(miss[3:])) > tolerance * weight * arm:
+            raise ValueError(f'the body cannot hang at rest in this attitude: its cables leave '
+                             f'{np.linalg.norm(miss[3:]):.3g} N m of moment unbalanced '
+                             '(docs/rigid_payload.md)')
+        miss = float(np.linalg.norm(miss[:3]))
+    else:
+        # (2 D^T) Lambda = -load
+        multipliers, *_ = np.linalg.lstsq(2.0 * offsets.T, -load, rcond=None)
+        miss = float(np.linalg.norm(2.0 * offsets.T @ multipliers + load))
+    if miss > tolerance * weight:
+        raise ValueError(f'the payload cannot hang at rest{where}: its cables leave {miss:.3g} '
+                         'N of its load unbalanced (Eq. 2.73)')
+    for i, multiplier in enumerate(multipliers):
+        if multiplier <= 0.0:
+            raise ValueError(f'cable {i + 1}: the equilibrium multiplier is {multiplier:.3g} '
+                             'N/m: the cable would be slack or in compression')
+    return multipliers

@@ -44,7 +44,7 @@ def air_velocity(px, py, gusts):
 def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
     """Drag (gusts and the steady wind included) on the payload over m_p [m/s^2], world,
     gravity excluded: at payload position (px, py, pz) [m] and velocity (pvx, pvy, pvz)
-    [m/s]. (The numpy form is disturbances.payload_drag and gust_velocity; tests hold them
+    [m/s]. (The numpy form is wind.gusts.payload_drag and gust_velocity; tests hold them
     equal.)"""
     drag = formation[FORMATION_DRAG]
     if drag <= 0.0:

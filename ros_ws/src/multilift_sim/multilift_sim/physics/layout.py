@@ -89,7 +89,7 @@ EVENT_DURATION = 7          # gust: how long it blows [s]
 EVENT_VELOCITY = 8          # gust: its peak velocity [m/s], world (3)
 EVENT_COLUMNS = 11
 
-# -- a gust (seed Eq. 2.55; disturbances.Gust) ------------------------------------------------
+# -- a gust (seed Eq. 2.55; wind.gusts.Gust) --------------------------------------------------
 GUST_CENTER = 0             # (x, y) of its centre [m], world (2 slots)
 GUST_DIRECTION = 2          # unit direction, world (3 slots)
 GUST_GRADIENT_DISTANCE = 5  # h [m]

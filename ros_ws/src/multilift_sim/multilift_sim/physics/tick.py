@@ -27,6 +27,7 @@ from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.sensors import sensed_states
 from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
+                                                   run_add_thrust_margin,
                                                    run_add_gust_speed, run_add_slack,
                                                    run_add_tensions, run_check)
 from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
@@ -113,6 +114,8 @@ def advance(a, m, b, speeds, saturated, tension):
     held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
                   m.held_saturated[b])
     run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
+    run_add_thrust_margin(m.run[b], m.held[b], m.effectiveness[b], a.allocation[b],
+                          a.rotor_speed_max[b])
     formation = period_formation(a.formation[b], a.wind_series[b], m.tick[b])
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],

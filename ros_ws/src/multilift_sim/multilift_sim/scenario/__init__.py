@@ -14,10 +14,11 @@ from multilift_sim.scenario.config import (CABLE_MODELS,  # noqa: F401
                                            ControlConfig, EventConfig,
                                            FormationConfig, MissionConfig, MissionSegment,
                                            PayloadConfig, Scenario, ScenarioError, SensorConfig,
-                                           SimulationConfig, TurbulenceConfig, UavConfig)
+                                           SimulationConfig, UavConfig)
 from multilift_sim.scenario.controllers import (FOLLOWER_CONTROLLERS,  # noqa: F401
                                                 LEADER_CONTROLLERS, follower_controllers,
                                                 leader_controllers)
-from multilift_sim.scenario.files import load, loads, resolve, scenario_dir  # noqa: F401
+from multilift_sim.scenario.files import (anchored, load, loads, resolve,  # noqa: F401
+                                          scenario_dir)
 from multilift_sim.scenario.vehicle import (INERTIA_SOURCES, SEED_INERTIA,  # noqa: F401
                                             VEHICLE_KEYS)

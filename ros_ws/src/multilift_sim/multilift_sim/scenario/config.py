@@ -5,14 +5,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any
 from dataclasses import dataclass, field
+from typing import Any
 
-from multilift_sim.disturbances import Gust
 from multilift_sim.events import moves_air
 from multilift_sim.formation_params import FormationParams
 from multilift_sim.formation_geometry import FORMATION_GEOMETRIES  # noqa: F401 (the registry)
 from multilift_sim.multirotor import MultirotorParams
+from multilift_sim.wind.gusts import Gust
 
 
 class ScenarioError(ValueError):
@@ -156,16 +156,6 @@ class EventConfig:
 
 
 @dataclass(frozen=True)
-class TurbulenceConfig:
-    """Dryden turbulence on top of the steady wind (`wind.turbulence`, multilift_sim.turbulence):
-    components u (along the mean wind), v (to its left), w (up)."""
-    intensity: tuple[float, float, float]     # sigma_u, sigma_v, sigma_w [m/s]
-    length_scale: tuple[float, float, float]  # L_u, L_v, L_w [m]
-    airspeed: float                           # V [m/s]: how fast the field passes
-    seed: int                                 # of the series (a run's seed)
-
-
-@dataclass(frozen=True)
 class SensorConfig:
     """What the controllers receive of each UAV (`sensors:`, multilift_sim.sensors,
     docs/sensors.md): per quantity of SENSED_QUANTITIES (position [m], velocity [m/s],
@@ -198,8 +188,10 @@ class Scenario:
     cable_model: str = 'rigid'       # one of CABLE_MODELS
     events: tuple[EventConfig, ...] = ()  # in time order
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world
-    turbulence: TurbulenceConfig | None = None
+    # the wind models `wind:` names: (name, its config) (multilift_sim.wind.WIND_MODELS)
+    wind_models: tuple[tuple[str, Any], ...] = ()
     sensors: SensorConfig | None = None  # None: the controllers read the exact state
+    parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
 
     @property
     def n_uavs(self) -> int:
@@ -209,7 +201,7 @@ class Scenario:
     def has_wind(self) -> bool:
         """Whether the air moves everywhere (a steady wind, turbulence or an event that blows
         air: /formation/wind carries it), beyond the seed's gusts at places."""
-        return (any(self.wind) or self.turbulence is not None
+        return (any(self.wind) or bool(self.wind_models)
                 or any(moves_air(e.type) for e in self.events))
 
     def formation_params(self, baumgarte_alpha: float | None = None,

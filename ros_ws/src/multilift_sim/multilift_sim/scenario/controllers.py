@@ -5,10 +5,10 @@
 The parts are multilift_control's (their compiled laws: `multilift_control.controllers`,
 docs/extending.md); they register here, and a process that reads a scenario before it
 imported them finds them through `multilift_sim.parts.load` (the `multilift.parts` entry
-points, MULTILIFT_PARTS). What validation reads of a part: `NAME`, `KEYS` (its own keys in the
-`control:` section) and, with keys, `parse(c) -> dict` (c: the `control:` section, a
-`scenario.reading.Section`; the dict: `ControlConfig` fields, a part's own numbers in
-`values`).
+points; a part of one's own: the scenario's `parts:`). What validation reads of a part:
+`NAME`, `KEYS` (its own keys in the `control:` section) and, with keys, `parse(c) -> dict`
+(c: the `control:` section, a `scenario.reading.Section`; the dict: `ControlConfig` fields, a
+part's own numbers in `values`).
 """
 from __future__ import annotations
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -44,6 +45,15 @@ def load(name_or_path: str) -> Scenario:
     except yaml.YAMLError as exc:
         raise ScenarioError(f'{path}: not valid YAML: {exc}'.replace('\n', ' ')) from None
     return scenario_of(data, str(path))
+
+
+def anchored(data: Any, folder: Path) -> Any:
+    """A scenario's mapping with its `parts:` files made absolute against `folder` (the
+    file's own), for a copy validated elsewhere (a sweep's runs, `loads`)."""
+    if isinstance(data, dict) and isinstance(data.get('parts'), list):
+        data = dict(data, parts=[str((folder / p).resolve()) if isinstance(p, str) else p
+                                 for p in data['parts']])
+    return data
 
 
 def loads(text: str, where: str = '<string>') -> Scenario:

@@ -7,21 +7,24 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 from typing import Any
 
-from multilift_sim.disturbances import Gust
+from multilift_sim.wind import WIND_MODELS
+from multilift_sim.wind.gusts import Gust
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
 from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
 from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_rigid_body_inertia,
                                          solid_inertia)
 from multilift_sim.events import EVENT_KINDS
+from multilift_sim.parts import PartsError, import_part, resolve_part
 from multilift_sim.physics.layout import SENSED_QUANTITIES
 from multilift_sim.scenario.config import (CABLE_MODELS, FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
                                            MissionConfig, MissionSegment, PayloadConfig,
                                            Scenario, ScenarioError, SensorConfig,
-                                           SimulationConfig, TurbulenceConfig, UavConfig,
+                                           SimulationConfig, UavConfig,
                                            flies_a_period, one_period_rule)
 from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_controllers,
                                                 leader_controllers)
@@ -33,6 +36,7 @@ from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inerti
 
 def scenario_of(data: Any, where: str) -> Scenario:
     top = Section(data, '', where)
+    parts = _parts(top)  # first: the rest may name what they register
     name = top.text('name')
     description = top.text('description', '')
     top.text('frame', 'world', choices=('world',))
@@ -146,14 +150,12 @@ def scenario_of(data: Any, where: str) -> Scenario:
     events = _events(top, uavs, duration)
     w = top.section('wind', {})
     wind = w.vector('velocity', [0.0, 0.0, 0.0])  # steady, everywhere (issue 21)
-    turbulence = None
-    if w.has('turbulence'):
-        d = w.section('turbulence')
-        turbulence = TurbulenceConfig(
-            intensity=d.vector('intensity', check=lambda v: v >= 0, rule='must be >= 0'),
-            length_scale=d.vector('length_scale', check=lambda v: v > 0, rule='must be > 0'),
-            airspeed=d.positive('airspeed'), seed=d.count('seed', 0))
-        d.done()
+    wind_models = []  # the registered models the section names (multilift_sim.wind)
+    for model_name, model in WIND_MODELS.items():
+        if w.has(model_name):
+            d = w.section(model_name)
+            wind_models.append((model_name, model.parse(d)))
+            d.done()
     w.done()
     sensors = _sensors(top.section('sensors'), sim) if top.has('sensors') else None
 
@@ -202,13 +204,13 @@ def scenario_of(data: Any, where: str) -> Scenario:
                                               reference_filter_time=reference_filter_time),
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, events=events, wind=tuple(wind),
-                        turbulence=turbulence, sensors=sensors)
+                        wind_models=tuple(wind_models), sensors=sensors, parts=parts)
     _check_feasible(scenario)
     check_limits(scenario)
     # what only the engine's DAE (physics/) models: refused with another formulation
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
-    windy = any(wind) or turbulence is not None or any(u.vehicle.drag_coefficient
+    windy = any(wind) or wind_models or any(u.vehicle.drag_coefficient
                                                        for u in scenario.uavs)
     rigid = payload.type == 'rigid_body'
     off_centre = [i + 1 for i, u in enumerate(scenario.uavs) if any(u.attach_point)]
@@ -248,6 +250,24 @@ def _controller_keys(c: Section, leader: Any, follower: Any) -> dict[str, Any]:
                 if c.has(key):
                     raise c.fail(key, c.raw(key), f'is a key of control.{kind}: {other.NAME}')
     return dict(fields, values=tuple(values))
+
+
+def _parts(top: Section) -> tuple[str, ...]:
+    """`parts:` imported (multilift_sim.parts), as absolute paths: files relative to the
+    scenario file's folder (a scenario given as text: the working directory's)."""
+    source = Path(top.where)
+    base = source.parent if source.is_file() else Path.cwd()
+    paths = []
+    for entry in top.sequence('parts', []):
+        if not isinstance(entry, str):
+            raise top.fail('parts', entry, 'must be a list of Python file paths')
+        try:
+            path = resolve_part(entry, base)
+            import_part(path)
+        except PartsError as exc:
+            raise top.fail('parts', entry, str(exc)) from None
+        paths.append(str(path))
+    return tuple(paths)
 
 
 def _payload_feedback(c: Section, mode: str) -> dict[str, float]:

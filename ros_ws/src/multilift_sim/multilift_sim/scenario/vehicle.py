@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from multilift_sim.allocation import FRAME_TYPES
+from multilift_sim.vehicles import frame_types
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.scenario.reading import Section
 
@@ -21,7 +21,7 @@ def vehicle_params(sec: Section, base: dict[str, Any] | None) -> MultirotorParam
         return ... if base is None else base[key]
     mass = sec.positive('mass', default('mass'))
     inertia = sec.vector('inertia', default('inertia'), check=lambda v: v > 0, rule='must be > 0')
-    frame_type = sec.text('frame_type', default('frame_type'), choices=FRAME_TYPES)
+    frame_type = sec.text('frame_type', default('frame_type'), choices=frame_types())
     arm_length = sec.positive('arm_length', default('arm_length'))
     k_t = sec.positive('thrust_coefficient', default('thrust_coefficient'))
     k_d = sec.positive('moment_coefficient', default('moment_coefficient'))

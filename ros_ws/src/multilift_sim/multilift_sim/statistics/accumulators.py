@@ -20,7 +20,7 @@ from multilift_sim.statistics.layout import (
     CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS,
     FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ, PITCH_LIMIT,
     RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED,
-    RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
+    RUN_LEAST_THRUST_MARGIN, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
     RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
 from multilift_sim.statistics.swing import swing_at
 
@@ -53,6 +53,29 @@ def run_add_commands(run: np.ndarray, rotor_speeds: np.ndarray, saturated: np.nd
             if saturated[i, r]:
                 run[block + RUN_SATURATED_TIME] += period
                 break
+
+
+@jit
+def run_add_thrust_margin(run: np.ndarray, rotor_speeds: np.ndarray, effectiveness: np.ndarray,
+                          allocation: np.ndarray, rotor_speed_max: np.ndarray) -> None:
+    """One control period of commands: each UAV's thrust margin 1 - u_T / u_T,max lowers its
+    least (RUN_LEAST_THRUST_MARGIN): u_T = sum_r k_T,r e_r omega_r^2 of the commanded speeds
+    (n, rotors) [rad/s] and u_T,max the same at rotor_speed_max (n,) [rad/s], with the
+    allocation's thrust row (n, 4, rotors) (seed Eq. 2.14) and the rotors' effectiveness
+    (n, rotors) in [0, 1] (a failed rotor lifts nothing, nor counts in the largest thrust).
+    A UAV without a command (NaN) or that can lift nothing is left as it is."""
+    for i in range(rotor_speeds.shape[0]):
+        top = rotor_speed_max[i] * rotor_speed_max[i]
+        thrust = largest = 0.0
+        for r in range(rotor_speeds.shape[1]):
+            lift = allocation[i, 0, r] * effectiveness[i, r]
+            thrust += lift * rotor_speeds[i, r] * rotor_speeds[i, r]
+            largest += lift * top
+        if largest > 0.0 and not math.isnan(thrust):
+            margin = 1.0 - thrust / largest
+            slot = RUN_SCALARS + RUN_UAV_COLUMNS * i + RUN_LEAST_THRUST_MARGIN
+            if margin < run[slot]:
+                run[slot] = margin
 
 
 @jit

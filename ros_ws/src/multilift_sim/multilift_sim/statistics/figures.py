@@ -17,7 +17,8 @@ from multilift_sim import kernels
 from multilift_sim.statistics.layout import (
     FORMATION_MAX_ABS, FORMATION_NORM_SUM, FORMATION_SAMPLES, FORMATION_SIZE, PEAK_MAX,
     PEAK_SAMPLES, PEAK_SIZE, PEAK_SUM_SQ, RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
-    RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION,
+    RUN_LEAST_THRUST_MARGIN, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION,
+    RUN_MIN_TENSION,
     RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
     RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR, TRACKING_SIZE, run_size)
 
@@ -185,6 +186,7 @@ class RunStatistics:
             run = np.zeros(run_size(n_uavs))
             run[RUN_MIN_TENSION] = math.inf
             run[RUN_MAX_TENSION] = -math.inf
+            run[RUN_SCALARS + RUN_LEAST_THRUST_MARGIN:run_size(n_uavs):RUN_UAV_COLUMNS] = math.inf
         self.run = run
         self.swing = PeakRms(self.run, RUN_SWING)      # payload swing [m]
         self._functions = {name: compiled('accumulators', name) for name in (
@@ -215,6 +217,12 @@ class RunStatistics:
         """Per UAV, time with a rotor held at a speed limit the allocator wanted it beyond
         [s] (not a failed rotor, nor one the reallocation pins at its minimum)."""
         return self._per_uav(RUN_SATURATED_TIME)
+
+    @property
+    def least_thrust_margin(self) -> list[float | None]:
+        """Per UAV, the least share of its largest thrust its commands left, 1 - u_T / u_T,max
+        (rotor effectiveness included; None before a command)."""
+        return [v if math.isfinite(v) else None for v in self._per_uav(RUN_LEAST_THRUST_MARGIN)]
 
     @property
     def min_tension(self) -> float:
@@ -279,6 +287,7 @@ class RunStatistics:
                 'max_abs_constraint_rate': self.max_abs_constraint_rate,
                 'max_rotor_speed': self.max_rotor_speed,
                 'saturated_time': self.saturated_time,
+                'least_thrust_margin': self.least_thrust_margin,
                 'min_tension': self.min_tension,
                 'max_tension': self.max_tension,
                 'simulated_time': self.simulated_time,

@@ -37,7 +37,9 @@ RUN_MAX_ROTOR_SPEED = 0     # its peak commanded rotor speed [rad/s]
 RUN_SATURATED_TIME = 1      # time with a rotor held at a speed limit the allocator wanted it
 #                             beyond (the mixer's `saturated`; not a failed or pinned rotor) [s]
 RUN_SLACK_TIME = 2          # time its cable was slack (cable_model: slack) [s]
-RUN_UAV_COLUMNS = 3
+RUN_LEAST_THRUST_MARGIN = 3  # least share of its largest thrust left by its commands (1 -
+#                              u_T / u_T,max with the rotors' effectiveness; +inf: none yet)
+RUN_UAV_COLUMNS = 4
 
 
 def run_size(n_uavs: int) -> int:

@@ -22,6 +22,8 @@ def summary_row(summary: dict) -> dict:
         'max_abs_g_dot': sim.get('max_abs_constraint_rate'),
         'max_rotor_speed': max(sim['max_rotor_speed']) if sim.get('max_rotor_speed') else None,
         'saturated_time': sum(sim['saturated_time']) if sim.get('saturated_time') else None,
+        'least_thrust_margin': min((m for m in sim.get('least_thrust_margin') or []
+                                    if m is not None), default=None),
         'min_tension': finite(sim.get('min_tension')),
         'max_tension': finite(sim.get('max_tension')),
         'payload_swing_max': sim.get('max_payload_swing'),

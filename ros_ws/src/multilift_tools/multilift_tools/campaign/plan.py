@@ -124,4 +124,4 @@ def load_base(name_or_path: str) -> tuple[str, dict]:
                                         .replace('\n', ' ')) from None
     if not isinstance(base, dict):
         raise scenario_io.ScenarioError(f'{path}: top level: expected a mapping')
-    return str(path), base
+    return str(path), scenario_io.anchored(base, path.parent)

@@ -1,7 +1,8 @@
 """Dryden turbulence (MIL-F-8785C; MIL-HDBK-1797 §B.4.8.2), the continuous von Karman
 approximation of the military specifications, as a seeded series of wind velocities at the
-control rate (issue 21 item 3). No ROS, no numba: the series is drawn once per run, before it
-flies, and the physics holds each sample over its control period (docs/wind.md).
+control rate (issue 21 item 3): the wind model `wind.turbulence` (multilift_sim.wind's registry). No ROS,
+no numba: the series is drawn once per run, before it flies, and the physics holds each sample
+over its control period (docs/wind.md).
 
 With airspeed V (the speed at which the frozen turbulence field passes the formation), length
 scales L and intensities sigma, the one-sided spectra of the three components, over the
@@ -24,6 +25,8 @@ to its left, w up (z up, world frame).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -104,3 +107,36 @@ def dryden_series(samples: int, dt: float, intensity, length_scale, airspeed: fl
     out[:, :2] = np.outer(components[0], along) + np.outer(components[1], left)
     out[:, 2] = components[2]
     return out
+
+
+# -- the wind model `wind.turbulence` (multilift_sim.wind) -------------------------------------
+NAME = 'turbulence'
+UNITS = {'intensity': 'm/s', 'length_scale': 'm', 'airspeed': 'm/s', 'seed': ''}
+
+
+@dataclass(frozen=True)
+class TurbulenceConfig:
+    """Dryden turbulence on top of the steady wind (`wind.turbulence`): components u (along
+    the mean wind), v (to its left), w (up)."""
+    intensity: tuple[float, float, float]     # sigma_u, sigma_v, sigma_w [m/s]
+    length_scale: tuple[float, float, float]  # L_u, L_v, L_w [m]
+    airspeed: float                           # V [m/s]: how fast the field passes
+    seed: int                                 # of the series (a run's seed)
+
+
+def parse(section) -> TurbulenceConfig:
+    """`wind.turbulence`'s keys (a `scenario.reading.Section`)."""
+    return TurbulenceConfig(
+        intensity=section.vector('intensity', check=lambda v: v >= 0, rule='must be >= 0'),
+        length_scale=section.vector('length_scale', check=lambda v: v > 0, rule='must be > 0'),
+        airspeed=section.positive('airspeed'), seed=section.count('seed', 0))
+
+
+def series(config: TurbulenceConfig, scenario: Any, samples: int, dt: float) -> np.ndarray:
+    """`dryden_series` of the config, u along the scenario's steady wind."""
+    return dryden_series(samples, dt, config.intensity, config.length_scale, config.airspeed,
+                         scenario.wind, config.seed)
+
+
+def seed(config: TurbulenceConfig) -> int:
+    return config.seed

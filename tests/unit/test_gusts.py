@@ -1,10 +1,10 @@
-"""disturbances.py: the 1-cosine gust of seed Eq. 2.55 and the air-relative drag of Eq. 2.53."""
+"""wind/gusts.py: the 1-cosine gust of seed Eq. 2.55 and the air-relative drag of Eq. 2.53."""
 import math
 
 import numpy as np
 import pytest
 
-from multilift_sim.disturbances import Gust, gust_velocity, payload_drag
+from multilift_sim.wind.gusts import Gust, gust_velocity, payload_drag
 
 # seed Sec. 4.2: lateral gust at (-4, 6) m, H = 2 m, U_ref = 3 m/s, along +j of the seed
 # (-y of the world)

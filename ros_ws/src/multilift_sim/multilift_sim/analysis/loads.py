@@ -1,0 +1,166 @@
+"""Load shares (issue 35, the seed's §5.2 third suggestion): how a formation shares its payload
+among its cables and what each UAV's rotors have left, from the statics of Eq. 2.73. World frame
+(z up), SI units.
+
+- At hover: the static equilibrium itself (`equilibrium.scenario_equilibrium`: each cable's
+  tension, each UAV's thrust u_T, attitudes and attach points included).
+- Moving: quasi-statically, the whole formation at one acceleration a and velocity v (the
+  mission reference's): in the formation's frame every body feels g e_z + a instead of g e_z,
+  and the payload its drag in still air (Eq. 2.53). The UAVs keep their hover places (the
+  followers hold the geometry); a point payload hangs where its apparent weight and drag take
+  it (the lowest point along them the cables reach: a single lift's swings out fully, a
+  twin-lift's about the UAVs' line, three cables or more pin it; a rigid body's turn and a UAV
+  held off its centre are not solved: their hover only). The tensions then follow from the
+  payload's rows (`equilibrium.payload_multipliers`) over the cables still taut, and UAV i's
+  rotors give u_T,i = |m_i (g e_z + a) - 2 lambda_i d_i| (its row of Eq. 2.73).
+
+A UAV's thrust margin is 1 - u_T / u_T,max, u_T,max its rotors' thrust at rotor_speed_max (Eq.
+2.9): the share of its largest thrust left. Transients (a payload swinging after a corner, the
+controllers' overshoot) are not in it: the run summary's least thrust margin measures them.
+With four cables or more the statics are indeterminate; the least-norm tensions are the
+formation's when the UAVs are equal and symmetric, not in general.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from multilift_sim.analysis.coordinates import cable_offsets
+from multilift_sim.analysis.equilibrium import (payload_multipliers, scenario_configuration,
+                                                scenario_equilibrium)
+from multilift_sim.constraints import cable_tension
+from multilift_sim.scenario import Scenario
+
+TAUT = 1e-6  # a cable within this share of its length of taut carries load [-]
+
+
+@dataclass(frozen=True)
+class LoadShares:
+    """Each cable's tension and each UAV's thrust under one (quasi-)static load."""
+    acceleration: np.ndarray    # a (3,) [m/s^2], world: the formation's
+    tensions: np.ndarray        # T_i (n,) [N]
+    thrusts: np.ndarray         # u_T,i (n,) [N]
+    largest_thrusts: np.ndarray  # u_T,max,i (n,) [N]: every rotor at rotor_speed_max
+
+    @property
+    def margins(self) -> np.ndarray:
+        """1 - u_T / u_T,max (n,) [-]: negative where the rotors cannot give the thrust."""
+        return 1.0 - self.thrusts / self.largest_thrusts
+
+
+def largest_thrusts(scenario: Scenario) -> np.ndarray:
+    """u_T,max (n,) [N]: each UAV's rotors all at rotor_speed_max (Eq. 2.9)."""
+    return np.array([u.vehicle.collective_thrust(np.full(u.vehicle.n_rotors,
+                                                         u.vehicle.rotor_speed_max))
+                     for u in scenario.uavs])
+
+
+def hover_loads(scenario: Scenario) -> LoadShares:
+    """The shares at the formation's hanging rest (Eq. 2.73 exactly; ValueError as
+    `static_equilibrium` raises it where the formation cannot hover)."""
+    equilibrium = scenario_equilibrium(scenario)
+    return LoadShares(np.zeros(3), equilibrium.tensions, equilibrium.wrenches[:, 0].copy(),
+                      largest_thrusts(scenario))
+
+
+class QuasiStatic:
+    """The quasi-static shares of one scenario's formation (the module's docstring), its hover
+    configuration computed once: `loads(acceleration, velocity)` per instant."""
+
+    def __init__(self, scenario: Scenario):
+        self.params = scenario.formation_params(0.0, 0.0)
+        if self.params.rigid_payload or self.params.uav_attach_points is not None:
+            raise ValueError('quasi-static loads under acceleration are solved for a point '
+                             'payload on cables from the UAVs\' centres (a rigid body would '
+                             'turn, a UAV held off its centre tilt): hover loads only')
+        self.uavs, self.hover_payload = scenario_configuration(scenario)
+        self.lengths = np.asarray(self.params.cable_lengths, dtype=float)
+        self.masses = np.array([u.vehicle.mass for u in scenario.uavs])
+        self.largest = largest_thrusts(scenario)
+
+    def loads(self, acceleration: ArrayLike, velocity: ArrayLike = (0.0, 0.0, 0.0)
+              ) -> LoadShares:
+        """The shares with the formation at `acceleration` [m/s^2] and `velocity` [m/s],
+        world, in still air. ValueError where no cable holds the payload."""
+        params = self.params
+        a = np.asarray(acceleration, dtype=float).reshape(3)
+        v = np.asarray(velocity, dtype=float).reshape(3)
+        effective = np.array([0.0, 0.0, params.gravity]) + a     # g e_z + a [m/s^2]
+        speed = float(np.linalg.norm(v))
+        # what the cables must give the payload [N]: m_p (g e_z + a) less its drag (Eq. 2.53)
+        load = params.payload_mass * effective + params.payload_drag_coefficient * speed * v
+        payload = _hang(self.uavs, self.hover_payload, self.lengths, load)
+        offsets = cable_offsets(params, self.uavs, payload, None)  # d_i, (n, 3)
+        taut = np.linalg.norm(offsets, axis=1) >= self.lengths * (1.0 - TAUT)
+        if not taut.any():
+            raise ValueError('every cable is slack: the payload falls')
+        multipliers = np.zeros(len(self.lengths))
+        multipliers[taut] = payload_multipliers(params, offsets[taut], None, load,
+                                                tolerance=1e-6)
+        forces = self.masses[:, None] * effective - 2.0 * multipliers[:, None] * offsets
+        return LoadShares(a, cable_tension(multipliers, self.lengths),
+                          np.linalg.norm(forces, axis=1), self.largest)
+
+
+def _hang(uavs: np.ndarray, start: np.ndarray, lengths: np.ndarray,
+          load: np.ndarray) -> np.ndarray:
+    """Where a point payload hangs with its cables from `uavs` (n, 3) [m] when they must give
+    it `load` [N] (its apparent weight and drag): the lowest point along -load within every
+    cable's reach. A linear
+    potential over the balls' intersection is least on its boundary, where one cable (the end
+    of a straight cable), two (the lowest point of their circle) or three (a corner of the
+    spheres) are at their length: the lowest candidate every cable reaches. `start` (the hover
+    place) when none is (the cables cannot all reach one point)."""
+    down = -load / np.linalg.norm(load)  # where the apparent weight and the drag pull
+    n = len(lengths)
+    candidates = [uavs[i] + lengths[i] * down for i in range(n)]
+    for i in range(n):
+        for j in range(i + 1, n):
+            circle = _circle(uavs[i], lengths[i], uavs[j], lengths[j])
+            if circle is None:
+                continue
+            centre, axis, radius = circle
+            across = down - (down @ axis) * axis
+            if np.linalg.norm(across) > 1e-12:
+                candidates.append(centre + radius * across / np.linalg.norm(across))
+            for k in range(j + 1, n):
+                candidates.extend(_corners(circle, uavs[k], lengths[k]))
+    reached = [p for p in candidates
+               if np.all(np.linalg.norm(p - uavs, axis=1) <= lengths * (1.0 + 1e-9))]
+    if not reached:
+        return np.asarray(start, dtype=float)
+    return max(reached, key=lambda p: float(down @ p))
+
+
+def _circle(a: np.ndarray, ra: float, b: np.ndarray, rb: float):
+    """The circle where spheres (a, ra) and (b, rb) meet: (centre, unit axis a -> b, radius),
+    or None."""
+    span = b - a
+    distance = float(np.linalg.norm(span))
+    if distance == 0.0 or distance > ra + rb or distance < abs(ra - rb):
+        return None
+    axis = span / distance
+    along = (distance ** 2 + ra ** 2 - rb ** 2) / (2.0 * distance)
+    return a + along * axis, axis, float(np.sqrt(max(ra ** 2 - along ** 2, 0.0)))
+
+
+def _corners(circle, c: np.ndarray, rc: float) -> list[np.ndarray]:
+    """The points of `circle` (centre, axis, radius) at distance rc from c."""
+    centre, axis, radius = circle
+    offset = c - centre
+    height = float(offset @ axis)                 # c above the circle's plane
+    flat = offset - height * axis
+    reach = float(np.linalg.norm(flat))
+    # |p - c|^2 = radius^2 + reach^2 + height^2 - 2 radius reach cos(angle) = rc^2
+    if reach == 0.0:
+        return []
+    cosine = (radius ** 2 + reach ** 2 + height ** 2 - rc ** 2) / (2.0 * radius * reach) \
+        if radius > 0.0 else 2.0
+    if abs(cosine) > 1.0:
+        return []
+    e1 = flat / reach
+    e2 = np.cross(axis, e1)
+    sine = float(np.sqrt(1.0 - cosine ** 2))
+    return [centre + radius * (cosine * e1 + sign * sine * e2) for sign in (1.0, -1.0)]

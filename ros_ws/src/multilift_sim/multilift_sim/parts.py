@@ -92,8 +92,11 @@ def import_parts(paths: tuple[str, ...]) -> None:
 
 
 def load() -> None:
-    """Import the shipped parts of the `multilift.parts` entry points (each once per
-    process)."""
+    """Import the shipped parts of the `multilift.parts` entry points, once per process (the
+    scan of the installed packages' metadata costs tens of milliseconds)."""
+    if _entries:
+        return
+    _entries.add(ENTRY_POINTS)
     for entry in importlib.metadata.entry_points(group=ENTRY_POINTS):
         if entry.value not in _entries:
             _entries.add(entry.value)

@@ -104,7 +104,8 @@ VECTOR_RULES = {  # key -> element rule for valid values (None: any finite), inv
                                      st.one_of(st.floats(min_value=20.01, max_value=1e12),
                                                st.floats(min_value=-1e12, max_value=-20.01))),
 }
-CHOICE_RULES = {'vehicle.frame_type': FRAME_TYPES, 'control.mode': scenario_io.CONTROL_MODES}
+CHOICE_RULES = {'vehicle.frame_type': FRAME_TYPES,
+                'control.mode': tuple(scenario_io.leader_controllers())}
 REQUIRED = ['name', 'simulation', 'simulation.duration', 'simulation.physics_rate',
             'simulation.control_rate', 'simulation.baumgarte_alpha',
             'simulation.baumgarte_beta', 'simulation.constraint_tolerance',
@@ -375,14 +376,14 @@ def test_non_finite_rotor_command_stops_the_simulator_naming_the_uav(bad):
 
 def test_nan_from_a_controller_stops_a_headless_run(monkeypatch):
     from multilift_control import controllers
-    original = controllers.MissionLeader.update
+    original = controllers.LeaderController.update
 
     def broken(self, t, state):
         out, ref = original(self, t, state)
         if t >= 0.5:
             out.rotor_speeds[0] = math.nan
         return out, ref
-    monkeypatch.setattr(controllers.MissionLeader, 'update', broken)
+    monkeypatch.setattr(controllers.LeaderController, 'update', broken)
     with pytest.raises(SimulationStopped, match=r'uav1: rotor command is not finite .* '
                                                 r'at t = 0\.500 s'):
         run_headless(scenario_io.load('single_lift'))

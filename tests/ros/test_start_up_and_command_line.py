@@ -70,7 +70,7 @@ def test_controller_nodes_load_the_compiled_laws_unless_told(setting, expected):
             'from multilift_sim import kernels, scenario\n'
             's = scenario.load("twin_lift")\n'
             'prepare_node_laws(s, 1)\n'
-            'law = ControllerRuntime(s, 1).follower._tick\n'
+            'law = ControllerRuntime(s, 1).follower._answer\n'
             'kind = ("uncompiled" if not hasattr(law, "py_func") else\n'
             '        "just-in-time" if len(law.signatures) > 0 else "not loaded")\n'
             'print(kernels.mode(), kind)\n')

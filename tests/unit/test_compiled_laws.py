@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from multilift_control import laws
-from multilift_control.controllers import MissionLeader
+from multilift_control.controllers import LeaderController
 from multilift_control.formation import FormationFollower
 from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_control.headless import run_headless
@@ -117,7 +117,7 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
     check = Checker()
     rng = np.random.default_rng(7)
     twin = scenario_io.load('twin_lift')
-    leader = MissionLeader(twin, 0)
+    leader = LeaderController(twin, 0)
     c, m = leader.cascade.constants, leader.cascade.mixer.rows
     damped = c.copy()  # with the swing feedback (control.payload_feedback) on
     damped[CASCADE_SWING_STIFFNESS], damped[CASCADE_SWING_DAMPING] = 0.8, 0.3

@@ -127,3 +127,45 @@ def test_answers_from_outside_fly_the_engine_s_own_tick_to_the_bit():
     assert commanded.memory.tick.tolist() == [0, 41]
     with pytest.raises(ValueError, match='speeds must be'):
         commanded.step_commanded(np.zeros((2, 3, 3)))
+
+
+def _hexa_beside_quads(name: str, duration: float, hexa: int) -> scenario_io.Scenario:
+    """Scenario `name` with UAV `hexa` (from 0) a hexa_x, the others its quads."""
+    import yaml
+    data = yaml.safe_load(scenario_io.resolve(name).read_text())
+    data['simulation']['duration'] = duration
+    data['uavs'][hexa] = dict(data['uavs'][hexa] or {}, frame_type='hexa_x')
+    return scenario_io.loads(yaml.safe_dump(data))
+
+
+@pytest.mark.parametrize('hexa', [0, 1])
+def test_mixed_rotor_counts_fly_in_the_engine_as_the_per_object_run(hexa):
+    """A hexa beside quads: each UAV's rotors padded to the formation's most, the padding
+    never answered (0, not saturated): the engine flies it to the per-object run's bits."""
+    scenario = _hexa_beside_quads('twin_lift', 6.0, hexa)
+    assert sorted({u.vehicle.n_rotors for u in scenario.uavs}) == [4, 6]
+    engine = Engine(scenario)
+    record = engine.new_record(50)
+    engine.step(50, record)
+    quad = 1 - hexa  # its padding: 0, not saturated
+    assert not record.speeds[:, 0, quad, 4:].any() and not record.saturated[:, 0, quad, 4:].any()
+    assert record.speeds[:, 0, hexa, 4:].min() > 0  # the hexa's last two rotors answered
+    engine.step(10 ** 6)
+    run = run_headless(scenario)
+    assert engine.finished[0]
+    assert np.array_equal(engine.state[0], run.simulator.state)
+    expected = run.summary()
+    del expected['sim']['wall_time']
+    assert engine.summary(0) == expected
+
+
+def test_a_batch_of_mixed_rotor_counts_equals_its_formations_alone():
+    """hexa + quad beside quad + hexa: one batch (the same shapes), each formation's padding
+    its own."""
+    scenarios = [_hexa_beside_quads('twin_lift', 3.0, hexa) for hexa in (0, 1)]
+    batch = Engine(scenarios)
+    batch.step(10 ** 6)
+    for b, scenario in enumerate(scenarios):
+        single = Engine(scenario)
+        single.step(10 ** 6)
+        assert np.array_equal(batch.state[b], single.state[0])

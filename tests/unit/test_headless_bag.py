@@ -76,3 +76,14 @@ def test_state_rows_are_the_snapshots_numbers():
     n = scenario.n_uavs
     assert snapshot[0, 9 * n:12 * n].tolist() == np.concatenate(
         [u.body_rates for u in snap.uavs]).tolist()
+
+
+def test_a_hexa_beside_a_quad_writes_the_per_object_path_s_bag(tmp_path, monkeypatch):
+    """Mixed rotor counts: the engine's padded rows written as each UAV's own rotors."""
+    import yaml
+    data = yaml.safe_load(scenario_io.resolve('twin_lift').read_text())
+    data['simulation']['duration'] = 0.6
+    data['uavs'][1] = {'frame_type': 'hexa_x'}
+    engine_run, object_run = _same_bags(tmp_path, scenario_io.loads(yaml.safe_dump(data)), 16,
+                                        monkeypatch)
+    assert engine_run.error is None and object_run.error is None

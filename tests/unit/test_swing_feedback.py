@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from multilift_control import laws
-from multilift_control.controllers import MissionLeader, swing_period, swing_rest
+from multilift_control.controllers import LeaderController, swing_period, swing_rest
 from multilift_control.engine import Engine
 from multilift_control.headless import run_headless
 from multilift_control.laws.layout import (CASCADE_SWING_DAMPING, CASCADE_SWING_LIMIT,
@@ -93,7 +93,7 @@ def test_the_rest_offset_is_the_hanging_formation_s():
     uavs, payload = formation_start(scenario)
     assert swing_rest(scenario) == pytest.approx((payload - uavs.mean(axis=0))[:2], abs=1e-12)
     assert swing_rest(scenario_io.load('single_lift')) == (0.0, 0.0)
-    leader = MissionLeader(_with_feedback('twin_lift', 0.75, 0.25), 0)
+    leader = LeaderController(_with_feedback('twin_lift', 0.75, 0.25), 0)
     assert leader.cascade.constants[CASCADE_SWING_REST:CASCADE_SWING_REST + 2] == \
         pytest.approx(swing_rest(scenario), abs=0)
 
@@ -116,11 +116,11 @@ def test_a_leader_without_the_payload_state_refuses_to_guess():
     scenario = _with_feedback('twin_lift', 0.75, 0.25)
     states = uav_states(FormationSimulator(scenario).snapshot())
     bare = type(states)(states)  # the UAVs only
-    leader = MissionLeader(scenario, 0)
+    leader = LeaderController(scenario, 0)
     with pytest.raises(ValueError, match='payload_feedback needs the payload'):
         leader.update(0.0, bare)
     leader.update(0.0, states)
-    seed = MissionLeader(scenario_io.load('twin_lift'), 0)
+    seed = LeaderController(scenario_io.load('twin_lift'), 0)
     seed.update(0.0, bare)  # the seed's law does not read it
 
 
@@ -129,7 +129,7 @@ def test_a_leader_answers_its_own_state_alone_as_before_the_feedback():
     leader one UavState: answered as the formation of one, the same as the stacked call."""
     scenario = scenario_io.load('single_lift')
     states = uav_states(FormationSimulator(scenario).snapshot())
-    alone, stacked = MissionLeader(scenario, 0), MissionLeader(scenario, 0)
+    alone, stacked = LeaderController(scenario, 0), LeaderController(scenario, 0)
     for t in (0.0, 0.01, 0.02):
         output, reference = alone.update(t, states[0])
         expected, expected_reference = stacked.update(t, type(states)(states[:1]))
@@ -250,8 +250,8 @@ def test_the_feedback_yields_to_the_rotor_limits():
     """A share 1, 1/2, 1/4 of m a_s that saturates no rotor is flown; where all three would,
     the leader flies the seed's command (its integral advanced once either way)."""
     scenario = _with_feedback('twin_lift', 0.75, 0.25)
-    leader = MissionLeader(scenario, 0)
-    seed = MissionLeader(scenario_io.load('twin_lift'), 0)
+    leader = LeaderController(scenario, 0)
+    seed = LeaderController(scenario_io.load('twin_lift'), 0)
     states = uav_states(FormationSimulator(scenario).snapshot()).array.copy()
     rest = np.array(formation_start(scenario)[1])
     law = laws.runnable(cascade_law.leader_update)

@@ -20,7 +20,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 
 from multilift_control.cascade import FormationStates, UavState
-from multilift_control.controllers import make_controller
+from multilift_control.controllers import LeaderController
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import odometry_arrays
 
@@ -29,7 +29,7 @@ class ExampleLeader(Node):
     def __init__(self) -> None:
         super().__init__('example_leader')
         name = self.declare_parameter('scenario', 'single_lift').value
-        self.controller = make_controller(scenario_io.load(name), index=0)
+        self.controller = LeaderController(scenario_io.load(name), index=0)
         self.command_pub = self.create_publisher(RotorCommand, '/uav1/rotor_cmd', 10)
         self.create_subscription(Odometry, '/uav1/odom', self.on_odometry, 10)
         self.answered = 0

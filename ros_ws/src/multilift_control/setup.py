@@ -17,6 +17,8 @@ setup(
     description='Leader cascade controller and virtual-constraint follower nodes of multilift.',
     license='Apache-2.0',
     entry_points={
+        # the parts multilift_sim's scenario validation finds (multilift_sim.parts)
+        'multilift.parts': ['controllers = multilift_control.controllers'],
         'console_scripts': [
             'leader_node = multilift_control.ros.leader_node:main',
             'follower_node = multilift_control.ros.follower_node:main',

@@ -20,7 +20,6 @@ import numpy as np
 
 from multilift_control.cascade import balancing_rotor_speed
 from multilift_control.engine import Engine
-from multilift_control.engine.arrays import engine_flies
 from multilift_control.runtime import (ControllerAnswer, ControllerRuntime, answer_tick,
                                        formation_runtimes, uav_states)
 from multilift_sim.scenario import Scenario
@@ -111,15 +110,11 @@ def progress_ticker(progress: Callable[[float, float], None],
 
 
 def fly(scenario: Scenario, progress: Callable[[float, float], None] | None = None,
-        raise_on_stop: bool = True) -> FlownRun | HeadlessRun:
+        raise_on_stop: bool = True) -> FlownRun:
     """Fly `scenario` to t_max through the engine: the whole mission in one compiled call, or
-    PROGRESS_TICKS at a time with `progress(t, t_max)` [s] after each (what the engine does not
-    fly, `engine.arrays.not_flown`, goes tick by tick: `run_headless`). A simulation that stops
+    PROGRESS_TICKS at a time with `progress(t, t_max)` [s] after each. A simulation that stops
     itself raises SimulationStopped (its message the simulator's), or with raise_on_stop=False
     ends the run with `error` set."""
-    if not engine_flies(scenario):  # tick by tick: the same tick, another integrator
-        return run_headless(scenario, None if progress is None else progress_ticker(progress),
-                            raise_on_stop)
     start = time.monotonic()
     engine = Engine(scenario)
     run = FlownRun(scenario, engine)

@@ -18,9 +18,8 @@ import numpy as np
 
 from multilift_control import laws
 from multilift_control.cascade import ControlOutput, FormationStates, UavState
-from multilift_control.controllers import make_controller
+from multilift_control.controllers import FollowerController, LeaderController
 from multilift_control.faults import FaultReallocation
-from multilift_control.formation import FormationFollower
 from multilift_control.laws.follower import lift_vectors
 from multilift_control.laws.layout import UAV_BODY_RATES, UAV_EULER, UAV_POSITION, UAV_VELOCITY
 from multilift_control.laws.mixer import collective_thrust
@@ -95,8 +94,9 @@ class ThrustBook:
 
 
 class ControllerRuntime:
-    """UAV `index`'s controller (0: the leader of `control.mode`, else a virtual-constraint
-    follower) with its bookkeeping and its run statistics."""
+    """UAV `index`'s controller (0: the leader of `control.mode`, else the follower of
+    `control.follower`: `multilift_control.controllers`) with its bookkeeping and its run
+    statistics."""
 
     def __init__(self, scenario: Scenario, index: int, thrusts: ThrustBook | None = None):
         """`thrusts`: a follower's ThrustBook, shared by the followers of one process
@@ -106,11 +106,11 @@ class ControllerRuntime:
         self._period_ns = int(round(1e9 / scenario.simulation.control_rate))
         self._faults = FaultReallocation(scenario, index)
         if self.is_follower:
-            self.follower = FormationFollower.from_scenario(scenario, index)
+            self.follower = FollowerController(scenario, index)
             self.thrusts = ThrustBook(scenario) if thrusts is None else thrusts
             self.statistics = FormationErrorStatistics()
         else:
-            self.leader = make_controller(scenario, index)
+            self.leader = LeaderController(scenario, index)
             self.statistics = TrackingStatistics()
 
     @property
@@ -130,10 +130,9 @@ class ControllerRuntime:
     def answer(self, t_ns: int, states: Sequence[UavState]) -> ControllerAnswer:
         """The answer to the formation state at t_ns (`states`: every UAV, from the leader)."""
         t = t_ns * 1e-9
-        cascade = self.follower.cascade if self.is_follower else getattr(self.leader, 'cascade',
-                                                                         None)
+        controller = self.follower if self.is_follower else self.leader
         # the faults known from their tick on: this UAV's rotors, a follower's cable released
-        self._faults.at(t_ns // self._period_ns, None if cascade is None else cascade.mixer,
+        self._faults.at(t_ns // self._period_ns, controller.cascade.mixer,
                         self.follower.constraints if self.is_follower else None)
         if not self.is_follower:
             output, reference = self.leader.update(t, states)

@@ -28,7 +28,8 @@ from typing import Any, Callable
 # the subpackages of numba kernels, in any multilift_* package (physics and statistics here,
 # the laws and the engine's tick above): numba compiles a kernel together with the kernels it
 # calls from other files, but checks a cached kernel against its own file only
-KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine', 'events', 'sensors')
+KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine', 'events', 'sensors', 'controllers',
+                  'controllers/leaders', 'controllers/followers')
 CACHE_ROOT = (Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache')
               / 'multilift' / 'numba')
 
@@ -89,17 +90,22 @@ def prune_cache(days: float = 7.0) -> list[Path]:
     return stale
 
 
-def jit(function: Callable) -> Callable:
+def jit(function: Callable | None = None, *, inline: bool = False) -> Callable:
     """The decorator of every kernel (physics, statistics, the laws, the engine's tick):
     numba's njit with its on-disk cache and IEEE arithmetic in the source's order (no
     fastmath), or the function itself where numba does not import (then only its uncompiled
-    run exists)."""
+    run exists). `@jit(inline=True)`: numba inlines it into its compiled callers (its IR, the
+    same arithmetic), which spares a call that passes a batch's tuples of arrays (each array's
+    reference counted in and out)."""
+    if function is None:
+        return lambda f: jit(f, inline=inline)
     try:
         _import_numba_quietly()
         import numba
     except ImportError:  # pragma: no cover - numba is a dependency; the pure run still works
         return function
-    return numba.njit(cache=True, fastmath=False, nogil=True)(function)
+    return numba.njit(cache=True, fastmath=False, nogil=True,
+                      inline='always' if inline else 'never')(function)
 
 
 def mode() -> str:

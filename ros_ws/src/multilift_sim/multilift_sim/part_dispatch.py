@@ -21,15 +21,14 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
-import inspect
 import os
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from types import ModuleType
-from typing import Any, Callable
+from typing import Callable
 
 from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
+from multilift_sim import parts
 from multilift_sim.kernels import kernel_modules
 
 BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
@@ -48,19 +47,15 @@ class GeneratedDispatcher:
     caller: str
     parts: Callable[[], dict]        # the registry as it is
     shipped: Callable[[], tuple]     # the parts shipped, in their order
-    _loaded: dict[str, ModuleType] = field(default_factory=dict)
 
     def steps(self) -> list[Callable]:
-        return [_python(getattr(part, self.step)) for part in self.parts().values()]
+        return [parts.python(getattr(part, self.step)) for part in self.parts().values()]
 
     def digest(self) -> str:
         """A digest of the registered parts: their names, order and sources (each step's
-        module, name and file)."""
-        digest = hashlib.sha256()
-        for name, python in zip(self.parts(), self.steps()):
-            digest.update(f'{name}\0{python.__module__}.{python.__qualname__}\0'.encode())
-            digest.update(Path(inspect.getsourcefile(python)).read_bytes())
-        return digest.hexdigest()[:16]
+        module, name and file: `parts.source_digest`)."""
+        return parts.source_digest({name: getattr(part, self.step)
+                                    for name, part in self.parts().items()})
 
     def source(self) -> str:
         """The generated dispatcher's source for the registry as it is."""
@@ -82,23 +77,11 @@ class GeneratedDispatcher:
 
     def compiled(self) -> Callable:
         """The registry's compiled dispatcher, its file written once per source (named by the
-        source's digest)."""
+        source's digest, `parts.generated_module`)."""
         source = self.source()
         key = hashlib.sha256(source.encode()).hexdigest()[:16]
-        if key not in self._loaded:
-            path = BASE_CACHE / self.label / f'{self.function}_{key}.py'
-            if not path.exists() or path.read_text() != source:
-                path.parent.mkdir(parents=True, exist_ok=True)
-                partial = path.with_suffix(f'.{os.getpid()}.tmp')
-                partial.write_text(source)
-                os.replace(partial, path)  # whole, for a process importing it at the same time
-            name = f'multilift_{self.label}_dispatch_{key}'
-            spec = importlib.util.spec_from_file_location(name, path)
-            module = importlib.util.module_from_spec(spec)
-            sys.modules[name] = module
-            spec.loader.exec_module(module)
-            self._loaded[key] = module
-        return getattr(self._loaded[key], self.function)
+        return getattr(parts.generated_module(self.label, f'{self.function}_{key}', source),
+                       self.function)
 
     def is_shipped(self) -> bool:
         """Whether the registry holds the shipped parts only, in their order."""
@@ -116,12 +99,9 @@ def add(dispatcher: GeneratedDispatcher) -> GeneratedDispatcher:
 
 
 def cache_folder() -> Path:
-    """numba's cache folder for the registries as they are (see the module docstring)."""
-    if all(d.is_shipped() for d in DISPATCHERS):
-        return BASE_CACHE
-    digest = hashlib.sha256('\0'.join(f'{d.label}:{d.digest()}' for d in DISPATCHERS)
-                            .encode()).hexdigest()[:16]
-    return BASE_CACHE / f'parts-{digest}'
+    """numba's cache folder for the registries as they are (`parts.cache_folder`: these
+    dispatchers and the controllers' registries alike)."""
+    return parts.cache_folder()
 
 
 def refresh(dispatcher: GeneratedDispatcher) -> None:
@@ -155,43 +135,6 @@ def refresh(dispatcher: GeneratedDispatcher) -> None:
                 step._reset_overloads()
     setattr(module, dispatcher.function, dispatcher.compiled())
     if Dispatcher is not None:
-        for function in callers(getattr(module, dispatcher.caller), Dispatcher):
+        for function in parts.callers([getattr(module, dispatcher.caller)], Dispatcher):
             function.enable_caching()  # at the registries' folder
             function._reset_overloads()
-
-
-def callers(target: Any, kind: type) -> list[Any]:
-    """`target` and every compiled function (a `kind` of dispatcher) of a loaded multilift
-    module that calls it, directly or through others (by a global name, or a module's
-    attribute)."""
-    functions = []
-    for name, module in list(sys.modules.items()):
-        if name.startswith('multilift_') and module is not None:
-            functions += [value for value in vars(module).values() if isinstance(value, kind)]
-    reached = {id(target): target}
-    grew = True
-    while grew:
-        grew = False
-        for function in functions:
-            if id(function) in reached:
-                continue
-            if any(id(value) in reached for value in _referenced(function)):
-                reached[id(function)] = function
-                grew = True
-    return list(reached.values())
-
-
-def _python(function: Callable) -> Callable:
-    return getattr(function, 'py_func', function)
-
-
-def _referenced(function: Any) -> list[Any]:
-    python = _python(function)
-    names = python.__code__.co_names
-    found = []
-    for name in names:
-        value = python.__globals__.get(name)
-        found.append(value)
-        if isinstance(value, ModuleType):
-            found += [getattr(value, other, None) for other in names]
-    return found

@@ -9,9 +9,8 @@ ticks per compiled call into a `TickRecord`, and packs each tick's messages from
 rows (`EngineBag`): the state at t and every answer to it, then `/formation/state` (the
 tension of the integration that starts at t, g and g_dot at t) and every MARKER_DECIMATION-th
 tick the markers. The state at t_max has no answers; its `/formation/state` is solved under the
-commands held since the tick before, as the simulator node does. A scenario the engine does not
-fly (another integrator, UAVs of different rotor counts) goes tick by tick through the objects
-the nodes use (`HeadlessBag` on `run_headless`), which writes the same bag.
+commands held since the tick before, as the simulator node does. `HeadlessBag` writes the same
+bag tick by tick from `run_headless` (the objects the nodes use).
 """
 from __future__ import annotations
 
@@ -23,7 +22,7 @@ import numpy as np
 
 from multilift_control.answer_messages import AnswerMessages
 from multilift_control.engine import Engine
-from multilift_control.engine.arrays import MODE_CASCADE, TickRecord, engine_flies
+from multilift_control.engine.arrays import TickRecord
 from multilift_control.headless import FlownRun, HeadlessRun, progress_ticker, run_headless
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
@@ -71,7 +70,14 @@ class EngineBag:
         arrays = engine.arrays
         self._period_ns = int(arrays.period_ns[0])
         self._own_rows = arrays.own_rows[0].tolist()
-        self._reference = int(arrays.leader_mode[0]) == MODE_CASCADE
+        self._reference = bool(arrays.leader_tracks[0])  # its part's TRACKS_MISSION
+        # each UAV's rotors of the record's padded (n, rotors) rows: all, or (mixed rotor
+        # counts) the real ones (`engine.arrays.ControlArrays`)
+        counts = arrays.rotor_counts[0].tolist()
+        rotors = arrays.allocation.shape[-1]
+        self._counts = None if min(counts) == rotors else counts
+        self._real = np.concatenate([i * rotors + np.arange(c) for i, c in enumerate(counts)])
+        self._edges = np.cumsum(counts)[:-1]  # each UAV's speeds in a row of the real ones
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
@@ -96,6 +102,8 @@ class EngineBag:
             else [None] * count
         speeds = record.speeds[:count, 0]
         flat = speeds.reshape(count, -1)
+        if self._counts is not None:
+            flat = flat[:, self._real]
         if self._held is None:  # from t = 0: no rotor speeds held yet
             snapshots = [snapshots[0].tolist()] + np.concatenate(
                 (snapshots[1:], flat[:-1]), axis=1).tolist()
@@ -121,6 +129,9 @@ class EngineBag:
             payload_velocity = payload_velocity.tolist()
         gusts = record.gust[:count, 0].tolist()
         speed_lists, saturated = speeds.tolist(), record.saturated[:count, 0].tolist()
+        if self._counts is not None:
+            speed_lists, saturated = ([[row[:c] for row, c in zip(uavs, self._counts)]
+                                       for uavs in lists] for lists in (speed_lists, saturated))
         setpoints, thrusts = record.setpoints[:count, 0].tolist(), record.thrust[:count, 0].tolist()
         references = record.reference[:count, 0].tolist()
         errors = [record.errors[:count, 0, i, :rows[i]].tolist() for i in range(n)]
@@ -176,7 +187,7 @@ class EngineBag:
         model.effectiveness[:] = memory.effectiveness[0]
         if len(engine.arrays.wind_series[0]):  # the last tick's wind, as FormationSimulator's
             model.set_wind(self._wind[tick])
-        held = list(self._held.reshape(n, -1)) if self._held is not None else None
+        held = (np.split(self._held, self._edges) if self._held is not None else None)
         tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
@@ -249,14 +260,12 @@ class HeadlessBag:
 
 
 def record_headless(scenario: Scenario, bag_dir: Path, progress: Progress | None = None,
-                    raise_on_stop: bool = True) -> FlownRun | HeadlessRun:
+                    raise_on_stop: bool = True) -> FlownRun:
     """Fly `scenario` without ROS and write every topic of a ROS run to `bag_dir`: the
     simulator's state and every controller's answer as the nodes publish them;
     `progress(t, t_max)` [s] every CHUNK_TICKS ticks. A simulation that stops itself raises
     SimulationStopped once its ticks are written, or with raise_on_stop=False ends the run with
     `error` set (as `multilift_control.headless.fly`)."""
-    if not engine_flies(scenario):
-        return _record_per_object(scenario, bag_dir, progress, raise_on_stop)
     start = time.monotonic()
     engine = Engine(scenario)
     run = FlownRun(scenario, engine)
@@ -288,8 +297,7 @@ def record_headless(scenario: Scenario, bag_dir: Path, progress: Progress | None
 def _record_per_object(scenario: Scenario, bag_dir: Path, progress: Progress | None = None,
                        raise_on_stop: bool = True) -> HeadlessRun:
     """`record_headless` tick by tick through the objects the nodes use (`run_headless`
-    observed by `HeadlessBag`): for what the engine does not fly, and the reference the
-    engine's bag is tested against."""
+    observed by `HeadlessBag`): the reference the engine's bag is tested against."""
     writer = BagWriter(bag_dir)
     bag = HeadlessBag(scenario, writer)
     simulator: list[FormationSimulator] = []

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from multilift_control.controllers import MissionLeader
+from multilift_control.controllers import LeaderController
 from multilift_sim.analysis.loads import LoadShares, QuasiStatic, hover_loads
 from multilift_sim.scenario import Scenario, ScenarioError, load
 from multilift_tools.plot_style import Parser, parse_args
@@ -22,9 +22,9 @@ from multilift_tools.plot_style import Parser, parse_args
 
 def mission_loads(scenario: Scenario) -> list[tuple[float, LoadShares]]:
     """(t [s], the quasi-static shares) at every control tick of the leader's reference
-    (`MissionLeader`'s path: filters and input shaping as flown); instants with the same
+    (`LeaderController`'s path: filters and input shaping as flown); instants with the same
     reference acceleration and velocity share one solve."""
-    path = MissionLeader(scenario, 0).path
+    path = LeaderController(scenario).path
     statics = QuasiStatic(scenario)
     solved: dict[tuple, LoadShares] = {}
     out = []

@@ -1,10 +1,12 @@
 """The arrays of B formations the compiled tick reads and writes, named once (the engine's
 layout). Every field has the batch axis first; the formations of one batch share their shapes
-(n UAVs, rotors per UAV, gusts, mission segments, virtual-constraint rows), not their values.
+(n UAVs, the most rotors of a UAV, gusts, mission segments, virtual-constraint rows, the
+controllers' arrays), not their values.
 
 They are built from each scenario by the physics' `multilift_sim.tick_arrays.physics_fields`
-and through the objects the per-process runtime uses (`MissionLeader`, `FormationFollower`,
-`ThrustBook`), so a formation's numbers have one source. Units: SI, world frame z up
+and by the controllers' parts (`multilift_control.controllers`: each part's `arrays`, the
+vehicles' cascades, the formation's rows) and `ThrustBook`, as the per-process runtime builds
+them, so a formation's numbers have one source. Units: SI, world frame z up
 (docs/conventions.md).
 """
 from __future__ import annotations
@@ -15,25 +17,17 @@ from typing import NamedTuple
 
 import numpy as np
 
-from multilift_control.controllers import LEADER_CONTROLLERS, ConstantRotorSpeed, MissionLeader
+from multilift_control.controllers import (FOLLOWER_CONTROLLERS, LEADER_CONTROLLERS,
+                                           LeaderController, follower_part, formation_rows,
+                                           law_index, leader_part, vehicle_cascade)
 from multilift_control.faults import fault_mixers, mixer_uavs, target_schedule
-from multilift_control.formation import FormationFollower
-from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_MEMORY_SIZE,
-                                           FOLLOWER_SIZE, FOLLOWER_TWO_ALPHA, REFERENCE_SIZE,
-                                           ROW_SIZE, UAV_STATE_SIZE)
+from multilift_control.laws.layout import MIXER_SIZE, REFERENCE_SIZE, ROW_SIZE, UAV_STATE_SIZE
 from multilift_control.runtime import ThrustBook
 from multilift_sim.physics.layout import (STATUS_FINISHED, STATUS_NOT_FINITE,
-                                          STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING,
-                                          UAV_MASS)
+                                          STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
 from multilift_sim.scenario import Scenario
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
 from multilift_sim.tick_arrays import PhysicsArrays, PhysicsMemory, physics_fields, stacked
-
-# A leader's `control.mode` -> its code in `FormationArrays.leader_mode`: the index in the one
-# registry of leader controllers (multilift_control.controllers.LEADER_CONTROLLERS)
-LEADER_MODES = tuple(LEADER_CONTROLLERS)
-MODE_CASCADE = LEADER_MODES.index('cascade')
-MODE_CONSTANT = LEADER_MODES.index('constant_rotor_speed')
 
 # `FormationMemory.status` of a formation (multilift_sim.physics.layout STATUS_*)
 RUNNING = STATUS_RUNNING
@@ -45,24 +39,28 @@ OFF_RATE = STATUS_OFF_RATE
 
 class ControlArrays(NamedTuple):
     """What the controllers keep constant during a run, for B formations (first axis):
-    the engine's arrays after the physics' (`FormationArrays`)."""
-    # the leader (multilift_control.laws.layout slots)
-    leader_mode: np.ndarray       # (B,) int: MODE_*
+    the engine's arrays after the physics' (`FormationArrays`). A UAV with fewer rotors than
+    the formation's most has its rows padded: its rotors' slots past its count are never
+    answered (their speeds 0, not saturated: what the physics pads its commands with)."""
+    rotor_counts: np.ndarray      # (B, n) int: each UAV's rotors
     cascade: np.ndarray           # (B, n, CASCADE_SIZE): every UAV's cascade constants
     fault_mixers: np.ndarray      # (B, k, rotors, MIXER_SIZE): faults.fault_mixers
     mixer_uavs: np.ndarray        # (B, k) int: the UAV each event's mixer is of (-1: none)
     target_schedule: np.ndarray   # (B, S, 1 + m): (tick, targets) rows, faults.target_schedule
+    # the leader: its part (multilift_control.controllers) and the mission it may track
+    leader_law: np.ndarray        # (B,) int: its part's index in LEADER_CONTROLLERS
+    leader_tracks: np.ndarray     # (B,) bool: its part's TRACKS_MISSION
+    leader: np.ndarray            # (B, its part's constants)
     mission: np.ndarray           # (B, MISSION_SIZE)
     segments: np.ndarray          # (B, s, SEGMENT_SIZE)
     mission_steps: np.ndarray     # (B, s + 1 or 0, STEP_SIZE)
-    constant_speeds: np.ndarray   # (B, rotors) [rad/s]: MODE_CONSTANT's command
-    constant_saturated: np.ndarray  # (B, rotors) bool
-    # the followers (rows 1..n-1 of the per-UAV fields; row 0 unused)
-    follower: np.ndarray          # (B, n, FOLLOWER_SIZE)
+    # the followers: their part (rows 1..n-1 of the per-UAV fields; row 0 unused)
+    follower_law: np.ndarray      # (B,) int: their part's index in FOLLOWER_CONTROLLERS
+    follower: np.ndarray          # (B, n, its constants)
     masses: np.ndarray            # (B, n): M_f,r [kg]
     rows: np.ndarray              # (B, m, ROW_SIZE) int: the rows of g_vc
-    law_p: np.ndarray             # (B, n, 3, m): a linear follower's P (zeros otherwise)
-    law_q: np.ndarray             # (B, n, 3, 3n): its Q
+    law_p: np.ndarray             # (B, n, 3, m): a follower's first matrix (linear VC: P)
+    law_q: np.ndarray             # (B, n, 3, 3n): its second (linear VC: Q)
     own_rows: np.ndarray          # (B, n) int: how many rows of g_vc involve UAV i
     thrust_coefficients: np.ndarray  # (B, n) [N s^2/rad^2]
 
@@ -72,8 +70,8 @@ class ControlMemory(NamedTuple):
     mixers: np.ndarray            # (B, n, rotors, MIXER_SIZE): every UAV's, faults reallocated
     targets: np.ndarray           # (B, m): the rows' targets, after the releases so far
     next_target: np.ndarray       # (B,) int: the row of target_schedule to come
-    cascade_memory: np.ndarray    # (B, n, CASCADE_MEMORY_SIZE)
-    follower_memory: np.ndarray   # (B, n, FOLLOWER_MEMORY_SIZE)
+    leader_memory: np.ndarray     # (B, the leader part's memory)
+    follower_memory: np.ndarray   # (B, n, the follower part's memory)
     thrusts: np.ndarray           # (B, n): the thrust book u_T,j [N]
     tracking: np.ndarray          # (B, TRACKING_SIZE): the leader's tracking error
     formation_errors: np.ndarray  # (B, n, FORMATION_SIZE): each follower's (row 0 unused)
@@ -110,67 +108,59 @@ class TickRecord(NamedTuple):
     gust: np.ndarray              # (ticks, B, 3): the air velocity at the payload [m/s], world
 
 
-def not_flown(scenario: Scenario) -> str | None:
-    """Why the engine's controllers do not fly `scenario` as the runtimes do, or None: they
-    fly one rotor count for every UAV (the physics flies any: `multilift_sim.physics.tick`;
-    the others' controllers answer through the runtimes: `headless.run_headless`)."""
-    rotor_counts = {u.vehicle.n_rotors for u in scenario.uavs}
-    if len(rotor_counts) != 1:
-        return f'UAVs of {len(rotor_counts)} rotor counts {sorted(rotor_counts)}'
-    return None
-
-
-def engine_flies(scenario: Scenario) -> bool:
-    """Whether the engine flies `scenario` (`not_flown`)."""
-    return not_flown(scenario) is None
+def _padded(rows: np.ndarray, rotors: int) -> np.ndarray:
+    """Mixer rows (k, MIXER_SIZE) padded with zero rows to `rotors`."""
+    out = np.zeros((rotors, MIXER_SIZE))
+    out[:rows.shape[0]] = rows
+    return out
 
 
 def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
     """One formation's (FormationArrays fields, FormationMemory fields), without the batch
-    axis: the physics' (`multilift_sim.tick_arrays.physics_fields`), then the controllers'."""
+    axis: the physics' (`multilift_sim.tick_arrays.physics_fields`), then the controllers'
+    (their parts' arrays, `multilift_control.controllers`)."""
     n = scenario.n_uavs
-    why = not_flown(scenario)
-    if why is not None:
-        raise ValueError(f'{scenario.name}: the engine does not fly it: {why}')
     arrays, memory = physics_fields(scenario)
-    # the leader's cascade and path (a constant-speed leader: the ones it would fly, unused)
-    mission_leader = MissionLeader(scenario, 0)
-    path = mission_leader.path
-    constant = ConstantRotorSpeed(scenario, 0).output
-    followers = [FormationFollower.from_scenario(scenario, i) for i in range(1, n)]
-    if len({(f.constants[FOLLOWER_GRAVITY], f.constants[FOLLOWER_TWO_ALPHA])
-            for f in followers}) > 1:  # the tick computes their shared terms once
-        raise ValueError(f'{scenario.name}: the followers differ in gravity or alpha_vc')
-    cascades = [mission_leader.cascade] + [f.cascade for f in followers]
-    rows = followers[0].constraints.rows if followers else np.zeros((0, ROW_SIZE), np.int64)
+    counts = np.array([u.vehicle.n_rotors for u in scenario.uavs], dtype=np.int64)
+    rotors = int(counts.max())
+    leader = leader_part(scenario)
+    path = LeaderController(scenario).path  # the mission (unused by a leader without one)
+    leader_constants, leader_memory = (np.asarray(a, dtype=float)
+                                       for a in leader.arrays(scenario, 0))
+    cascades = [vehicle_cascade(scenario, i) for i in range(n)]
+    masses, constraints = formation_rows(scenario)
+    rows = constraints.rows if n > 1 else np.zeros((0, ROW_SIZE), dtype=np.int64)
+    follower = follower_part(scenario)
+    built = [follower.arrays(scenario, i) for i in range(1, n)]
+    size, memory_size = ((len(built[0][0]), len(built[0][1])) if built else (0, 0))
     m = rows.shape[0]
-    follower = np.zeros((n, FOLLOWER_SIZE))
-    follower_memory = np.zeros((n, FOLLOWER_MEMORY_SIZE))
+    follower_constants = np.zeros((n, size))
+    follower_memory = np.zeros((n, memory_size))
     law_p, law_q = np.zeros((n, 3, m)), np.zeros((n, 3, 3 * n))
     own_rows = np.zeros(n, dtype=np.int64)
-    for i, f in enumerate(followers, start=1):
-        follower[i], follower_memory[i], own_rows[i] = f.constants, f.memory, len(f.rows)
-        if f.law_p.shape == (3, m):  # linear rows (else the law solves each tick)
-            law_p[i], law_q[i] = f.law_p, f.law_q
+    for i, (constants, own_memory, p, q) in enumerate(built, start=1):
+        follower_constants[i], follower_memory[i] = constants, own_memory
+        if p is not None:  # a part without matrices leaves them zeros
+            law_p[i], law_q[i] = p, q
+        own_rows[i] = len(constraints.rows_of(i))
     arrays.update(
-        leader_mode=LEADER_MODES.index(scenario.control.mode),
+        rotor_counts=counts,
         cascade=np.stack([c.constants for c in cascades]),
         fault_mixers=fault_mixers(scenario), mixer_uavs=mixer_uavs(scenario),
         target_schedule=target_schedule(scenario),
+        leader_law=law_index(LEADER_CONTROLLERS, leader.NAME),
+        leader_tracks=bool(leader.TRACKS_MISSION), leader=leader_constants,
         mission=path.mission, segments=path.segments, mission_steps=path.steps,
-        constant_speeds=np.asarray(constant.rotor_speeds, dtype=float),
-        constant_saturated=np.asarray(constant.saturated, dtype=bool),
-        follower=follower,
-        masses=followers[0].masses if followers else np.array([arrays['uavs'][0, UAV_MASS]]),
+        follower_law=law_index(FOLLOWER_CONTROLLERS, follower.NAME),
+        follower=follower_constants, masses=masses,
         rows=np.ascontiguousarray(rows, dtype=np.int64),
         law_p=law_p, law_q=law_q, own_rows=own_rows,
         thrust_coefficients=np.array([u.vehicle.thrust_coefficient for u in scenario.uavs],
                                      dtype=float))
     memory.update(
-        mixers=np.stack([c.mixer.rows for c in cascades]),
-        targets=followers[0].constraints.targets if followers else np.zeros(0), next_target=0,
-        cascade_memory=np.stack([c.memory for c in cascades]),
-        follower_memory=follower_memory,
+        mixers=np.stack([_padded(c.mixer.rows, rotors) for c in cascades]),
+        targets=constraints.targets if n > 1 else np.zeros(0), next_target=0,
+        leader_memory=leader_memory, follower_memory=follower_memory,
         thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float),
         tracking=TrackingStatistics().acc,
         formation_errors=np.stack([FormationErrorStatistics().acc for _ in range(n)]))

@@ -12,10 +12,11 @@ import math
 
 import numpy as np
 
-from multilift_control.engine.arrays import MODE_CASCADE, RUNNING
+from multilift_control.controllers import compiled as controllers
+from multilift_control.engine.arrays import RUNNING
 from multilift_control.laws import jit
-from multilift_control.laws.cascade import attitude_command, leader_update
-from multilift_control.laws.follower import follower_update, formation_terms, lift_vectors
+from multilift_control.laws.cascade import attitude_command
+from multilift_control.laws.follower import lift_vectors
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
@@ -23,57 +24,45 @@ from multilift_sim.physics import tick as physics
 from multilift_sim.physics.measurement import payload_position, payload_velocity
 from multilift_sim.statistics.accumulators import formation_error_add, tracking_add
 
+# the registered controllers' compiled dispatchers (multilift_control.controllers.compiled),
+# rebound when a registry changes (controllers.compiled.refresh)
+leader_answer = controllers.dispatchers().leader_answer
+followers_answer = controllers.dispatchers().followers_answer
 
-@jit
+
+@jit(inline=True)  # into formation_tick: no call passing the batch's tuples
 def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
                      errors, rates):
     """Every controller's answer to formation b's measured `states` (n, UAV_STATE_SIZE) at t
-    [s], into speeds, saturated (n, rotors), setpoints (n, 3), thrust (n,), reference
-    (REFERENCE_SIZE,: NaN without one), errors and rates (n, rows: NaN past a follower's own):
-    the leader first, then the thrust book (the leader's thrust to this state, the followers'
-    to the previous one), then the followers (what their laws share, once: `formation_terms`),
-    whose thrusts the book then notes."""
+    [s], into speeds, saturated (n, rotors: a UAV's past its rotor count untouched, 0 and
+    False), setpoints (n, 3), thrust (n,), reference (REFERENCE_SIZE,: NaN without one),
+    errors and rates (n, rows: NaN past a follower's own): the leader's part first, then the
+    thrust book (the leader's thrust to this state, the followers' to the previous one), then
+    the followers' part (what their laws share, once), whose thrusts the book then notes."""
     n = states.shape[0]
-    if a.leader_mode[b] == MODE_CASCADE:
-        s, sat, setpoint, lift, ref = leader_update(
-            a.cascade[b, 0], m.mixers[b, 0], m.cascade_memory[b, 0], a.mission[b],
-            a.segments[b], a.mission_steps[b], t, states, payload_position(m.state[b], n),
-            payload_velocity(m.state[b], n))
-        for k in range(REFERENCE_SIZE):
-            reference[k] = ref[k]
-        tracking_add(m.tracking[b], ref[REFERENCE_POSITION:REFERENCE_POSITION + 3],
+    # a UAV's slots past its rotor count: 0 and False, whatever another formation left
+    for i in range(n):
+        for k in range(a.rotor_counts[b, i], speeds.shape[1]):
+            speeds[i, k] = 0.0
+            saturated[i, k] = False
+    count = a.rotor_counts[b, 0]
+    thrust[0] = leader_answer(
+        a.leader_law[b], a.leader[b], m.leader_memory[b], a.cascade[b, 0],
+        m.mixers[b, 0, :count], a.mission[b], a.segments[b], a.mission_steps[b], t, states,
+        payload_position(m.state[b], n), payload_velocity(m.state[b], n), speeds[0, :count],
+        saturated[0, :count], setpoints[0], reference)
+    if not math.isnan(reference[REFERENCE_POSITION]):
+        tracking_add(m.tracking[b], reference[REFERENCE_POSITION:REFERENCE_POSITION + 3],
                      states[0, UAV_POSITION:UAV_POSITION + 3])
-    else:  # constant rotor speed: the same command every tick, no reference
-        s, sat = a.constant_speeds[b], a.constant_saturated[b]
-        setpoint = np.zeros(3)
-        lift = collective_thrust(a.thrust_coefficients[b, 0], s)
-        for k in range(REFERENCE_SIZE):
-            reference[k] = math.nan
-    speeds[0, :] = s
-    saturated[0, :] = sat
-    setpoints[0, :] = setpoint
-    thrust[0] = lift
     thrusts = m.thrusts[b]
     thrusts[0] = collective_thrust(a.thrust_coefficients[b, 0], speeds[0])
     vectors = lift_vectors(states, thrusts)
-    # what every follower's law shares, once (O(n)), then each follower's own step; the
-    # constants of any follower (the last; n = 1: the unused row 0)
-    terms = formation_terms(a.follower[b, n - 1], a.masses[b], a.rows[b], m.targets[b], states,
-                            vectors)
+    followers_answer(a.follower_law[b], a.follower[b], m.follower_memory[b], a.cascade[b],
+                     m.mixers[b], a.rotor_counts[b], a.own_rows[b], t, states, vectors,
+                     a.masses[b], a.rows[b], m.targets[b], a.law_p[b], a.law_q[b], speeds,
+                     saturated, setpoints, thrust, errors, rates)
     for i in range(1, n):
-        s, sat, setpoint, lift, own_errors, own_rates = follower_update(
-            a.follower[b, i], a.masses[b], a.rows[b], m.targets[b], a.law_p[b, i],
-            a.law_q[b, i], i, m.follower_memory[b, i], t, states, vectors, terms,
-            a.cascade[b, i], m.mixers[b, i])
-        speeds[i, :] = s
-        saturated[i, :] = sat
-        setpoints[i, :] = setpoint
-        thrust[i] = lift
-        for k in range(own_errors.shape[0]):
-            errors[i, k] = own_errors[k]
-            rates[i, k] = own_rates[k]
-        formation_error_add(m.formation_errors[b, i], own_errors)
-    for i in range(1, n):
+        formation_error_add(m.formation_errors[b, i], errors[i, :a.own_rows[b, i]])
         thrusts[i] = collective_thrust(a.thrust_coefficients[b, i], speeds[i])
 
 
@@ -93,7 +82,7 @@ def tell_controllers(a, m, b, first):
         m.next_target[b] += 1
 
 
-@jit
+@jit(inline=True)  # into formation_tick and run_commanded
 def advance_formation(a, m, b, speeds, saturated, tension):
     """Formation b under rotor `speeds` (n, rotors) [rad/s] commanded over the control period
     (`multilift_sim.physics.tick.advance`: the physics' half, the one implementation), then
@@ -153,7 +142,7 @@ def mission_references(a, t, out):
     """Every formation's mission reference (B, REFERENCE_SIZE) at its time t (B,) [s]
     (`laws.reference.mission_reference`; a formation without a mission: NaN)."""
     for b in range(t.shape[0]):
-        if a.leader_mode[b] != MODE_CASCADE:
+        if not a.leader_tracks[b]:
             out[b, :] = math.nan
             continue
         out[b, :] = mission_reference(a.mission[b], a.segments[b], a.mission_steps[b], t[b])
@@ -204,8 +193,8 @@ def run_ticks(a, m, ticks, record):
     recording = record.speeds.shape[0] > 0
     flown = np.zeros(batch, dtype=np.int64)
     states = np.empty((n, record.measured.shape[3]))
-    speeds = np.empty((n, rotors))
-    saturated = np.empty((n, rotors), dtype=np.bool_)
+    speeds = np.zeros((n, rotors))  # a UAV's slots past its rotor count stay 0 and False
+    saturated = np.zeros((n, rotors), dtype=np.bool_)
     setpoints = np.empty((n, 3))
     thrust = np.empty(n)
     reference = np.empty(REFERENCE_SIZE)

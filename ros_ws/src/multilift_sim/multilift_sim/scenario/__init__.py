@@ -9,12 +9,15 @@ The package: `config` (the dataclasses), `reading` (a mapping read with checks),
 cannot fly), `files` (names, paths, load/loads). Its names are
 imported from here: `from multilift_sim import scenario as scenario_io; scenario_io.load(...)`.
 """
-from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES,  # noqa: F401
+from multilift_sim.scenario.config import (CABLE_MODELS,  # noqa: F401
                                            FORMATION_GEOMETRIES, INPUT_SHAPERS,
                                            ControlConfig, EventConfig,
                                            FormationConfig, MissionConfig, MissionSegment,
                                            PayloadConfig, Scenario, ScenarioError, SensorConfig,
                                            SimulationConfig, UavConfig)
+from multilift_sim.scenario.controllers import (FOLLOWER_CONTROLLERS,  # noqa: F401
+                                                LEADER_CONTROLLERS, follower_controllers,
+                                                leader_controllers)
 from multilift_sim.scenario.files import (anchored, load, loads, resolve,  # noqa: F401
                                           scenario_dir)
 from multilift_sim.scenario.vehicle import (INERTIA_SOURCES, SEED_INERTIA,  # noqa: F401

@@ -19,7 +19,6 @@ class ScenarioError(ValueError):
     """A scenario that cannot be run; the message says where and why."""
 
 
-CONTROL_MODES = ('cascade', 'constant_rotor_speed')
 CABLE_MODELS = ('rigid', 'slack')  # the seed's two-way rod; pulls only (multilift_sim.slack)
 # `control.payload_feedback.input_shaping` (issue 20, not in the seed): each velocity step of the
 # mission split into impulses (time in periods T of the payload's pendulum, share of the step);
@@ -98,7 +97,7 @@ class FormationConfig:
 
 @dataclass(frozen=True)
 class ControlConfig:
-    mode: str                        # 'cascade' or 'constant_rotor_speed'
+    mode: str                        # the leader's law: a name of LEADER_CONTROLLERS
     constant_rotor_speed: float | None  # [rad/s]; None = balance the total weight
     position_kp: tuple[float, float, float]  # [1/s^2]
     position_kd: tuple[float, float, float]  # [1/s]
@@ -114,6 +113,13 @@ class ControlConfig:
     # the mission's corners passed through one of INPUT_SHAPERS at the hanging payload's
     # pendulum period (multilift_control.mission.MissionPath); 'none' = the seed's corners
     input_shaping: str = 'none'
+    # the followers' law: a name of FOLLOWER_CONTROLLERS (scenario.controllers)
+    follower: str = 'virtual_constraints'
+    values: tuple[tuple[str, Any], ...] = ()  # a controller part's own keys (its parse)
+
+    def value(self, key: str) -> Any:
+        """A controller part's own value `key` (of `values`)."""
+        return dict(self.values)[key]
 
 
 @dataclass(frozen=True)

@@ -19,13 +19,15 @@ from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_
 from multilift_sim.events import EVENT_KINDS
 from multilift_sim.parts import PartsError, import_part, resolve_part
 from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
-from multilift_sim.scenario.config import (CABLE_MODELS, CONTROL_MODES, FORMATION_GEOMETRIES,
+from multilift_sim.scenario.config import (CABLE_MODELS, FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
                                            MissionConfig, MissionSegment, PayloadConfig,
                                            Scenario, ScenarioError, SensorConfig,
                                            SimulationConfig, UavConfig,
                                            flies_a_period, one_period_rule)
+from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_controllers,
+                                                leader_controllers)
 from multilift_sim.scenario.limits import check_limits
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
@@ -158,15 +160,14 @@ def scenario_of(data: Any, where: str) -> Scenario:
     sensors = _sensors(top.section('sensors'), sim) if top.has('sensors') else None
 
     c = top.section('control')
-    mode = c.text('mode', choices=CONTROL_MODES)
-    constant = c.raw('constant_rotor_speed', None)
-    if constant is not None:
-        constant = c.positive('constant_rotor_speed')
+    mode = c.text('mode', choices=tuple(leader_controllers()))
+    follower = c.text('follower', DEFAULT_FOLLOWER, choices=tuple(follower_controllers()))
+    chosen = _controller_keys(c, leader_controllers()[mode], follower_controllers()[follower])
     gains_pos = c.section('position_gains')
     gains_att = c.section('attitude_gains')
     nonneg = dict(check=lambda x: x >= 0, rule='must be >= 0')
     control = ControlConfig(
-        mode=mode, constant_rotor_speed=constant,
+        mode=mode, follower=follower, **chosen,
         position_kp=gains_pos.vector('kp', **nonneg), position_kd=gains_pos.vector('kd', **nonneg),
         position_ki=gains_pos.vector('ki', **nonneg),
         attitude_kp=gains_att.vector('kp', **nonneg), attitude_kd=gains_att.vector('kd', **nonneg),
@@ -228,6 +229,27 @@ def scenario_of(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')
     return scenario
+
+
+def _controller_keys(c: Section, leader: Any, follower: Any) -> dict[str, Any]:
+    """The chosen leader's and follower's own keys in `control:` (their KEYS, read by their
+    `parse` into ControlConfig fields: scenario.controllers), and a one-line error for a key
+    of a controller the scenario did not choose. Without its key, constant_rotor_speed is
+    None (the leader's default)."""
+    fields: dict[str, Any] = {'constant_rotor_speed': None}
+    values: list[tuple[str, Any]] = []
+    for part in (leader, follower):
+        if part.KEYS:
+            read = dict(part.parse(c))
+            values += list(read.pop('values', ()))
+            fields.update(read)
+    chosen = set(leader.KEYS) | set(follower.KEYS)
+    for kind, registry in (('mode', leader_controllers()), ('follower', follower_controllers())):
+        for other in registry.values():
+            for key in set(other.KEYS) - chosen:
+                if c.has(key):
+                    raise c.fail(key, c.raw(key), f'is a key of control.{kind}: {other.NAME}')
+    return dict(fields, values=tuple(values))
 
 
 def _parts(top: Section) -> tuple[str, ...]:

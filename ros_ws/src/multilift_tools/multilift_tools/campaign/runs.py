@@ -140,11 +140,10 @@ def run_chunk(source: str, base: dict, runs: list[tuple[list, str | None]],
     without a bag flown together, one engine batch per shape of formation
     (`multilift_control.headless.fly_batch`: a batch gives each formation the numbers it gets
     alone), a run's wall time its scenario's loading and its share of its batch's flight (the
-    worker's first batch warmed up untimed: `warm_up`); runs with a bag, and what the engine
-    does not fly (`engine.arrays.not_flown`), one by one. `runs`:
+    worker's first batch warmed up untimed: `warm_up`); runs with a bag one by one. `runs`:
     (edits, bag or None) each. A batch that raises is flown again run by run, so a fault is
     the row of the run that has it."""
-    from multilift_control.engine.arrays import engine_flies, shape_groups
+    from multilift_control.engine.arrays import shape_groups
     from multilift_control.headless import fly_batch
 
     results: list[dict[str, Any] | None] = [None] * len(runs)
@@ -160,11 +159,8 @@ def run_chunk(source: str, base: dict, runs: list[tuple[list, str | None]],
         except Exception as exc:  # noqa: BLE001 - a rejected value is that row's error
             results[k] = _result(error=exc, wall_time=time.perf_counter() - start)
             continue
-        if engine_flies(scenario):
-            loading[k] = time.perf_counter() - start
-            flights.append((k, scenario))
-        else:  # another integrator: tick by tick
-            results[k] = run_one(source, base, edits, duration)
+        loading[k] = time.perf_counter() - start
+        flights.append((k, scenario))
     for group in shape_groups([scenario for _, scenario in flights]):
         members = [flights[i] for i in group]
         warm_up('engine', members[0][1])

@@ -1,0 +1,1 @@
+"""The shipped follower controllers, a module each (`multilift_control.controllers`)."""

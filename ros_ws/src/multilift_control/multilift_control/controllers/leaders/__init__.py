@@ -1,0 +1,1 @@
+"""The shipped leader controllers, a module each (`multilift_control.controllers`)."""

@@ -1,0 +1,47 @@
+"""The mission leader (`control.mode: cascade`, seed Ch. 3 and §4.2): the cascade along the
+mission path, one law a tick (`laws.cascade.leader_update`), with the swing feedback of
+`control.payload_feedback` (issue 20; `laws.swing`).
+
+Its gains are the vehicle's cascade's (`CascadeController`: the CASCADE_* constants every UAV
+has, the swing gains among them); its memory is the position loop's, laws.layout's
+CASCADE_INTEGRAL (3) [m/s^2] and CASCADE_LAST_T [s] (NaN before the first tick)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from multilift_control.laws import jit
+from multilift_control.laws.cascade import leader_update
+from multilift_control.laws.layout import CASCADE_LAST_T, CASCADE_MEMORY_SIZE, REFERENCE_SIZE
+from multilift_sim.scenario import Scenario
+
+NAME = 'cascade'
+KEYS = ()                # its gains are the control section's shared keys
+TRACKS_MISSION = True    # answers with the mission reference (/uav1/reference)
+
+
+def arrays(scenario: Scenario, index: int) -> tuple[np.ndarray, np.ndarray]:
+    """(constants: none of its own, memory at t = 0: CASCADE_* memory slots)."""
+    memory = np.zeros(CASCADE_MEMORY_SIZE)
+    memory[CASCADE_LAST_T] = math.nan
+    return np.zeros(0), memory
+
+
+@jit
+def answer(constants, memory, cascade, mixer, mission, segments, steps, t, states,
+           payload_position, payload_velocity, speeds, saturated, setpoint, reference):
+    """The leader's tick at t [s] (`leader_update`): rotor speeds [rad/s] and saturation into
+    speeds, saturated (its rotors), roll, pitch, yaw [rad] into setpoint, the mission reference
+    (REFERENCE_* slots) into reference; returns the collective thrust asked [N]."""
+    s, sat, attitude, thrust, tracked = leader_update(
+        cascade, mixer, memory, mission, segments, steps, t, states, payload_position,
+        payload_velocity)
+    for k in range(s.shape[0]):
+        speeds[k] = s[k]
+        saturated[k] = sat[k]
+    for k in range(3):
+        setpoint[k] = attitude[k]
+    for k in range(REFERENCE_SIZE):
+        reference[k] = tracked[k]
+    return thrust

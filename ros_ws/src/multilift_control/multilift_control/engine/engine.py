@@ -200,7 +200,7 @@ class Engine:
             return None
         return stop_message(check, int(self.memory.worst_cable[b]),
                             float(self.memory.worst_value[b]), float(self.t[b]),
-                            self.scenarios[b].simulation)
+                            self.scenarios[b].simulation, self.scenarios[b].n_uavs)
 
     # ----------------------------------------------------------------------------- figures
     def summary(self, b: int = 0, wall_time: float | None = None) -> dict:

@@ -174,7 +174,8 @@ def translational_masses(uavs, formation):
 
 @jit
 def nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers):
-    """q_ddot into acc (6n + 3,) and Lambda into multipliers (n,) [N/m] at state x by Eq.
+    """q_ddot into acc[:3n + 3] (the attitude blocks' rates after it) and Lambda into multipliers
+    (n,) [N/m] at state x by Eq.
     2.71-2.72 with Eq. 2.57 (every cable a constraint; see the module docstring)."""
     n = uavs.shape[0]
     p = payload_slot(n)

@@ -214,7 +214,7 @@ def test_the_null_space_form_compiled_is_its_source_bit_for_bit(name):
     wrenches = model.wrenches([np.full(u.vehicle.n_rotors, 1500.0) for u in scenario.uavs])
     results = []
     for function in (nullspace_solve, kernels.uncompiled(nullspace_solve)):
-        acc, multipliers = np.empty(layout.n_coordinates), np.empty(scenario.n_uavs)
+        acc, multipliers = np.empty(layout.size - layout.n_coordinates), np.empty(scenario.n_uavs)
         function(x, wrenches, formation._uavs, formation._gusts, formation._formation, acc,
                  multipliers)
         results.append((acc, multipliers))

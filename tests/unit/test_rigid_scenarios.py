@@ -132,6 +132,7 @@ def test_the_markers_draw_the_body_and_end_the_cables_at_its_attach_points(name,
     """/visualization/markers of a rigid payload: its shape (a CUBE of the box's size, a
     CYLINDER of the beam's length laid along its x axis) at its pose, each cable from its UAV
     to its attach point r_p + R_p b_i."""
+    from multilift_sim.physics.layout import attitude_slot
     from multilift_sim.physics.rigid_payload import payload_rotation
     from multilift_sim.simulation import FormationSimulator
     from multilift_sim.wire.scene import CABLE_SEGMENTS, FormationScene
@@ -148,7 +149,7 @@ def test_the_markers_draw_the_body_and_end_the_cables_at_its_attach_points(name,
                  snap.payload_position, [1.0] * scenario.n_uavs, None,
                  snap.payload_attitude[0])
     assert scene.payload.type == kind
-    rotation = payload_rotation(simulator.state, 2 * layout.n_coordinates)
+    rotation = payload_rotation(simulator.state, attitude_slot(scenario.n_uavs))
     for cable, attach in zip(scene.cables, scenario.payload.attach_points):
         end = snap.payload_position + rotation @ np.array(attach)
         assert np.abs(np.array(cable.points[2 * CABLE_SEGMENTS - 1]) - end).max() < 1e-12

@@ -17,7 +17,7 @@ With ``f = B_f u_f + d_f - f_g - C_f q_dot`` the multipliers are
 
 which is Eq. 2.60/2.70 with the signs gathered. The cable rows of G touch only the UAV
 translations (mass m_i I) and the payload (m_p I), and C_f, B_f only couple each UAV's own
-coordinates, so the model never forms the (6n+3)^2 matrices (the arithmetic:
+coordinates, so the model never forms the dense mass matrix (the arithmetic:
 multilift_sim.physics.formation_dae):
 
 - each UAV's attitude is integrated on its own (Euler's equation J omega_dot = tau -

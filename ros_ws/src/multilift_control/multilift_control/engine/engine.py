@@ -156,7 +156,7 @@ class Engine:
     # ------------------------------------------------------------------------- state views
     @property
     def state(self) -> np.ndarray:
-        """The formation states (B, 2 (6n + 3); a rigid payload adds its attitude, 7) at the
+        """The formation states (B, len(x): docs/conventions.md) at the
         current tick (docs/conventions.md, docs/rigid_payload.md)."""
         return self.memory.state
 

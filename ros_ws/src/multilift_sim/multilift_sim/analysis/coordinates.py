@@ -150,6 +150,22 @@ def formation_residuals(params: FormationParams, x: np.ndarray) -> np.ndarray:
     return np.einsum('ij,ij->i', offsets, offsets) - np.asarray(params.cable_lengths) ** 2
 
 
+def seed_coordinates_of(layout: StateLayout, x: np.ndarray) -> np.ndarray:
+    """q_f (6n + 3,) of a state x (or (..., 6n + 3) of a stack): per UAV r_i [m] and the ZYX
+    angles eta_i [rad] of its quaternion, then r_p [m] (a rigid payload's attitude not
+    included)."""
+    x = np.asarray(x, dtype=float)
+    n = layout.n_uavs
+    out = np.empty(x.shape[:-1] + (seed_coordinates(n),))
+    euler = layout.uav_euler(x)
+    for i in range(n):
+        r, e = seed_uav_slot(i) + POSITION, seed_uav_slot(i) + SEED_EULER
+        out[..., r:r + 3] = layout.uav_positions(x)[..., i, :]
+        out[..., e:e + 3] = euler[..., i, :]
+    out[..., seed_payload_slot(n):] = layout.payload_position(x)
+    return out
+
+
 def displaced_state(layout: StateLayout, x: np.ndarray, dq: np.ndarray,
                     dq_dot: np.ndarray) -> np.ndarray:
     """The packed state x moved by dq (q_f [m, rad], a rigid payload's rotation vector theta

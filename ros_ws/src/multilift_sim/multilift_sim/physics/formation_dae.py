@@ -8,7 +8,7 @@ WRENCH_COLUMNS) the body wrenches (u_T [N], tau [N m], FLU), held; ``uavs`` (n, 
 ``gusts`` (k, GUST_COLUMNS) and ``formation`` (FORMATION_SCALARS,) the constants;
 ``taut`` (n,) bool: which cables are constraints (a slack cable has multiplier 0 and leaves
 UAV i and the payload free of each other); ``cables`` (n, CABLE_COLUMNS) and ``work``
-(WORK_ROWS, 2 (6n + 3)) scratch.
+(WORK_ROWS, len(x)) scratch.
 
 The equations (dynamics.py's docstring): with f the unconstrained forces,
 ``Lambda = (G M^-1 G^T)^-1 (G M^-1 f + G_dot q_dot + 2 alpha_f g_dot + beta_f^2 g)`` and
@@ -110,7 +110,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
         nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
         return
     if x.shape[0] > attitude_slot(uavs.shape[0]):
-        # a rigid-body payload (its attitude after q_f_dot: physics.rigid_payload)
+        # a rigid-body payload (its attitude block after the UAVs': physics.rigid_payload)
         rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
         return
     n = uavs.shape[0]

@@ -16,6 +16,10 @@ from multilift_sim.physics.layout import (BODY_QUATERNION, BODY_RATES, MEASURED_
 from multilift_sim.physics.state_slots import (payload_slot, rates_slot, uav_attitude_slot,
                                                uav_slot)
 
+# cos(pitch) below which `quaternion_euler` reads an attitude as gimbal-locked (pitch within
+# ~1e-7 rad of +-90 deg): roll and yaw from R's rounding would be good to only ~1e-16 / cos
+GIMBAL_LOCK = 1e-7
+
 
 @jit
 def measured_states(x, n, out):
@@ -42,14 +46,19 @@ def measured_states(x, n, out):
 def quaternion_euler(w, qx, qy, qz):
     """The ZYX Euler angles (roll phi, pitch theta, yaw psi) [rad] of the unit quaternion
     (w, x, y, z), body -> world, R = Rz(psi) Ry(theta) Rx(phi) (Eq. 2.6): roll and yaw in
-    (-pi, pi], pitch in [-pi/2, pi/2] from atan2 of -R_20 and |(R_00, R_10)| (full precision
-    near +-90 deg, where roll and yaw share one freedom; `euler_quaternion` the inverse)."""
+    (-pi, pi], pitch in [-pi/2, pi/2] from atan2 of -R_20 and cos(pitch) = |(R_00, R_10)|
+    (full precision near +-90 deg; `euler_quaternion` the inverse). Within GIMBAL_LOCK of
+    +-90 deg pitch, where only roll -+ yaw is defined (and rounding of the others would
+    dominate it), yaw is 0 and roll all of it: atan2(-R_12, R_11)."""
     r20 = 2.0 * (qx * qz - w * qy)
     r00 = 1.0 - 2.0 * (qy * qy + qz * qz)
     r10 = 2.0 * (qx * qy + w * qz)
-    r21 = 2.0 * (qy * qz + w * qx)
-    r22 = 1.0 - 2.0 * (qx * qx + qy * qy)
-    return (math.atan2(r21, r22), math.atan2(-r20, math.sqrt(r00 * r00 + r10 * r10)),
+    cos_pitch = math.sqrt(r00 * r00 + r10 * r10)
+    pitch = math.atan2(-r20, cos_pitch)
+    if cos_pitch < GIMBAL_LOCK:
+        return (math.atan2(-2.0 * (qy * qz - w * qx), 1.0 - 2.0 * (qx * qx + qz * qz)), pitch,
+                0.0)
+    return (math.atan2(2.0 * (qy * qz + w * qx), 1.0 - 2.0 * (qx * qx + qy * qy)), pitch,
             math.atan2(r10, r00))
 
 

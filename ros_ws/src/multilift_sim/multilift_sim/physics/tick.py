@@ -28,9 +28,9 @@ from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rate
                                                uav_attitude_slot)
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.sensors import sensed_states
-from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
-                                                   run_add_gust_speed, run_add_slack,
-                                                   run_add_tensions, run_check)
+from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
+                                                   run_add_compression, run_add_gust_speed,
+                                                   run_add_slack, run_add_tensions, run_check)
 from multilift_sim.statistics.layout import (CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE,
                                              CHECK_QUATERNION)
 
@@ -71,6 +71,16 @@ def period_formation(constants, series, tick):
 
 
 @jit
+def stop_quaternion(a, m, b, body):
+    """Formation b stopped as STATUS_QUATERNION: body `body` (UAV i, or n the rigid payload)
+    in worst_cable, its quaternion's | |q| - 1 | in worst_value."""
+    n = a.uavs.shape[1]
+    m.status[b], m.worst_cable[b] = STATUS_QUATERNION, body
+    m.worst_value[b] = quaternion_norm_error(
+        m.state[b], uav_attitude_slot(n, body) if body < n else attitude_slot(n))
+
+
+@jit
 def check(a, m, b):
     """Algorithm 1, lines 10-13, at formation b's current state (its g, g_dot), the run's
     figures accumulated (`statistics.accumulators.run_check`, then the gust at the payload):
@@ -86,10 +96,7 @@ def check(a, m, b):
         m.status[b] = STATUS_NOT_FINITE
         return
     if status == CHECK_QUATERNION:  # the body in worst_cable, | |q| - 1 | in worst_value
-        n = a.uavs.shape[1]
-        m.status[b], m.worst_cable[b] = STATUS_QUATERNION, cable
-        m.worst_value[b] = quaternion_norm_error(
-            x, uav_attitude_slot(n, cable) if cable < n else attitude_slot(n))
+        stop_quaternion(a, m, b, cable)
         return
     payload = payload_slot(a.uavs.shape[1])
     gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
@@ -112,8 +119,15 @@ def advance(a, m, b, speeds, saturated, tension):
     controller's held: `physics.events.held_commands`; RK4 through the rotors' actuators:
     `physics.actuators`), the events of the new tick applied (`physics.events`), then checked
     (`check`); the tension T_i = 2 l_i lambda_i [N] at the tick it started from into
-    tension. The second half of a tick, whoever answered."""
+    tension. The second half of a tick, whoever answered. A state whose quaternion is no
+    attitude (`statistics.accumulators.quaternion_fault`: set from outside; the model's own
+    stay unit) is not integrated: the formation stops as STATUS_QUATERNION."""
     n = speeds.shape[0]
+    body = quaternion_fault(m.state[b], n)
+    if body >= 0:  # a state given from outside that no attitude is: not integrated (the
+        stop_quaternion(a, m, b, body)  # step's renormalisation would hide it), stopped
+        tension[:] = 0.0
+        return
     period = a.period_ns[b] * 1e-9
     held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
                   m.held_saturated[b])

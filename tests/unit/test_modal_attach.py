@@ -95,7 +95,7 @@ def test_the_equilibrium_rests_and_the_rotors_cancel_the_cable_s_moment(name, po
         moment = np.cross(a, rotation.T @ pull)                      # the cable's, body FLU
         assert np.linalg.norm(moment) > 1e-3                          # N m: something to hold
         assert np.abs(wrench[1:] + moment).max() < 1e-9 * np.linalg.norm(moment)
-        assert euler[i, 2] == scenario.uavs[i].yaw
+        assert euler[i, 2] == pytest.approx(scenario.uavs[i].yaw, abs=1e-15)
     if scenario.n_uavs == 1:                  # a vertical cable: the UAV level, centre kept
         assert np.array_equal(euler[0, :2], [0.0, 0.0])
         assert np.abs(uavs[0] - scenario.uavs[0].position).max() < 1e-15

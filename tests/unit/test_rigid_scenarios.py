@@ -35,7 +35,7 @@ def test_the_box_starts_level_on_every_cable_with_the_solid_s_inertia():
         (2.0 / 12 * (0.36 + 0.16), 2.0 / 12 * (1.0 + 0.16), 2.0 / 12 * (1.0 + 0.36)))
     model = FormationModel(scenario.formation_params())
     x = initial_state(scenario)
-    assert x.size == model.layout.size == 2 * (6 * 4 + 3) + 7
+    assert x.size == model.layout.size == 2 * (3 * 4 + 3) + 7 * 4 + 7  # the UAVs' blocks, then its
     g, g_dot = model.constraint_residuals(x)
     assert np.abs(g).max() < 1e-12 and np.abs(g_dot).max() == 0.0
     assert model.layout.payload_quaternion(x).tolist() == [1.0, 0.0, 0.0, 0.0]
@@ -50,7 +50,7 @@ def test_cylinder_inertia_and_the_point_payload_unchanged():
         (0.5 * 1.5 * 0.03 ** 2, 1.5 / 12 * (3 * 0.03 ** 2 + 9.0), 1.5 / 12 * (3 * 0.03 ** 2 + 9.0)))
     twin = scenario_io.load('twin_lift')
     assert twin.payload.type == 'point' and twin.formation_params().payload_inertia is None
-    assert initial_state(twin).size == 2 * (6 * 2 + 3)
+    assert initial_state(twin).size == 2 * (3 * 2 + 3) + 7 * 2
 
 
 @pytest.mark.parametrize('payload,message', [

@@ -88,7 +88,9 @@ def test_a_twin_lift_in_the_wind_trails_its_payload_downwind():
         assert engine.summary(0)['sim']['max_abs_constraint'] < \
             scenario.simulation.constraint_tolerance
         states = record.states[:, 0]
-        places.append(states[:, 12:15] - 0.5 * (states[:, 0:3] + states[:, 6:9]))
+        layout = StateLayout(2)
+        places.append(layout.payload_position(states)
+                      - layout.uav_positions(states).mean(axis=1))
     trail = places[0][1000:, 0] - places[1][1000:, 0]  # from 10 s on, along the wind
     assert trail.mean() > 0.05
 

@@ -18,7 +18,7 @@ from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.kinematics import (euler_rate_matrix, euler_rate_matrix_dot,
                                       euler_rate_matrix_inverse, rotation_matrix)
 from multilift_sim.multirotor import euler_mass_matrix
-from multilift_sim.physics.attitude import quaternion_rotation
+from multilift_sim.physics import attitude
 from multilift_sim.physics.layout import (BODY_RATES, POSITION, SEED_EULER, attitude_slot,
                                           seed_coordinates, seed_payload_slot, seed_uav_slot,
                                           uav_attitude_slot)
@@ -26,10 +26,10 @@ from multilift_sim.physics.layout import (BODY_RATES, POSITION, SEED_EULER, atti
 ROTATION_NAMES = ('rx_p', 'ry_p', 'rz_p')  # a rigid payload's rotation vector, payload frame
 
 
-def payload_rotation(quaternion: ArrayLike) -> np.ndarray:
-    """R_p (3, 3), payload frame -> world, of a unit quaternion (w, x, y, z)."""
+def quaternion_rotation(quaternion: ArrayLike) -> np.ndarray:
+    """R (3, 3), body -> world, of a unit quaternion (w, x, y, z) (physics.attitude's)."""
     state = np.concatenate((np.zeros(1), np.asarray(quaternion, dtype=float)))
-    return quaternion_rotation(state, 1)
+    return attitude.quaternion_rotation(state, 1)
 
 
 def cable_offsets(params: FormationParams, uavs: np.ndarray, payload: np.ndarray,
@@ -75,7 +75,7 @@ def cable_moments(params: FormationParams, offsets: np.ndarray,
 
 def _state_rotation(layout: StateLayout, x: np.ndarray) -> np.ndarray | None:
     """A rigid payload's R_p (3, 3) at state x; None for a point payload."""
-    return payload_rotation(layout.payload_quaternion(x)) if layout.rigid_payload else None
+    return quaternion_rotation(layout.payload_quaternion(x)) if layout.rigid_payload else None
 
 
 def coordinate_names(n_uavs: int, rigid_payload: bool = False) -> tuple[str, ...]:

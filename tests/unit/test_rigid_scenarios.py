@@ -139,7 +139,6 @@ def test_the_markers_draw_the_body_and_end_the_cables_at_its_attach_points(name,
 
     scenario = scenario_io.load(name)
     simulator = FormationSimulator(scenario)
-    layout = simulator.model.layout
     hover = [np.full(4, 1900.0)] * scenario.n_uavs
     for _ in range(150):
         simulator.advance(hover, [np.zeros(4, bool)] * scenario.n_uavs)

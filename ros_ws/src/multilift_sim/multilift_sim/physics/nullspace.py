@@ -231,8 +231,8 @@ def nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers):
 
 @jit
 def project(x, uavs, masses, tolerance, max_steps):
-    """x (docs/conventions.md) moved onto the constraint manifold in place: positions by Newton steps
-    dq = -M^-1 G^T (G M^-1 G^T)^-1 g until |g_i| <= tolerance l_i^2 (at most max_steps), then
+    """x (docs/conventions.md) moved onto the constraint manifold in place: positions by Newton
+    steps dq = -M^-1 G^T (G M^-1 G^T)^-1 g until |g_i| <= tolerance l_i^2 (at most max_steps), then
     velocities dv = -M^-1 G^T (G M^-1 G^T)^-1 G v (exact: g_dot = G v is linear in v), with
     M_t = diag(`masses`) (3n + 3,) [kg] (`translational_masses`). Only the translations move
     (the attitude columns of G are zero)."""

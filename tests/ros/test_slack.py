@@ -56,14 +56,14 @@ def test_snap_keeps_momentum_and_does_not_add_energy():
     sim = FormationSimulator(scenario)
     model = sim.model
     x = sim.state.copy()
-    n, nq = 2, 6 * 2 + 3
+    layout = model.layout
     rng = np.random.default_rng(3)
-    x[nq:] += rng.normal(0.0, 1.0, nq)  # random velocities, cables at their length
+    layout.rates(x)[:] += rng.normal(0.0, 1.0, layout.n_coordinates)  # cables at their length
+    layout.uav_body_rates(x)[:] += rng.normal(0.0, 1.0, (2, 3))
     masses = np.array([u.vehicle.mass for u in scenario.uavs] + [scenario.payload.mass])
 
     def momentum(state):
-        v = np.vstack([state[nq + 6 * i:nq + 6 * i + 3] for i in range(n)]
-                      + [state[nq + 6 * n:]])
+        v = np.vstack([layout.uav_velocities(state), layout.payload_velocity(state)])
         return masses @ v
 
     for taut in ([True, False], [True, True]):
@@ -76,8 +76,7 @@ def test_snap_keeps_momentum_and_does_not_add_energy():
 
 def _stretch(model, x) -> np.ndarray:
     """|r_p - r_i| - l_i [m] per cable, from the positions (not from the model's g)."""
-    n = len(model.cable_lengths)
-    offsets = x[6 * n:6 * n + 3] - x[:6 * n].reshape(n, 6)[:, :3]
+    offsets = model.layout.payload_position(x) - model.layout.uav_positions(x)
     return np.linalg.norm(offsets, axis=1) - model.cable_lengths
 
 

@@ -26,7 +26,8 @@ from multilift_sim.formation_params import actuator_array
 from multilift_sim.physics.actuators import actuated_period, rotor_speed_at
 from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.formation_dae import integrate_period
-from multilift_sim.physics.layout import WRENCH_COLUMNS
+from multilift_sim.physics.layout import (ACTUATOR_TIME_CONSTANT, FORMATION_SUBSTEPS,
+                                          WRENCH_COLUMNS)
 from multilift_sim.start import initial_state
 
 
@@ -97,9 +98,9 @@ def test_a_lagging_climb_integrates_the_lagging_thrust():
     omega = np.array([rotor_speed_at(hover, command, 0.05, 6000.0, t) for t in s])
     acceleration = 4 * vehicle.thrust_coefficient * omega ** 2 / total - 9.81
     velocity = np.sum(0.5 * (acceleration[1:] + acceleration[:-1]) * np.diff(s))
-    nq = 6 + 3
-    assert x[nq + 2] == pytest.approx(velocity, rel=1e-6)     # UAV climbs ...
-    assert x[nq + 8] == pytest.approx(velocity, rel=1e-6)     # ... and the payload with it
+    layout = model.layout
+    assert layout.uav_velocities(x)[0, 2] == pytest.approx(velocity, rel=1e-6)  # UAV climbs ...
+    assert layout.payload_velocity(x)[2] == pytest.approx(velocity, rel=1e-6)  # ... the payload
     assert velocity > 0.05  # it did climb
     assert model.rotors[0] == pytest.approx(
         [rotor_speed_at(hover, command, 0.05, 6000.0, duration)] * 4, rel=1e-15)
@@ -186,3 +187,41 @@ def test_actuator_keys_are_validated():
              'need simulation.integrator: baumgarte')]:
         with pytest.raises(scenario_io.ScenarioError, match=message):
             scenario_io.loads(_edited(edit), 'x.yaml')
+
+
+@pytest.mark.parametrize('lag', [False, True], ids=['instant', 'lagging'])
+@pytest.mark.parametrize('slack', [False, True], ids=['rigid', 'slack'])
+def test_k_substeps_are_the_period_in_k_times_finer_steps(lag, slack):
+    """FORMATION_SUBSTEPS = k (docs/architecture.md, "The stepper"): the period's `steps`
+    physics steps of dt taken as k RK4 steps of dt / k each, the same bits as the period
+    asked for in k * steps steps of dt / k (instant or lagging rotors, rigid or slack cables;
+    compiled and uncompiled alike); k = 1 is dt itself; and finer, closer to a reference of
+    much finer steps."""
+    scenario = scenario_io.load('twin_lift')
+    model = FormationModel(scenario.formation_params())
+    actuators = actuator_array(scenario.formation_params())
+    if lag:
+        actuators[:, ACTUATOR_TIME_CONSTANT] = 0.03
+    rng = np.random.default_rng(5)
+    x = initial_state(scenario)
+    model.layout.rates(x)[:] = rng.normal(0.0, 0.3, model.layout.n_coordinates)
+    model.layout.uav_body_rates(x)[:] = rng.normal(0.0, 1.0, (2, 3))
+    commands = rng.uniform(1300.0, 1700.0, size=(2, 4))
+    start = rng.uniform(1300.0, 1700.0, size=(2, 4))
+    dt, steps = 0.005, 2
+
+    def period(substeps, h, count, function=actuated_period):
+        formation = model._formation.copy()
+        formation[FORMATION_SUBSTEPS] = substeps
+        return function(x, commands, start.copy(), actuators, np.ones((2, 4)), model.allocation,
+                        model._uavs, model._gusts, formation, np.ones(2, dtype=bool),
+                        np.zeros(2, dtype=bool), slack, h, count)
+
+    for k in (1, 3):
+        finer = period(1, dt / k, steps * k)
+        for function in (actuated_period, kernels.uncompiled(actuated_period)):
+            for a, b in zip(period(k, dt, steps, function), finer):
+                assert np.array_equal(a, b)
+    reference = period(1, dt / 64, steps * 64)[0]
+    coarse, fine = period(1, dt, steps)[0], period(4, dt, steps)[0]
+    assert np.abs(fine - reference).max() < 0.1 * np.abs(coarse - reference).max()

@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 
 from multilift_sim import kernels
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                       TrackingStatistics, accumulators, figures, swing)
-from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
+from multilift_sim.statistics.layout import (CHECK_QUATERNION, CHECK_G, CHECK_G_DOT,
                                              CHECK_NON_FINITE, CHECK_OK, PEAK_SIZE,
-                                             PITCH_LIMIT, RUN_SWING, run_size)
+                                             QUATERNION_NORM_TOLERANCE, RUN_SWING, run_size)
 
 pytest.importorskip('numba')
 
@@ -147,10 +148,11 @@ def test_the_accumulators_compiled_and_uncompiled_agree(n):
 def test_the_check_compiled_and_uncompiled_agree(n):
     rng = np.random.default_rng(200 + n)
     uavs, lengths = _formation(rng, n)
-    state = rng.normal(size=2 * (6 * n + 3))
-    state[:6 * n].reshape(n, 6)[:, :3] = uavs
-    state[:6 * n].reshape(n, 6)[:, 3:] = rng.normal(0.0, 0.3, (n, 3))  # attitudes a UAV flies
-    state[6 * n:6 * n + 3] = uavs.mean(axis=0) - [0.0, 0.0, 1.0]
+    layout = StateLayout(n)
+    state = rng.normal(size=layout.size)
+    layout.uav_positions(state)[:] = uavs
+    layout.set_uav_euler(state, rng.normal(0.0, 0.3, (n, 3)))  # attitudes a UAV flies
+    layout.payload_position(state)[:] = uavs.mean(axis=0) - [0.0, 0.0, 1.0]
     seen = set()
     for tick in range(160):
         run = _accumulators(rng, n)
@@ -161,8 +163,11 @@ def test_the_check_compiled_and_uncompiled_agree(n):
         tumbling = int(rng.integers(n))
         if tick % 7 == 6:
             x[rng.integers(len(x))] = rng.choice([math.nan, math.inf])
-        elif tick % 11 == 10:  # a UAV pitched past the Euler angles' limit, either side
-            x[6 * tumbling + 4] = rng.choice([-1.0, 1.0]) * rng.uniform(PITCH_LIMIT + 1e-6, 3.1)
+        elif tick % 11 == 10:  # a UAV's quaternion off unit length, either way
+            layout.uav_quaternions(x)[tumbling] *= 1.0 + rng.choice([-1.0, 1.0]) * rng.uniform(
+                2.0 * QUATERNION_NORM_TOLERANCE, 0.5)
+        elif tick % 5 == 4:  # pitched through 90 deg and beyond: an attitude like any other
+            layout.set_uav_euler(x, [[0.0, math.pi / 2.0 + 0.3, 0.1]] * n)
         status, cable = _same(accumulators.run_check, run, x, g, g_dot, taut, 2e-3, 2e-2,
                               tick * 0.01, tick, 1 if n <= 2 else 10, lengths)
         seen.add(status)
@@ -170,8 +175,10 @@ def test_the_check_compiled_and_uncompiled_agree(n):
             values = np.abs(g if status == CHECK_G else g_dot) * taut
             assert cable == int(np.argmax(values))
         if tick % 11 == 10 and tick % 7 != 6:
-            assert (status, cable) == (CHECK_ATTITUDE, tumbling)
-    assert seen == {CHECK_OK, CHECK_NON_FINITE, CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT}
+            assert (status, cable) == (CHECK_QUATERNION, tumbling)
+        elif tick % 5 == 4 and tick % 7 != 6:
+            assert status != CHECK_QUATERNION
+    assert seen == {CHECK_OK, CHECK_NON_FINITE, CHECK_QUATERNION, CHECK_G, CHECK_G_DOT}
 
 
 def test_the_classes_read_their_arrays():

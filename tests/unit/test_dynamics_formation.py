@@ -12,7 +12,8 @@ from multilift_sim.constraints import (cable_residual_rates, cable_residuals,
 from multilift_sim.wind.gusts import Gust, gust_velocity, payload_drag
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
-from multilift_sim.kinematics import euler_rate_matrix, rotation_matrix
+from multilift_sim.analysis.coordinates import coordinate_accelerations
+from multilift_sim.kinematics import euler_rate_matrix, quaternion_from_euler, rotation_matrix
 from multilift_sim.multirotor import MultirotorParams, euler_mass_matrix, euler_velocity_term
 from multilift_sim.slack import SlackCableModel
 
@@ -41,8 +42,8 @@ def dense_reference(formation: FormationModel, x: np.ndarray, rotor_speeds, taut
     p = formation.params
     layout = formation.layout
     n = p.n_uavs
-    size = layout.n_coordinates
-    q, q_dot = x[:size], x[size:]
+    q, q_dot = seed_coordinates(layout, x)
+    size = q.size
     mass = np.zeros((size, size))
     force = np.zeros(size)            # f_f = B_f u_f + d_f - f_g - C_f q_dot
     for i, uav in enumerate(p.uavs):
@@ -76,6 +77,20 @@ def dense_reference(formation: FormationModel, x: np.ndarray, rotor_speeds, taut
     return solution[:size], multipliers
 
 
+def seed_coordinates(layout: StateLayout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The seed's q_f = (r_i, eta_i, ..., r_p) (6n + 3) and q_f_dot of a state: eta_i the ZYX
+    angles of UAV i's quaternion, eta_dot_i = W(eta_i)^-1 omega_i (Eq. 2.7)."""
+    n = layout.n_uavs
+    euler = layout.uav_euler(x)
+    rates = np.array([np.linalg.solve(euler_rate_matrix(euler[i]), layout.uav_body_rates(x)[i])
+                      for i in range(n)])
+    q = np.concatenate((np.hstack((layout.uav_positions(x), euler)).ravel(),
+                        layout.payload_position(x)))
+    q_dot = np.concatenate((np.hstack((layout.uav_velocities(x), rates)).ravel(),
+                            layout.payload_velocity(x)))
+    return q, q_dot
+
+
 def random_state(layout: StateLayout, lengths, rng) -> np.ndarray:
     """A state near (not on) the constraint manifold, with random rates."""
     n = layout.n_uavs
@@ -102,7 +117,8 @@ def test_structured_solve_matches_the_dense_seed_system(n, kernel, monkeypatch):
                                       gusts=gusts, baumgarte_alpha=7.0, baumgarte_beta=5.0))
     x = random_state(formation.layout, lengths, rng)
     speeds = [rng.uniform(1200.0, 2000.0, uav.n_rotors) for uav in uavs]
-    q_ddot, multipliers = formation.accelerations(0.0, x, speeds)
+    acc, multipliers = formation.accelerations(0.0, x, speeds)
+    q_ddot = coordinate_accelerations(formation.layout, x, acc)
     expected_q_ddot, expected_multipliers = dense_reference(formation, x, speeds)
     assert np.allclose(q_ddot, expected_q_ddot, rtol=1e-9, atol=1e-9)
     assert np.allclose(multipliers, expected_multipliers, rtol=1e-9, atol=1e-9)
@@ -123,7 +139,8 @@ def test_a_solve_over_the_taut_cables_matches_the_dense_seed_system_of_those(n):
     speeds = [rng.uniform(1200.0, 2000.0, 4) for _ in range(n)]
     for taut in (rng.uniform(size=n) < 0.5, np.zeros(n, bool), np.ones(n, bool)):
         model.taut = taut
-        q_ddot, multipliers = model.accelerations(0.0, x, speeds)
+        acc, multipliers = model.accelerations(0.0, x, speeds)
+        q_ddot = coordinate_accelerations(model.layout, x, acc)
         expected_q_ddot, expected_multipliers = dense_reference(model, x, speeds, taut)
         scale = max(1.0, np.abs(expected_q_ddot).max())
         assert np.allclose(q_ddot, expected_q_ddot, rtol=1e-9, atol=1e-9 * scale)
@@ -150,18 +167,22 @@ def test_step_is_classic_rk4(kernel, monkeypatch):
     k3 = f(x + dt / 2 * k2)
     k4 = f(x + dt * k3)
     expected = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    quaternions = formation.layout.uav_quaternions(expected)   # each back to unit length
+    quaternions /= np.linalg.norm(quaternions, axis=-1, keepdims=True)
     assert np.allclose(formation.step(0.0, x, speeds, dt), expected, rtol=1e-12, atol=1e-12)
 
 
 def test_state_layout_views():
     layout = StateLayout(2)
-    assert (layout.n_coordinates, layout.size) == (15, 30)
+    assert (layout.n_coordinates, layout.size) == (9, 18 + 14)
     x = layout.pack([[1, 2, 3], [4, 5, 6]], [[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]], [7, 8, 9],
                     payload_velocity=[-1, -2, -3])
-    assert np.array_equal(x[:15], [1, 2, 3, 0.1, 0.2, 0.3, 4, 5, 6, 0.4, 0.5, 0.6, 7, 8, 9])
+    assert np.array_equal(x[:9], [1, 2, 3, 4, 5, 6, 7, 8, 9])
     assert np.array_equal(layout.payload_velocity(x), [-1, -2, -3])
-    layout.uav_euler_rates(x)[1, 2] = 5.0             # views write through
-    assert x[15 + 11] == 5.0
+    assert np.array_equal(x[18:22], quaternion_from_euler([0.1, 0.2, 0.3])[[3, 0, 1, 2]])
+    assert np.allclose(layout.uav_euler(x), [[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]], atol=1e-15)
+    layout.uav_body_rates(x)[1, 2] = 5.0             # views write through
+    assert x[18 + 7 + 4 + 2] == 5.0
     assert layout.uav_positions(x).shape == (2, 3)
 
 
@@ -184,7 +205,7 @@ def test_arrays_of_the_wrong_shape_are_refused_before_the_compiled_code_reads_th
     x = formation.layout.pack([[0, 0, 2], [1, 0, 2]], np.zeros((2, 3)), [0.5, 0, 0.3])
     with pytest.raises(ValueError, match=r'wrenches must have shape \(2, 4\), got \(2, 3\)'):
         formation.accelerations_from_wrenches(x, np.zeros((2, 3)))
-    with pytest.raises(ValueError, match=r'state must have shape \(30,\), got \(18,\)'):
+    with pytest.raises(ValueError, match=r'state must have shape \(32,\), got \(18,\)'):
         formation.constraint_residuals(x[:18])
 
 
@@ -270,7 +291,7 @@ def test_three_uav_swing_keeps_cables_and_balances_tensions():
     states = np.array(states)
     g = np.array([formation.constraint_residuals(s)[0] for s in states])
     assert np.abs(g).max() < 1e-6
-    assert np.ptp(states[:, 6 * N3 + 1]) > 0.1                  # the payload does swing
+    assert np.ptp(layout.payload_position(states)[:, 1]) > 0.1  # the payload does swing
     # Newton on the payload with the reported tensions, and every cable taut
     for state in states[::250]:
         q_ddot, _ = formation.accelerations(0.0, state, speeds)
@@ -278,7 +299,7 @@ def test_three_uav_swing_keeps_cables_and_balances_tensions():
         assert np.all(tensions > 0)
         units = (layout.uav_positions(state) - layout.payload_position(state)) / LENGTH3
         net = tensions @ units - PAYLOAD3 * GRAVITY * np.array([0, 0, 1.0])
-        assert np.allclose(PAYLOAD3 * q_ddot[6 * N3:], net, atol=1e-9)
+        assert np.allclose(PAYLOAD3 * layout.payload_position(q_ddot), net, atol=1e-9)
     # constant attitudes and thrusts: each thrust is a constant force with potential -F . r
     eulers = np.array([layout.uav_euler(s) for s in states])
     assert np.abs(eulers - eulers[0]).max() < 1e-12

@@ -7,7 +7,7 @@ import pytest
 
 from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.dynamics import FormationModel, initial_state_single_lift
-from multilift_sim.formation_params import FormationParams
+from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.frames import world_to_seed_vector
 from multilift_sim.multirotor import MultirotorParams
 
@@ -57,7 +57,9 @@ def linearised_period() -> float:
 
 def horizontal_swing(states: np.ndarray, direction: np.ndarray) -> np.ndarray:
     """Horizontal payload offset from the UAV along `direction` (world) [m]."""
-    return (states[:, 6:8] - states[:, 0:2]) @ direction
+    layout = StateLayout(1)
+    return (layout.payload_position(states)[:, :2]
+            - layout.uav_positions(states)[:, 0, :2]) @ direction
 
 
 @pytest.fixture(scope='module')
@@ -74,10 +76,14 @@ def seed_release():
 def test_release_position_matches_seed_section_4_1():
     x0 = initial_state_single_lift([1.0, -2.0, 30.0], [0.0, 0.0, 0.4], CABLE_LENGTH, ALPHA0,
                                    BETA0)
-    offset_seed = world_to_seed_vector(x0[6:9] - x0[0:3])
+    layout = StateLayout(1)
+    uav, payload = layout.uav_positions(x0)[0], layout.payload_position(x0)
+    offset_seed = world_to_seed_vector(payload - uav)
     assert np.allclose(offset_seed, [1.02, -0.65, 2.19], atol=0.005)
-    assert x0[8] < x0[2]                         # the payload hangs below the UAV (world z up)
-    assert np.array_equal(x0[9:], np.zeros(9))
+    assert payload[2] < uav[2]                   # the payload hangs below the UAV (world z up)
+    assert np.array_equal(layout.rates(x0), np.zeros(6))
+    assert np.array_equal(layout.uav_body_rates(x0), np.zeros((1, 3)))
+    assert np.allclose(layout.uav_euler(x0), [[0.0, 0.0, 0.4]], rtol=0, atol=1e-16)
     g, g_dot = model(20.0).constraint_residuals(x0)
     assert abs(g[0]) < 1e-12 and g_dot[0] == 0.0
 
@@ -103,7 +109,8 @@ def test_small_swing_period_matches_the_linearised_reduced_model():
 
 def test_seed_release_swings_slower_than_linear_and_as_the_reduced_model(seed_release):
     t, states, reference = seed_release
-    direction = states[0, 6:8] - states[0, 0:2]
+    layout = StateLayout(1)
+    direction = layout.payload_position(states[0])[:2] - layout.uav_positions(states[0])[0, :2]
     direction /= np.linalg.norm(direction)
     dae_period = swing_period(t, horizontal_swing(states, direction))
     uav, payload = REDUCED.to_world_positions(reference)
@@ -122,8 +129,9 @@ def test_dae_trajectory_matches_the_reduced_model(seed_release, alpha_f):
     if alpha_f != 20.0:
         t, states = simulate(model(alpha_f), states[0], 10.0, 1e-3)
     uav, payload = REDUCED.to_world_positions(reference)
-    assert np.abs(states[:, 0:3] - uav).max() < 1e-7
-    assert np.abs(states[:, 6:9] - payload).max() < 1e-7
+    layout = StateLayout(1)
+    assert np.abs(layout.uav_positions(states)[:, 0] - uav).max() < 1e-7
+    assert np.abs(layout.payload_position(states) - payload).max() < 1e-7
 
 
 def test_baumgarte_stabilisation_bounds_the_constraint_drift():
@@ -148,7 +156,8 @@ def test_baumgarte_stabilisation_bounds_the_constraint_drift():
 def test_baumgarte_pulls_an_inconsistent_start_back_onto_the_cable_length():
     # The seed prints r_p(0) = (1.02, -0.65, 2.19) m: rounded, it is 0.009 m^2 off the cable.
     x0 = initial_state_single_lift([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], CABLE_LENGTH, 0.0, 0.0)
-    x0[6:9] = x0[0:3] + np.array([1.02, 0.65, -2.19])           # seed -> world by hand
+    layout = StateLayout(1)
+    layout.payload_position(x0)[:] = layout.uav_positions(x0)[0] + [1.02, 0.65, -2.19]  # by hand
     g0 = abs(model(0.0).constraint_residuals(x0)[0][0])
     assert g0 > 5e-3
     finals = {}
@@ -169,7 +178,7 @@ def swing_invariant(formation: FormationModel, states: np.ndarray) -> np.ndarray
 
 def test_energy_with_thrust_work_is_conserved(seed_release):
     _, states, _ = seed_release
-    assert np.abs(states[:, 3:6]).max() < 1e-12         # no torque: the attitude stays level
+    assert np.abs(StateLayout(1).uav_euler(states)).max() < 1e-12  # no torque: level
     invariant = swing_invariant(model(20.0), states)
     swing_energy = PAYLOAD_MASS * GRAVITY * CABLE_LENGTH * (1 - math.cos(ALPHA0) * math.cos(BETA0))
     assert np.ptp(invariant) < 1e-8 * swing_energy
@@ -192,13 +201,14 @@ def test_free_fall_with_a_tumbling_uav_conserves_energy_and_spins_the_cable():
     layout = formation.layout
     relative_speed = 2.0
     x0 = layout.pack([0.0, 0.0, 50.0], [0.2, -0.1, 0.3], [0.0, 0.0, 50.0 - CABLE_LENGTH],
-                     uav_velocities=[0.0, 0.0, 0.0], uav_euler_rates=[0.5, 1.5, -0.4],
+                     uav_velocities=[0.0, 0.0, 0.0], uav_body_rates=[0.5, 1.5, -0.4],
                      payload_velocity=[relative_speed, 0.0, 0.0])
     stopped = [np.zeros(4)]
     _, states = simulate(formation, x0, 3.0, 1e-3, rotor_speeds=stopped)
     energy = np.array([formation.mechanical_energy(x) for x in states])
     assert np.ptp(energy) < 1e-8 * abs(energy[0])
-    assert np.abs(states[:, 3:6] - states[0, 3:6]).max() > 0.5          # it does tumble
+    euler = layout.uav_euler(states)
+    assert np.abs(euler - euler[0]).max() > 0.5                          # it does tumble
     reduced_mass = UAV.mass * PAYLOAD_MASS / (UAV.mass + PAYLOAD_MASS)
     for x in states[::500]:
         tension = formation.cable_tension(0.0, x, stopped)[0]

@@ -14,6 +14,7 @@ import pytest
 import yaml
 
 from multilift_control.headless import fly, run_headless
+from multilift_sim.formation_params import StateLayout
 from multilift_sim import events as event_kinds
 from multilift_sim import scenario as scenario_io
 from multilift_sim.events.keys import read_uav
@@ -72,10 +73,11 @@ def _single_lift(duration: float, events: list[dict]) -> scenario_io.Scenario:
 def _centre_of_mass(scenario: scenario_io.Scenario, x: np.ndarray) -> tuple[np.ndarray, ...]:
     """(position [m], velocity [m/s]) of a single lift's UAV and payload together."""
     m_uav, m_payload = scenario.uavs[0].vehicle.mass, scenario.payload.mass
-    q, v = x[:9], x[9:18]  # UAV (position, Euler angles), payload position; their rates
+    layout = StateLayout(1)
     total = m_uav + m_payload
-    return ((m_uav * q[:3] + m_payload * q[6:9]) / total,
-            (m_uav * v[:3] + m_payload * v[6:9]) / total)
+    return ((m_uav * layout.uav_positions(x)[0] + m_payload * layout.payload_position(x)) / total,
+            (m_uav * layout.uav_velocities(x)[0] + m_payload * layout.payload_velocity(x))
+            / total)
 
 
 def test_a_kind_defined_in_a_test_registers_compiles_and_flies():

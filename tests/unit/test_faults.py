@@ -19,6 +19,7 @@ from multilift_control.engine.arrays import FINISHED, NOT_FINITE
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
 from multilift_sim.allocation import allocation_matrix
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.formation_geometry import hanging_payload
 
 
@@ -117,7 +118,7 @@ def _payload_path_distance(record, scenario, n):
     """Horizontal distance [m] of the payload from its path: the leader's reference plus the
     payload's place relative to the leader at the start (tick by tick)."""
     states = record.states[:, 0]
-    payload = states[:, 6 * n:6 * n + 2]
+    payload = StateLayout(n).payload_position(states)[:, :2]
     reference = record.reference[:, 0, :2]
     start = payload[0] - states[0, :2]
     return np.hypot(*(payload - reference - start).T)
@@ -140,7 +141,7 @@ def test_v3_uav_loss_the_twin_left_delivers_the_payload():
     tension = record.tension[(t >= 115.0), 0]
     assert np.abs(tension[:, 0] - tension[:, 1]).max() < 0.1 * tension[:, :2].sum(axis=1).min()
     assert (tension[:, 2] == 0.0).all()
-    uavs = engine.state[0, :18].reshape(3, 6)[:, :3]
+    uavs = StateLayout(3).uav_positions(engine.state[0])
     assert np.hypot(*(uavs[2, :2] - uavs[0, :2])) > 7.5  # 4 m farther out than the V's 4
     # the formation's new offsets are what did it: without them the payload drifts away
     kept = Engine(scenario)

@@ -31,11 +31,11 @@ def _swinging(name: str, ticks: int = 5):
         simulator.advance(hover, idle)
     state = simulator.state.copy()
     if simulator.scenario.gusts:
-        n = simulator.n
-        shift = np.r_[np.asarray(simulator.scenario.gusts[0].center) - state[6 * n:6 * n + 2],
-                      0.0]
-        state[:6 * n].reshape(n, 6)[:, :3] += shift
-        state[6 * n:6 * n + 3] += shift
+        layout = simulator.model.layout
+        shift = np.r_[np.asarray(simulator.scenario.gusts[0].center)
+                      - layout.payload_position(state)[:2], 0.0]
+        layout.uav_positions(state)[:] += shift
+        layout.payload_position(state)[:] += shift
     rng = np.random.default_rng(3)
     speeds = [1500.0 + 20.0 * rng.standard_normal(u.vehicle.n_rotors)
               for u in simulator.scenario.uavs]
@@ -53,7 +53,7 @@ def test_the_solve_compiled_is_its_source_bit_for_bit(name):
     for taut in (np.ones(n, bool), np.arange(n) % 2 == 0):  # every cable, then some slack
         results = []
         for function in (solve, kernels.uncompiled(solve)):
-            acc, multipliers = np.empty(model.layout.n_coordinates), np.empty(n)
+            acc, multipliers = np.empty(x.size - model.layout.n_coordinates), np.empty(n)
             function(x, wrenches, *_constants(model), taut, acc, multipliers,
                      np.empty((n, layout.CABLE_COLUMNS)))
             results.append((acc, multipliers))
@@ -158,6 +158,7 @@ def test_runnable_follows_the_kernel_variable(monkeypatch):
     ('UAV_', 'UAV_COLUMNS', {'UAV_INV_INERTIA': 3, 'UAV_GYRO': 3, 'UAV_PAYLOAD_ATTACH': 3,
                              'UAV_ATTACH': 3}),
     ('GUST_', 'GUST_COLUMNS', {'GUST_CENTER': 2, 'GUST_DIRECTION': 3}),
+    ('BODY_', 'BODY_ATTITUDE', {'BODY_QUATERNION': 4, 'BODY_RATES': 3}),
     ('FORMATION_', 'FORMATION_SCALARS', {'FORMATION_WIND': 3, 'FORMATION_PAYLOAD_INERTIA': 3}),
     ('ACTUATOR_', 'ACTUATOR_COLUMNS', {}),
     ('EVENT_', 'EVENT_COLUMNS', {'EVENT_VELOCITY': 3}),
@@ -180,10 +181,16 @@ def test_the_state_layout_is_the_slots():
     from multilift_sim.formation_params import StateLayout
     state = StateLayout(3)
     x = np.arange(state.size, dtype=float)
-    assert state.n_coordinates == layout.n_coordinates(3) == 21
-    assert state.payload_position(x)[0] == layout.payload_slot(3)
-    assert state.uav_euler(x)[2, 0] == 2 * layout.UAV_COORDINATES + layout.EULER
-    assert state.uav_velocities(x)[1, 0] == 21 + layout.UAV_COORDINATES + layout.POSITION
+    assert state.n_coordinates == layout.n_coordinates(3) == 12
+    assert state.size == layout.attitude_slot(3) == 24 + 21
+    assert state.payload_position(x)[0] == layout.payload_slot(3) == 9
+    assert state.uav_positions(x)[2, 0] == layout.uav_slot(2) == 6
+    assert state.uav_velocities(x)[1, 0] == 12 + layout.uav_slot(1) + layout.POSITION
+    assert state.uav_quaternions(x)[2, 0] == layout.uav_attitude_slot(3, 2) == 24 + 14
+    assert state.uav_body_rates(x)[0, 0] == 24 + layout.BODY_RATES
+    rigid = StateLayout(3, rigid_payload=True)
+    assert rigid.size == 45 + layout.BODY_ATTITUDE
+    assert rigid.payload_quaternion(np.arange(rigid.size, dtype=float))[0] == 45
 
 
 def test_cache_dir_is_under_the_users_cache_and_named_by_the_kernels_sources(tmp_path,

@@ -17,7 +17,7 @@ import pytest
 
 from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
-from multilift_sim.analysis.coordinates import coordinate_names
+from multilift_sim.analysis.coordinates import coordinate_names, seed_coordinates_of
 from multilift_sim.analysis.equilibrium import (scenario_configuration, scenario_equilibrium,
                                                 static_equilibrium)
 from multilift_sim.analysis.modal import modal_analysis, mode_state, scenario_modal_analysis
@@ -42,7 +42,7 @@ def _rotation_vector(quaternion: np.ndarray) -> np.ndarray:
 
 def _minimal(layout: StateLayout, x: np.ndarray) -> np.ndarray:
     """q_f and the payload's rotation vector from the identity, (6n + 6,)."""
-    return np.concatenate((x[:layout.n_coordinates],
+    return np.concatenate((seed_coordinates_of(layout, x),
                            _rotation_vector(layout.payload_quaternion(x))))
 
 

@@ -40,6 +40,9 @@ HAND_OFFSETS = (
      'base = 2 * nq'),
     ('the rates\' payload by hand (StateLayout.payload_velocity)', r'\bnq\s*\+\s*6\b',
      'x[nq + 6 * n]'),
+    ('an attitude block by hand (layout.uav_attitude_slot)',
+     r'(?<![\w.\-])7\s*\*\s*\(?\s*[A-Za-z_]|\b(BODY|PAYLOAD)_ATTITUDE\s*\*',
+     'base = bodies + 7 * i'),
 )
 
 
@@ -75,15 +78,17 @@ def test_compiled_slots_are_the_layout_functions(n):
     assert state_slots.uav_slot(n - 1) == layout.uav_slot(n - 1)
     assert state_slots.payload_slot(n) == layout.payload_slot(n)
     assert state_slots.rates_slot(n) == layout.n_coordinates(n)
-    assert state_slots.attitude_slot(n) == layout.attitude_slot(n) == 2 * layout.n_coordinates(n)
+    assert state_slots.uav_attitude_slot(n, n - 1) == layout.uav_attitude_slot(n, n - 1)
+    assert state_slots.attitude_slot(n) == layout.attitude_slot(n) == \
+        layout.uav_attitude_slot(n, n) == 2 * layout.n_coordinates(n) + 7 * n
 
 
 @pytest.mark.parametrize('rigid', [False, True])
 def test_views_of_a_stack_are_the_views_of_each_state(rigid):
     views = StateLayout(3, rigid)
     stack = np.random.default_rng(7).normal(size=(4, 2, views.size))
-    for name in ('coordinates', 'rates', 'uav_coordinates', 'uav_rates', 'uav_positions',
-                 'uav_euler', 'payload_position', 'uav_velocities', 'uav_euler_rates',
+    for name in ('coordinates', 'rates', 'uav_attitudes', 'uav_quaternions', 'uav_body_rates',
+                 'uav_positions', 'payload_position', 'uav_velocities',
                  'payload_velocity') + (('payload_quaternion', 'payload_body_rates')
                                         if rigid else ()):
         view = getattr(views, name)
@@ -91,5 +96,9 @@ def test_views_of_a_stack_are_the_views_of_each_state(rigid):
             for j in range(2):
                 np.testing.assert_array_equal(view(stack)[k, j], view(stack[k, j]))
     x = stack[0, 0].copy()
-    views.uav_euler(x)[1] = (0.1, 0.2, 0.3)   # a view: writes reach x
-    assert tuple(x[layout.uav_slot(1) + layout.EULER:][:3]) == (0.1, 0.2, 0.3)
+    views.uav_body_rates(x)[1] = (0.1, 0.2, 0.3)   # a view: writes reach x
+    assert tuple(x[layout.uav_attitude_slot(3, 1) + layout.BODY_RATES:][:3]) == (0.1, 0.2, 0.3)
+    angles = np.array([[0.1, -1.2, 3.0], [2.0, 0.4, -0.5], [-3.0, 1.5, 0.2]])
+    views.set_uav_euler(stack, np.broadcast_to(angles, (4, 2, 3, 3)))  # stored as quaternions
+    np.testing.assert_allclose(views.uav_euler(stack), np.broadcast_to(angles, (4, 2, 3, 3)),
+                               rtol=0, atol=1e-12)

@@ -16,6 +16,7 @@ from multilift_sim.analysis.equilibrium import scenario_equilibrium
 from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.wind.gusts import Gust
 from multilift_sim.dynamics import FormationModel, initial_state_single_lift
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.formulations import make_formulation
 from multilift_sim.nullspace import NullSpaceModel
 from multilift_sim.start import initial_state
@@ -54,17 +55,21 @@ def test_accelerations_equal_the_multiplier_form(name):
     scenario = load(name)
     rng = np.random.default_rng(7)
     x = initial_state(scenario)
-    payload = x[6 * scenario.n_uavs:6 * scenario.n_uavs + 2]
+    layout = StateLayout(scenario.n_uavs)
+    payload = layout.payload_position(x)[:2]
     gust = Gust(center=tuple(payload + 0.5), direction=(0.0, 1.0, 0.0), gradient_distance=2.0,
                 reference_speed=3.0)                            # ~2 m/s at the payload
     params = dataclasses.replace(scenario.formation_params(0.0, 0.0),
                                  payload_drag_coefficient=0.3, gusts=(gust,))
     nullspace, multiplier = NullSpaceModel(params), FormationModel(params)
-    size = x.size // 2
+    size = layout.n_coordinates
     for _ in range(3):
         state = x.copy()
-        state[:size] += 0.05 * rng.standard_normal(size)
-        state[size:] = rng.standard_normal(size)
+        layout.coordinates(state)[:] += 0.05 * rng.standard_normal(size)
+        layout.rates(state)[:] = rng.standard_normal(size)
+        layout.set_uav_euler(state, layout.uav_euler(state)
+                             + 0.05 * rng.standard_normal((scenario.n_uavs, 3)))  # tilted
+        layout.uav_body_rates(state)[:] = rng.standard_normal((scenario.n_uavs, 3))
         state = nullspace.project(state)
         wrenches = np.column_stack((rng.uniform(20, 40, scenario.n_uavs),
                                     rng.uniform(-0.5, 0.5, (scenario.n_uavs, 3))))
@@ -78,16 +83,17 @@ def test_projection_puts_a_state_on_the_manifold():
     scenario = load('twin_lift')
     model = NullSpaceModel(scenario.formation_params())
     x = initial_state(scenario)
-    size = x.size // 2
+    layout = model.layout
+    size = layout.n_coordinates
     rng = np.random.default_rng(3)
-    x[:size] += 1e-3 * rng.standard_normal(size)
-    x[size:] = rng.standard_normal(size)
+    layout.coordinates(x)[:] += 1e-3 * rng.standard_normal(size)
+    layout.rates(x)[:] = rng.standard_normal(size)
+    layout.uav_body_rates(x)[:] = rng.standard_normal((2, 3))
     projected = model.project(x)
     g, g_dot = model.constraint_residuals(projected)
     assert np.abs(g).max() < 1e-12 and np.abs(g_dot).max() < 1e-12
-    attitudes = [3, 4, 5, 9, 10, 11]
-    attitudes += [size + k for k in attitudes]
-    assert np.array_equal(projected[attitudes], x[attitudes])       # only translations move
+    assert np.array_equal(layout.uav_attitudes(projected),          # only translations move
+                          layout.uav_attitudes(x))
 
 
 def test_projection_holds_the_residual_where_the_unstabilised_dae_drifts(swing):
@@ -120,10 +126,12 @@ def test_agrees_with_the_reduced_model_and_the_baumgarte_dae(swing):
     reference = reduced.simulate(rest_state([0, 0, 0], [0, 0, 0], ALPHA0, BETA0), speeds[0],
                                  duration, t_eval=t).y.T
     uav_ref, payload_ref = reduced.to_world_positions(reference)
-    assert np.abs(states[:, 0:3] - uav_ref).max() < 1e-7
-    assert np.abs(states[:, 6:9] - payload_ref).max() < 1e-7
+    layout = nullspace.layout
+    uavs, payloads = layout.uav_positions(states)[:, 0], layout.payload_position(states)
+    assert np.abs(uavs - uav_ref).max() < 1e-7
+    assert np.abs(payloads - payload_ref).max() < 1e-7
     assert np.abs(states - baumgarte).max() < 1e-7
-    assert np.abs(states[:, 6:9] - states[:, 0:3]).max() > 0.5    # it does swing
+    assert np.abs(payloads - uavs).max() > 0.5                      # it does swing
     # energy with the thrust's work (level, constant thrust) is conserved
     thrust = nullspace.wrenches(speeds)[0, 0]
     invariant = np.array([nullspace.mechanical_energy(x) for x in states]) \
@@ -214,7 +222,7 @@ def test_the_null_space_form_compiled_is_its_source_bit_for_bit(name):
     wrenches = model.wrenches([np.full(u.vehicle.n_rotors, 1500.0) for u in scenario.uavs])
     results = []
     for function in (nullspace_solve, kernels.uncompiled(nullspace_solve)):
-        acc, multipliers = np.empty(layout.n_coordinates), np.empty(scenario.n_uavs)
+        acc, multipliers = np.empty(layout.size - layout.n_coordinates), np.empty(scenario.n_uavs)
         function(x, wrenches, formation._uavs, formation._gusts, formation._formation, acc,
                  multipliers)
         results.append((acc, multipliers))

@@ -9,12 +9,14 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from multilift_sim import kernels
 from multilift_sim.wire import msgvalues
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
-from multilift_sim.kinematics import euler_rate_matrix, quaternion_from_euler, rotation_matrix
+from multilift_sim.formation_params import StateLayout
+from multilift_sim.kinematics import quaternion_from_euler, rotation_matrix
 from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
@@ -23,9 +25,17 @@ from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS,
 from multilift_sim.physics.measurement import measured_states, odometry_states
 
 
+def _angles(n: int, rng) -> np.ndarray:
+    """ZYX angles (n, 3) [rad] in the output's ranges: roll and yaw in (-pi, pi], pitch in
+    (-pi/2, pi/2)."""
+    return np.column_stack((rng.uniform(-3.1, 3.1, n), rng.uniform(-1.5, 1.5, n),
+                            rng.uniform(-3.1, 3.1, n)))
+
+
 def _random_state(n: int, rng) -> np.ndarray:
-    x = rng.normal(size=2 * (6 * n + 3))
-    x[:6 * n].reshape(n, 6)[:, 3:5] *= 0.4  # roll and pitch within +-1.2 rad or so
+    layout = StateLayout(n)
+    x = rng.normal(size=layout.size)
+    layout.set_uav_euler(x, _angles(n, rng))
     return x
 
 
@@ -37,16 +47,38 @@ def test_measured_states_compiled_equal_uncompiled_and_w_eta_dot(n):
     measured_states(x, n, compiled)
     kernels.uncompiled(measured_states)(x, n, python)
     assert np.array_equal(compiled, python)
-    nq = 6 * n + 3
+    layout = StateLayout(n)
     for i in range(n):
-        eta, eta_dot = x[6 * i + 3:6 * i + 6], x[nq + 6 * i + 3:nq + 6 * i + 6]
         row = compiled[i]
-        assert np.array_equal(row[MEASURED_POSITION:MEASURED_POSITION + 3], x[6 * i:6 * i + 3])
+        assert np.array_equal(row[MEASURED_POSITION:MEASURED_POSITION + 3],
+                              layout.uav_positions(x)[i])
         assert np.array_equal(row[MEASURED_VELOCITY:MEASURED_VELOCITY + 3],
-                              x[nq + 6 * i:nq + 6 * i + 3])
-        assert np.array_equal(row[MEASURED_EULER:MEASURED_EULER + 3], eta)
-        assert np.allclose(row[MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3],
-                           euler_rate_matrix(eta) @ eta_dot, rtol=1e-13, atol=1e-13)
+                              layout.uav_velocities(x)[i])
+        assert np.array_equal(row[MEASURED_BODY_RATES:MEASURED_BODY_RATES + 3],
+                              layout.uav_body_rates(x)[i])
+        # the angles are the quaternion's: R of them is R of the quaternion (scipy's, an
+        # independent form)
+        eta = row[MEASURED_EULER:MEASURED_EULER + 3]
+        w, qx, qy, qz = layout.uav_quaternions(x)[i]
+        np.testing.assert_allclose(rotation_matrix(eta),
+                                   Rotation.from_quat([qx, qy, qz, w]).as_matrix(),
+                                   rtol=0, atol=1e-14)
+
+
+def test_the_angles_of_a_quaternion_are_its_angles_up_to_and_at_90_degrees_pitch():
+    rng = np.random.default_rng(3)
+    angles = _angles(200, rng)
+    angles[:5, 1] = (math.pi / 2, -math.pi / 2, math.pi / 2 - 1e-9, 1.0, -1.0)
+    layout = StateLayout(200)
+    x = np.zeros(layout.size)
+    layout.set_uav_euler(x, angles)
+    back = layout.uav_euler(x)
+    assert np.abs(back[3:] - angles[3:]).max() < 1e-13
+    for k in range(200):  # at 90 deg pitch only roll - yaw (or + yaw) is defined: compare R
+        np.testing.assert_allclose(rotation_matrix(back[k]), rotation_matrix(angles[k]),
+                                   rtol=0, atol=1e-8 if k < 3 else 1e-14)
+    assert np.abs(np.abs(back[:2, 1]) - math.pi / 2).max() < 1e-8
+    assert np.array_equal(back[:3, 2], np.zeros(3))  # at the lock: yaw 0, roll the rest
 
 
 @pytest.mark.parametrize('n', [1, 2, 5])

@@ -6,6 +6,7 @@ import numpy as np
 
 from multilift_sim.analysis.reduced_model import ReducedSingleLiftModel, rest_state
 from multilift_sim.constraints import cable_residual_rates, cable_residuals
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.kinematics import euler_rate_matrix
 from multilift_sim.multirotor import MultirotorParams
 
@@ -58,9 +59,11 @@ def test_velocity_and_gravity_terms_match_the_euler_lagrange_equation():
 def test_world_state_of_a_reduced_state_satisfies_the_cable_constraint():
     for q, q_dot in SAMPLES:
         x = MODEL.to_formation_state(np.concatenate((q, q_dot)))
-        positions, payload = x[None, 0:3], x[6:9]
+        layout = StateLayout(1)
+        positions, payload = layout.uav_positions(x), layout.payload_position(x)
         assert abs(cable_residuals(positions, payload, [2.5])[0]) < 1e-12
-        assert abs(cable_residual_rates(positions, x[None, 9:12], payload, x[15:18])[0]) < 1e-12
+        assert abs(cable_residual_rates(positions, layout.uav_velocities(x), payload,
+                                        layout.payload_velocity(x))[0]) < 1e-12
 
 
 def test_linearised_pendulum_mode_is_2_13_rad_s_and_2_94_s():

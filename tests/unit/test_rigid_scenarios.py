@@ -34,7 +34,7 @@ def test_the_box_starts_level_on_every_cable_with_the_solid_s_inertia():
         (2.0 / 12 * (0.36 + 0.16), 2.0 / 12 * (1.0 + 0.16), 2.0 / 12 * (1.0 + 0.36)))
     model = FormationModel(scenario.formation_params())
     x = initial_state(scenario)
-    assert x.size == model.layout.size == 2 * (6 * 4 + 3) + 7
+    assert x.size == model.layout.size == 2 * (3 * 4 + 3) + 7 * 4 + 7  # the UAVs' blocks, then its
     g, g_dot = model.constraint_residuals(x)
     assert np.abs(g).max() < 1e-12 and np.abs(g_dot).max() == 0.0
     assert model.layout.payload_quaternion(x).tolist() == [1.0, 0.0, 0.0, 0.0]
@@ -48,7 +48,7 @@ def test_cylinder_inertia_and_the_point_payload_unchanged():
         (0.5 * 1.5 * 0.03 ** 2, 1.5 / 12 * (3 * 0.03 ** 2 + 9.0), 1.5 / 12 * (3 * 0.03 ** 2 + 9.0)))
     twin = scenario_io.load('twin_lift')
     assert twin.payload.type == 'point' and twin.formation_params().payload_inertia is None
-    assert initial_state(twin).size == 2 * (6 * 2 + 3)
+    assert initial_state(twin).size == 2 * (3 * 2 + 3) + 7 * 2
 
 
 @pytest.mark.parametrize('payload,message', [
@@ -130,13 +130,13 @@ def test_the_markers_draw_the_body_and_end_the_cables_at_its_attach_points(name,
     """/visualization/markers of a rigid payload: its shape (a CUBE of the box's size, a
     CYLINDER of the beam's length laid along its x axis) at its pose, each cable from its UAV
     to its attach point r_p + R_p b_i."""
+    from multilift_sim.physics.layout import attitude_slot
     from multilift_sim.physics.rigid_payload import payload_rotation
     from multilift_sim.simulation import FormationSimulator
     from multilift_sim.wire.scene import CABLE_SEGMENTS, FormationScene
 
     scenario = scenario_io.load(name)
     simulator = FormationSimulator(scenario)
-    layout = simulator.model.layout
     hover = [np.full(4, 1900.0)] * scenario.n_uavs
     for _ in range(150):
         simulator.advance(hover, [np.zeros(4, bool)] * scenario.n_uavs)
@@ -146,7 +146,7 @@ def test_the_markers_draw_the_body_and_end_the_cables_at_its_attach_points(name,
                  snap.payload_position, [1.0] * scenario.n_uavs, None,
                  snap.payload_attitude[0])
     assert scene.payload.type == kind
-    rotation = payload_rotation(simulator.state, 2 * layout.n_coordinates)
+    rotation = payload_rotation(simulator.state, attitude_slot(scenario.n_uavs))
     for cable, attach in zip(scene.cables, scenario.payload.attach_points):
         end = snap.payload_position + rotation @ np.array(attach)
         assert np.abs(np.array(cable.points[2 * CABLE_SEGMENTS - 1]) - end).max() < 1e-12

@@ -19,7 +19,6 @@ from test_rigid_payload import BOX_CORNERS, BOX_INERTIA, _hanging, _params
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
-from multilift_sim.kinematics import euler_rate_matrix, rotation_matrix
 from multilift_sim.physics.layout import CABLE_COLUMNS, SLACK_CABLE_ROWS
 from multilift_sim.physics.slack_cables import integrate_period as slack_period
 from multilift_sim.physics.slack_cables import snap
@@ -59,32 +58,33 @@ def _payload_rotation(q) -> np.ndarray:
 
 
 def _velocities(model, x) -> np.ndarray:
-    """The generalized velocities u: per UAV (v_i, eta_dot_i), then v_p, then omega_p (a
-    rigid payload's body rates)."""
-    nq = model.layout.n_coordinates
-    u = x[nq:2 * nq]
-    return np.concatenate((u, model.layout.payload_body_rates(x))) if model.layout.rigid_payload \
-        else u.copy()
+    """The generalized velocities u: q_dot (each UAV's v_i, then v_p), each UAV's body rates
+    omega_i, then a rigid payload's omega_p."""
+    layout = model.layout
+    parts = [layout.rates(x), layout.uav_body_rates(x).ravel()]
+    if layout.rigid_payload:
+        parts.append(layout.payload_body_rates(x))
+    return np.concatenate(parts)
 
 
 def _with_velocities(model, x, u) -> np.ndarray:
-    nq = model.layout.n_coordinates
+    layout = model.layout
+    nq, n = layout.n_coordinates, layout.n_uavs
     out = np.array(x)
-    out[nq:2 * nq] = u[:nq]
-    if model.layout.rigid_payload:
-        model.layout.payload_body_rates(out)[:] = u[nq:]
+    layout.rates(out)[:] = u[:nq]
+    layout.uav_body_rates(out)[:] = u[nq:nq + 3 * n].reshape(n, 3)
+    if layout.rigid_payload:
+        layout.payload_body_rates(out)[:] = u[nq + 3 * n:]
     return out
 
 
 def _mass_matrix(model, x) -> np.ndarray:
-    """M of the kinetic energy 1/2 u^T M u: m_i I and W_i^T J_i W_i per UAV (omega_i = W_i
-    eta_dot_i, Eq. 2.7), m_p I, and J_p for a rigid payload's body rates."""
+    """M of the kinetic energy 1/2 u^T M u: m_i I per UAV, m_p I, J_i per UAV's body rates,
+    and J_p for a rigid payload's."""
     layout = model.layout
-    blocks = []
-    for i in range(len(model.uav_masses)):
-        w = euler_rate_matrix(layout.uav_euler(x)[i])
-        blocks += [model.uav_masses[i] * np.eye(3), w.T @ np.diag(model.uav_inertia[i]) @ w]
+    blocks = [model.uav_masses[i] * np.eye(3) for i in range(len(model.uav_masses))]
     blocks.append(model.payload_mass * np.eye(3))
+    blocks += [np.diag(model.uav_inertia[i]) for i in range(len(model.uav_masses))]
     if layout.rigid_payload:
         blocks.append(np.diag(model.params.payload_inertia))
     size = sum(len(b) for b in blocks)
@@ -106,9 +106,8 @@ def _g_dot(model, x, u) -> np.ndarray:
         spin = layout.payload_body_rates(x)
     out = []
     for i in range(len(model.uav_masses)):
-        eta = layout.uav_euler(x)[i]
-        rotation_i = rotation_matrix(eta)
-        omega_i = euler_rate_matrix(eta) @ layout.uav_euler_rates(x)[i]
+        rotation_i = _payload_rotation(layout.uav_quaternions(x)[i])   # the same R of a q
+        omega_i = layout.uav_body_rates(x)[i]
         a = np.array(params.uav_attach_points[i]) if params.uav_attach_points else np.zeros(3)
         b = np.array(params.payload_attach_points[i]) if layout.rigid_payload else np.zeros(3)
         d = (layout.payload_position(x) + rotation_p @ b - layout.uav_positions(x)[i]
@@ -140,20 +139,21 @@ def _momenta(model, x) -> tuple[np.ndarray, np.ndarray]:
         angular = angular + _payload_rotation(layout.payload_quaternion(x)) @ (
             np.array(model.params.payload_inertia) * layout.payload_body_rates(x))
     for i in range(len(model.uav_masses)):
-        eta = layout.uav_euler(x)[i]
-        omega = euler_rate_matrix(eta) @ layout.uav_euler_rates(x)[i]
+        omega = layout.uav_body_rates(x)[i]
         angular = angular + model.uav_masses[i] * np.cross(layout.uav_positions(x)[i],
                                                            layout.uav_velocities(x)[i])
-        angular = angular + rotation_matrix(eta) @ (model.uav_inertia[i] * omega)
+        angular = angular + _payload_rotation(layout.uav_quaternions(x)[i]) @ (
+            model.uav_inertia[i] * omega)
     return linear, angular
 
 
 def _tumbling(model, x, seed: int) -> np.ndarray:
     """x with random velocities: every body moving and turning."""
     rng = np.random.default_rng(seed)
-    nq = model.layout.n_coordinates
+    layout = model.layout
     x = np.array(x)
-    x[nq:2 * nq] = rng.normal(0.0, 0.5, nq)
+    layout.rates(x)[:] = rng.normal(0.0, 0.5, layout.n_coordinates)
+    layout.uav_body_rates(x)[:] = rng.normal(0.0, 0.5, (layout.n_uavs, 3))
     if model.layout.rigid_payload:
         model.layout.payload_body_rates(x)[:] = rng.normal(0.0, 0.5, 3)
     return x
@@ -235,7 +235,7 @@ def _flying_apart(model, x) -> np.ndarray:
     if layout.rigid_payload:
         layout.payload_body_rates(x)[:] = [0.3, -0.2, 0.5]
     if model.params.uav_attach_points:
-        layout.uav_euler_rates(x)[:] = rng.normal(0.0, 0.5, (4, 3))
+        layout.uav_body_rates(x)[:] = rng.normal(0.0, 0.5, (4, 3))
     model.taut = False
     g, _ = model.constraint_residuals(x)
     assert g.max() < -0.5

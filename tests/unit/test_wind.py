@@ -16,6 +16,7 @@ from multilift_control.engine import Engine
 from multilift_control.headless import run_headless
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.start import initial_state
 
 WIND = (3.0, -1.0, 0.5)  # [m/s], world
@@ -43,21 +44,20 @@ def test_the_formation_s_momentum_changes_by_the_external_forces_alone():
     speeds = [np.full(4, 1500.0), np.array([1400.0, 1550.0, 1500.0, 1450.0])]
     acc, _ = model.accelerations(0.0, x, speeds)
     masses = model.uav_masses
-    nq = layout.n_coordinates
-    uav_acc = np.array([acc[6 * i:6 * i + 3] for i in range(2)])
-    rate = masses @ uav_acc + model.payload_mass * acc[12:15]
+    uav_acc = layout.uav_positions(acc)
+    rate = masses @ uav_acc + model.payload_mass * layout.payload_position(acc)
     wrenches = model.wrenches(speeds)
     wind = np.array(WIND)
     expected = -(masses.sum() + model.payload_mass) * np.array([0.0, 0.0, 9.81])
     for i in range(2):
-        phi, theta, psi = x[6 * i + 3:6 * i + 6]
+        phi, theta, psi = layout.uav_euler(x)[i]
         # R e_z of ZYX Euler angles: the body z axis in the world
         body_z = np.array([np.cos(psi) * np.sin(theta) * np.cos(phi) + np.sin(psi) * np.sin(phi),
                            np.sin(psi) * np.sin(theta) * np.cos(phi) - np.cos(psi) * np.sin(phi),
                            np.cos(theta) * np.cos(phi)])
-        relative = x[nq + 6 * i:nq + 6 * i + 3] - wind
+        relative = layout.uav_velocities(x)[i] - wind
         expected += wrenches[i, 0] * body_z - 0.08 * np.linalg.norm(relative) * relative
-    relative = x[nq + 12:nq + 15] - wind  # the payload (no gust at the start place)
+    relative = layout.payload_velocity(x) - wind  # the payload (no gust at the start place)
     expected -= scenario.payload.drag_coefficient * np.linalg.norm(relative) * relative
     assert rate == pytest.approx(expected, rel=1e-12, abs=1e-12)
     calm = FormationModel(scenario_io.load('twin_lift').formation_params())
@@ -88,7 +88,9 @@ def test_a_twin_lift_in_the_wind_trails_its_payload_downwind():
         assert engine.summary(0)['sim']['max_abs_constraint'] < \
             scenario.simulation.constraint_tolerance
         states = record.states[:, 0]
-        places.append(states[:, 12:15] - 0.5 * (states[:, 0:3] + states[:, 6:9]))
+        layout = StateLayout(2)
+        places.append(layout.payload_position(states)
+                      - layout.uav_positions(states).mean(axis=1))
     trail = places[0][1000:, 0] - places[1][1000:, 0]  # from 10 s on, along the wind
     assert trail.mean() > 0.05
 
@@ -179,9 +181,9 @@ def test_a_gust_event_blows_through_the_formation_alike_in_both_paths():
     engine.step(600, record)
     still.step(600, still_record)
     assert np.array_equal(record.states[:201], still_record.states[:201])
-    n = 2
-    drift = record.states[:, 0, :6 * n + 3] - still_record.states[:, 0, :6 * n + 3]
-    payload_y = drift[:, 6 * n + 1]
+    layout = StateLayout(2)
+    payload_y = (layout.payload_position(record.states[:, 0])[:, 1]
+                 - layout.payload_position(still_record.states[:, 0])[:, 1])
     assert payload_y[400] > 0.05  # pushed along +y by the end of the gust
     run = run_headless(scenario)
     assert np.array_equal(engine.state[0], run.simulator.state)

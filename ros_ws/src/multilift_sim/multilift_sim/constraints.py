@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from multilift_sim.physics.layout import POSITION, n_coordinates, payload_slot, uav_slot
+from multilift_sim.physics.layout import (POSITION, seed_coordinates, seed_payload_slot,
+                                          seed_uav_slot)
 
 
 def cable_residuals(uav_positions: ArrayLike, payload_position: ArrayLike,
@@ -52,11 +53,11 @@ def constraint_jacobian(uav_positions: ArrayLike, payload_position: ArrayLike) -
     positions = np.asarray(uav_positions, dtype=float)
     n = positions.shape[0]
     offsets = np.asarray(payload_position, dtype=float) - positions
-    jacobian = np.zeros((n, n_coordinates(n)))
+    jacobian = np.zeros((n, seed_coordinates(n)))
     for i in range(n):
-        r = uav_slot(i) + POSITION
+        r = seed_uav_slot(i) + POSITION
         jacobian[i, r:r + 3] = -2.0 * offsets[i]            # Eq. 2.66
-        jacobian[i, payload_slot(n):] = 2.0 * offsets[i]    # Eq. 2.67
+        jacobian[i, seed_payload_slot(n):] = 2.0 * offsets[i]    # Eq. 2.67
     return jacobian
 
 

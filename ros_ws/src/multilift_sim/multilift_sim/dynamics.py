@@ -1,7 +1,9 @@
 """Formation DAE of n >= 1 multirotors carrying one payload on rigid cables (seed Eq. 2.41-2.70).
 
-World frame (z up), SI units, state layout of docs/conventions.md: ``x = (q_f, q_f_dot)`` with
-``q_f = (r_1, eta_1, ..., r_n, eta_n, r_p)`` of length 6n + 3.
+World frame (z up), SI units, state layout of docs/conventions.md: the translations
+``q = (r_1, ..., r_n, r_p)`` (3n + 3) and ``q_dot``, then each UAV's attitude as a unit
+quaternion and its body rates (and a rigid payload's): the seed's q_f = (r_i, eta_i, ..., r_p)
+with each eta_i's ZYX angles replaced by a quaternion, which no attitude makes singular.
 
 Equations of motion (seed Eq. 2.46, 2.59-2.60, 2.70):
 
@@ -15,17 +17,17 @@ With ``f = B_f u_f + d_f - f_g - C_f q_dot`` the multipliers are
 
 which is Eq. 2.60/2.70 with the signs gathered. The cable rows of G touch only the UAV
 translations (mass m_i I) and the payload (m_p I), and C_f, B_f only couple each UAV's own
-coordinates, so the model never forms the (6n+3)^2 matrices (the arithmetic:
+coordinates, so the model never forms the dense mass matrix (the arithmetic:
 multilift_sim.physics.formation_dae):
 
-- each UAV's attitude is integrated on its own (Euler equation pulled back to eta, see
-  multirotor.py);
+- each UAV's attitude is integrated on its own (Euler's equation J omega_dot = tau -
+  omega x J omega in body rates, Eq. 2.28, and q_dot = q (x) (0, omega) / 2);
 - with ``d_i = r_p - r_i``, ``G M^-1 G^T = diag(4 |d_i|^2 / m_i) + 4 D D^T / m_p`` (n x n),
   solved by the Woodbury identity as a 3 x 3 system, and
   ``(G M^-1 f)_i = 2 d_i . (a_p - a_i)`` with a the unconstrained accelerations.
 
-Forces: UAV i gets thrust ``u_T R(eta_i) e_z`` and gravity ``-m_i g e_z``, and body torque tau
-enters as ``W^T tau``; the payload gets gravity and the air-relative quadratic drag of
+Forces: UAV i gets thrust ``u_T R_i e_z`` and gravity ``-m_i g e_z``, and body torque tau
+enters Euler's equation; the payload gets gravity and the air-relative quadratic drag of
 wind/gusts.py (gusts included). Rotor speeds are held constant over each RK4 step; with
 lagging rotors (`vehicle.motor_time_constant`, `motor_rate_limit`) each step holds the speed
 whose square is the step's mean of omega^2 (multilift_sim.physics.actuators).
@@ -43,7 +45,6 @@ from numpy.typing import ArrayLike
 
 from multilift_sim import kernels
 from multilift_sim.frames import seed_to_world_vector
-from multilift_sim.multirotor import rotational_kinetic_energy
 from multilift_sim.formation_params import (FormationParams, StateLayout, actuator_array,
                                              constant_arrays)
 from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_NULL_SPACE, FORMATION_WIND,
@@ -53,7 +54,7 @@ from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_NULL_SPACE, F
 @dataclass(frozen=True)
 class Integration:
     """What holding the rotor speeds over a control period gives (`Formulation.integrate`)."""
-    state: np.ndarray              # the formation state at the end, (2(6n+3),)
+    state: np.ndarray              # the formation state at the end (StateLayout.size,)
     cable_tension: np.ndarray      # T_i = 2 l_i lambda_i at the start [N], (n,)
     constraint: np.ndarray         # g_i at the end [m^2], (n,)
     constraint_rate: np.ndarray    # g_i_dot at the end [m^2/s], (n,)
@@ -191,10 +192,9 @@ class FormationModel:
     # --------------------------------------------------------------------------- dynamics
     def accelerations(self, t: float, x: np.ndarray,
                       rotor_speeds: Sequence[ArrayLike]) -> tuple[np.ndarray, np.ndarray]:
-        """(q_ddot (6n+3,), cable multipliers Lambda (n,) [N/m]) at time t [s] and state x.
-
-        q_ddot holds [m/s^2] for positions and [rad/s^2] for Euler angles (world frame).
-        """
+        """(acc, cable multipliers Lambda (n,) [N/m]) at time t [s] and state x: acc holds
+        q_ddot (3n + 3,) [m/s^2] (world frame), then the rates of the bodies' attitude blocks
+        (each quaternion's rate [1/s] and omega_dot [rad/s^2], body frame)."""
         del t  # the model is autonomous: the inputs are held, gusts are stationary
         return self.accelerations_from_wrenches(x, self.wrenches(rotor_speeds))
 
@@ -210,8 +210,8 @@ class FormationModel:
 
     def derivative(self, t: float, x: np.ndarray,
                    rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
-        """State derivative ``x_dot = (q_f_dot, q_f_ddot)``, shape (2(6n+3),) (with a rigid
-        payload, then its attitude block's rate)."""
+        """State derivative ``x_dot = (q_dot, q_ddot, the attitude blocks' rates)``, the
+        state's shape."""
         x = np.asarray(x, dtype=float)
         q_ddot, _ = self.accelerations(t, x, rotor_speeds)
         return np.concatenate((self.layout.rates(x), q_ddot))
@@ -261,8 +261,8 @@ class FormationModel:
         payload_velocity = layout.payload_velocity(x)
         translational = 0.5 * (np.sum(self.uav_masses * np.sum(velocities ** 2, axis=1))
                                + self.payload_mass * payload_velocity @ payload_velocity)
-        rotational = np.sum(rotational_kinetic_energy(self.uav_inertia, layout.uav_euler(x),
-                                                      layout.uav_euler_rates(x)))
+        omega = layout.uav_body_rates(x)   # 1/2 omega_i . J_i omega_i (Eq. 2.24 in body rates)
+        rotational = 0.5 * float(np.sum(self.uav_inertia * omega * omega))
         if layout.rigid_payload:  # the payload's own spin, 1/2 omega_p . J_p omega_p
             omega = layout.payload_body_rates(x)
             rotational += 0.5 * float(np.dot(self.params.payload_inertia, omega * omega))
@@ -300,7 +300,7 @@ def initial_state_single_lift(uav_position: ArrayLike, eta: ArrayLike, cable_len
     uav_position [m] and eta [rad] in the world frame; alpha, beta [rad] in the SEED convention:
     ``r_p - r = l (c_a s_b, -s_a, c_a c_b)`` in the seed's z-down frame, mapped to the world
     with frames.seed_to_world_vector (so alpha = beta = 0 hangs the payload straight below).
-    All velocities are zero, which satisfies Eq. 2.56. Returns x of length 18.
+    All velocities are zero, which satisfies Eq. 2.56. Returns x (docs/conventions.md).
     """
     seed_offset = cable_length * np.array([math.cos(alpha) * math.sin(beta), -math.sin(alpha),
                                            math.cos(alpha) * math.cos(beta)])

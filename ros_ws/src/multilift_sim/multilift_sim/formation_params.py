@@ -1,6 +1,7 @@
 """A formation's parameters and the arrays built from them: `FormationParams` (what the DAE
-needs of a scenario), `StateLayout` (numpy views of the formation state x = (q_f, q_f_dot),
-docs/conventions.md) and the constant rows the physics functions read (`constant_arrays`,
+needs of a scenario), `StateLayout` (numpy views of the formation state x: the translations'
+(q, q_dot), then the bodies' attitude blocks, docs/conventions.md) and the constant rows the
+physics functions read (`constant_arrays`,
 `actuator_array`; their slots: multilift_sim.physics.layout). World frame (z up), SI units."""
 from __future__ import annotations
 
@@ -10,17 +11,18 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from multilift_sim.wind.gusts import Gust
+from multilift_sim.kinematics import euler_from_quaternion, quaternion_from_euler
 from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (
     ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, FORMATION_BETA_SQ,
     FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
     FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS, FORMATION_PROJECTION_STEPS,
-    FORMATION_PROJECTION_TOLERANCE, FORMATION_SCALARS, FORMATION_TWO_ALPHA,
+    FORMATION_PROJECTION_TOLERANCE, FORMATION_SCALARS, FORMATION_SUBSTEPS, FORMATION_TWO_ALPHA,
     FORMATION_WIND, GUST_CENTER, GUST_COLUMNS, GUST_DIRECTION, GUST_GRADIENT_DISTANCE,
     GUST_REFERENCE_SPEED, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ,
     UAV_ATTACH, UAV_MASS, UAV_PAYLOAD_ATTACH)
+from multilift_sim.wind.gusts import Gust
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -119,14 +121,16 @@ class FormationParams:
 
 @dataclass(frozen=True)
 class StateLayout:
-    """Named views into the packed formation state ``x = (q_f, q_f_dot)`` of length 2(6n+3),
-    and with a rigid payload its attitude after them (`physics.layout` PAYLOAD_ATTITUDE: the
-    unit quaternion (w, x, y, z), payload frame -> world, and its body rates [rad/s]).
+    """Named views into the packed formation state x (docs/conventions.md): the translations
+    q = (r_1, ..., r_n, r_p) [m] and their velocities q_dot [m/s], then each UAV's attitude
+    block and a rigid payload's (`physics.layout` BODY_*: the unit quaternion (w, x, y, z),
+    body -> world, and the body rates [rad/s]).
 
     Each accessor takes one state (size,) or a stack of them (..., size) (a batch, a run's
-    record) and returns a view (writable when x is a contiguous float array), not a copy; the
-    shapes below are one state's, a stack's have its leading axes first. The one place of these
-    offsets outside the compiled functions (which use physics.state_slots).
+    record) and returns a view (writable when x is a contiguous float array), not a copy, but
+    `uav_euler`, computed from the quaternions; the shapes below are one state's, a stack's
+    have its leading axes first. The one place of these offsets outside the compiled functions
+    (which use physics.state_slots).
     """
 
     n_uavs: int
@@ -138,53 +142,59 @@ class StateLayout:
 
     @property
     def n_coordinates(self) -> int:
-        """Length of q_f: 6n + 3."""
+        """Length of q: 3n + 3."""
         return slots.n_coordinates(self.n_uavs)
 
     @property
     def size(self) -> int:
-        """Length of the state x: 2 (6n + 3), plus 7 with a rigid payload."""
+        """Length of the state x: 2 (3n + 3) + 7n, plus 7 with a rigid payload."""
         return slots.attitude_slot(self.n_uavs) + (
-            slots.PAYLOAD_ATTITUDE if self.rigid_payload else 0)
+            slots.BODY_ATTITUDE if self.rigid_payload else 0)
 
     def coordinates(self, x: np.ndarray) -> np.ndarray:
-        """q_f, shape (6n + 3,)."""
+        """q, the translations (r_1, ..., r_n, r_p) [m], shape (3n + 3,)."""
         return x[..., :self.n_coordinates]
 
     def rates(self, x: np.ndarray) -> np.ndarray:
-        """q_f_dot, shape (6n + 3,)."""
-        return x[..., self.n_coordinates:slots.attitude_slot(self.n_uavs)]
+        """q_dot, their velocities [m/s], shape (3n + 3,)."""
+        return x[..., self.n_coordinates:slots.uav_attitude_slot(self.n_uavs, 0)]
 
     def payload_quaternion(self, x: np.ndarray) -> np.ndarray:
         """A rigid payload's attitude, the unit quaternion (w, x, y, z), shape (4,)."""
-        base = slots.attitude_slot(self.n_uavs) + slots.PAYLOAD_QUATERNION
+        base = slots.attitude_slot(self.n_uavs) + slots.BODY_QUATERNION
         return x[..., base:base + 4]
 
     def payload_body_rates(self, x: np.ndarray) -> np.ndarray:
         """A rigid payload's angular velocity omega_p [rad/s], payload frame, shape (3,)."""
-        base = slots.attitude_slot(self.n_uavs) + slots.PAYLOAD_BODY_RATES
+        base = slots.attitude_slot(self.n_uavs) + slots.BODY_RATES
         return x[..., base:base + 3]
 
     def _uav_block(self, q: np.ndarray) -> np.ndarray:
         return q[..., :slots.payload_slot(self.n_uavs)].reshape(
             q.shape[:-1] + (self.n_uavs, slots.UAV_COORDINATES))
 
-    def uav_coordinates(self, x: np.ndarray) -> np.ndarray:
-        """Every UAV's block of q_f, (r_i [m], eta_i [rad]) by the slots POSITION and EULER,
-        shape (n, 6)."""
-        return self._uav_block(self.coordinates(x))
-
-    def uav_rates(self, x: np.ndarray) -> np.ndarray:
-        """Every UAV's block of q_f_dot, (r_i_dot [m/s], eta_i_dot [rad/s]), shape (n, 6)."""
-        return self._uav_block(self.rates(x))
+    def uav_attitudes(self, x: np.ndarray) -> np.ndarray:
+        """Every UAV's attitude block (quaternion, body rates), shape (n, 7)."""
+        blocks = x[..., slots.uav_attitude_slot(self.n_uavs, 0):slots.attitude_slot(self.n_uavs)]
+        return blocks.reshape(x.shape[:-1] + (self.n_uavs, slots.BODY_ATTITUDE))
 
     def uav_positions(self, x: np.ndarray) -> np.ndarray:
         """UAV centres of mass r_i [m], world, shape (n, 3)."""
-        return self.uav_coordinates(x)[..., slots.POSITION:slots.POSITION + 3]
+        return self._uav_block(self.coordinates(x))[..., slots.POSITION:slots.POSITION + 3]
+
+    def uav_quaternions(self, x: np.ndarray) -> np.ndarray:
+        """UAV attitudes, unit quaternions (w, x, y, z), body FLU -> world, shape (n, 4)."""
+        return self.uav_attitudes(x)[..., slots.BODY_QUATERNION:slots.BODY_QUATERNION + 4]
+
+    def uav_body_rates(self, x: np.ndarray) -> np.ndarray:
+        """UAV body rates omega_i [rad/s], body FLU, shape (n, 3)."""
+        return self.uav_attitudes(x)[..., slots.BODY_RATES:slots.BODY_RATES + 3]
 
     def uav_euler(self, x: np.ndarray) -> np.ndarray:
-        """UAV ZYX Euler angles eta_i (roll, pitch, yaw) [rad], shape (n, 3)."""
-        return self.uav_coordinates(x)[..., slots.EULER:slots.EULER + 3]
+        """UAV ZYX Euler angles eta_i (roll, pitch, yaw) [rad] of their quaternions, shape
+        (n, 3): a new array (physics.measurement.quaternion_euler), not a view."""
+        quaternions = np.asarray(self.uav_quaternions(np.asarray(x, dtype=float)))
+        return euler_from_quaternion(quaternions[..., [1, 2, 3, 0]])
 
     def payload_position(self, x: np.ndarray) -> np.ndarray:
         """Payload position r_p [m], world, shape (3,)."""
@@ -192,23 +202,20 @@ class StateLayout:
 
     def uav_velocities(self, x: np.ndarray) -> np.ndarray:
         """UAV velocities [m/s], world, shape (n, 3)."""
-        return self.uav_rates(x)[..., slots.POSITION:slots.POSITION + 3]
-
-    def uav_euler_rates(self, x: np.ndarray) -> np.ndarray:
-        """UAV Euler angle rates eta_dot_i [rad/s], shape (n, 3)."""
-        return self.uav_rates(x)[..., slots.EULER:slots.EULER + 3]
+        return self._uav_block(self.rates(x))[..., slots.POSITION:slots.POSITION + 3]
 
     def payload_velocity(self, x: np.ndarray) -> np.ndarray:
         """Payload velocity [m/s], world, shape (3,)."""
         return self.rates(x)[..., slots.payload_slot(self.n_uavs):]
 
     def pack(self, uav_positions: ArrayLike, uav_euler: ArrayLike, payload_position: ArrayLike,
-             uav_velocities: ArrayLike | None = None, uav_euler_rates: ArrayLike | None = None,
+             uav_velocities: ArrayLike | None = None, uav_body_rates: ArrayLike | None = None,
              payload_velocity: ArrayLike | None = None,
              payload_quaternion: ArrayLike | None = None,
              payload_body_rates: ArrayLike | None = None) -> np.ndarray:
-        """Packed state from its parts (world frame, SI); omitted rates are zero, a rigid
-        payload's omitted attitude the identity."""
+        """Packed state from its parts (world frame, SI; the UAVs' attitudes as ZYX Euler
+        angles [rad], stored as their quaternions); omitted rates are zero, a rigid payload's
+        omitted attitude the identity."""
         x = np.zeros(self.size)
         if self.rigid_payload:
             self.payload_quaternion(x)[:] = (1.0, 0.0, 0.0, 0.0) if payload_quaternion is None \
@@ -216,15 +223,21 @@ class StateLayout:
             if payload_body_rates is not None:
                 self.payload_body_rates(x)[:] = payload_body_rates
         self.uav_positions(x)[:] = np.reshape(uav_positions, (self.n_uavs, 3))
-        self.uav_euler(x)[:] = np.reshape(uav_euler, (self.n_uavs, 3))
+        self.set_uav_euler(x, uav_euler)
         self.payload_position(x)[:] = payload_position
         if uav_velocities is not None:
             self.uav_velocities(x)[:] = np.reshape(uav_velocities, (self.n_uavs, 3))
-        if uav_euler_rates is not None:
-            self.uav_euler_rates(x)[:] = np.reshape(uav_euler_rates, (self.n_uavs, 3))
+        if uav_body_rates is not None:
+            self.uav_body_rates(x)[:] = np.reshape(uav_body_rates, (self.n_uavs, 3))
         if payload_velocity is not None:
             self.payload_velocity(x)[:] = payload_velocity
         return x
+
+    def set_uav_euler(self, x: np.ndarray, uav_euler: ArrayLike) -> None:
+        """The UAVs' quaternions of x (or of a stack of states) set to the ZYX Euler angles
+        uav_euler (n, 3) [rad] (physics.measurement.euler_quaternion)."""
+        angles = np.reshape(np.asarray(uav_euler, dtype=float), x.shape[:-1] + (self.n_uavs, 3))
+        self.uav_quaternions(x)[:] = quaternion_from_euler(angles)[..., [3, 0, 1, 2]]
 
 
 def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -260,6 +273,7 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     formation[FORMATION_NULL_SPACE] = 0.0  # the multipliers' form (nullspace.NullSpaceModel: 1)
     formation[FORMATION_PROJECTION_STEPS] = 0.0   # no projection (nullspace.NullSpaceModel's)
     formation[FORMATION_PROJECTION_TOLERANCE] = 0.0
+    formation[FORMATION_SUBSTEPS] = 1.0   # one RK4 step per physics step
     formation[FORMATION_PAYLOAD_INERTIA:FORMATION_PAYLOAD_INERTIA + 3] = (
         params.payload_inertia if params.rigid_payload else 0.0)
     uavs[:, UAV_PAYLOAD_ATTACH:UAV_PAYLOAD_ATTACH + 3] = (

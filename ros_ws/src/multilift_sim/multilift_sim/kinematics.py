@@ -13,7 +13,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from multilift_sim import kernels
-from multilift_sim.physics.measurement import euler_quaternions, euler_rotations
+from multilift_sim.physics.measurement import (euler_quaternions, euler_rotations,
+                                              quaternion_eulers)
 
 
 def _angles(eta: ArrayLike) -> np.ndarray:
@@ -115,13 +116,12 @@ def _over_stack(function, eta: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
 
 def euler_from_quaternion(q: ArrayLike) -> np.ndarray:
     """ZYX Euler angles (roll, pitch, yaw) [rad], shape (..., 3), of unit quaternions
-    (x, y, z, w), shape (..., 4): the inverse of `quaternion_from_euler` for |pitch| < pi/2."""
+    (x, y, z, w), shape (..., 4): the inverse of `quaternion_from_euler` for |pitch| < pi/2
+    (physics.measurement.quaternion_euler over the stack, the measured state's angles)."""
     quat = np.asarray(q, dtype=float)
     if quat.shape[-1:] != (4,):
         raise ValueError(f'quaternions must have shape (..., 4), got shape {quat.shape}')
-    x, y, z, w = quat[..., 0], quat[..., 1], quat[..., 2], quat[..., 3]
-    eta = np.empty(quat.shape[:-1] + (3,))
-    eta[..., 0] = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    eta[..., 1] = np.arcsin(np.clip(2 * (w * y - z * x), -1.0, 1.0))
-    eta[..., 2] = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return eta
+    rows = np.ascontiguousarray(quat.reshape(-1, 4)[:, [3, 0, 1, 2]])  # (w, x, y, z)
+    out = np.empty((rows.shape[0], 3))
+    _kernel(quaternion_eulers, kernels.mode())(rows, out)
+    return out.reshape(quat.shape[:-1] + (3,))

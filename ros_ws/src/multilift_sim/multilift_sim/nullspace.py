@@ -88,7 +88,8 @@ class NullSpaceModel:
 
     def accelerations_from_wrenches(self, x: np.ndarray,
                                     wrenches: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """(q_ddot (6n+3,) [m/s^2, rad/s^2], multipliers Lambda (n,) [N/m]) by Eq. 2.71-2.72
+        """(acc (q_ddot, then the attitude blocks' rates), multipliers Lambda (n,) [N/m]) by Eq.
+        2.71-2.72
         with Eq. 2.57, under body wrenches (n, 4) (u_T [N], tau [N m], FLU)."""
         return self.formation.accelerations_from_wrenches(x, wrenches)
 
@@ -99,7 +100,7 @@ class NullSpaceModel:
 
     def derivative(self, t: float, x: np.ndarray,
                    rotor_speeds: Sequence[ArrayLike]) -> np.ndarray:
-        """State derivative ``(q_dot, q_ddot)``, shape (2(6n+3),)."""
+        """State derivative, the state's shape (FormationModel.derivative)."""
         return self.formation.derivative(t, x, rotor_speeds)
 
     def step(self, t: float, x: np.ndarray, rotor_speeds: Sequence[ArrayLike],

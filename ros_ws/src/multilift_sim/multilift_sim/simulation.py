@@ -8,7 +8,6 @@ World frame, SI units.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,8 +25,8 @@ from multilift_sim.physics.rigid_payload import payload_rotation
 from multilift_sim.scenario import Scenario
 from multilift_sim.schedules import event_records
 from multilift_sim.statistics import RunStatistics
-from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_NON_FINITE,
-                                             PITCH_LIMIT)
+from multilift_sim.statistics.layout import (CHECK_G, CHECK_NON_FINITE, CHECK_QUATERNION,
+                                             QUATERNION_NORM_TOLERANCE)
 from multilift_sim.tick_arrays import (STOP_CHECKS, PhysicsArrays, PhysicsMemory,
                                        physics_fields, stacked)
 
@@ -63,17 +62,20 @@ class Snapshot:
     payload_attitude: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
 
-def stop_message(status: int, cable: int, value: float, t: float, sim) -> str:
+def stop_message(status: int, cable: int, value: float, t: float, sim, n_uavs: int) -> str:
     """Why Algorithm 1 stopped a run (a `statistics.accumulators.run_check` status other than
-    CHECK_OK): the non-finite state, the UAV (from 0, in `cable`) pitched to `value` [rad]
-    beyond what its Euler angles represent, or the cable (from 0) whose |g| [m^2] or |g_dot| [m^2/s]
-    `value` left its tolerance (`sim`: the scenario's SimulationConfig), at t [s]."""
+    CHECK_OK): the non-finite state, the body (from 0, in `cable`: a UAV, or n the rigid
+    payload) whose quaternion's | |q| - 1 | is `value` (no attitude), or the cable (from 0) whose
+    |g| [m^2] or |g_dot| [m^2/s]
+    `value` left its tolerance (`sim`: the scenario's SimulationConfig), at t [s], in a
+    formation of n_uavs."""
     if status == CHECK_NON_FINITE:
         return f'the formation state became non-finite at t = {t:.3f} s'
-    if status == CHECK_ATTITUDE:  # `cable`: the UAV, `value`: its pitch [rad]
-        return (f'uav{cable + 1}: pitch {value:.4f} rad is beyond {math.degrees(PITCH_LIMIT):g} '
-                f'deg at t = {t:.3f} s, where the state\'s ZYX Euler angles (seed Eq. 2.6) no '
-                'longer represent its attitude (their rates diverge at 90 deg)')
+    if status == CHECK_QUATERNION:  # `cable`: the body, `value`: | |q| - 1 |
+        body = f'uav{cable + 1}' if cable < n_uavs else 'the payload'
+        return (f'{body}: its attitude quaternion\'s norm is {value:.3g} off 1 at t = {t:.3f} s '
+                f'(beyond {QUATERNION_NORM_TOLERANCE:g}): the state no longer represents an '
+                'attitude')
     if status == CHECK_G:
         return (f'cable {cable + 1}: constraint residual |g| = {value:.3g} m^2 exceeds '
                 f'the tolerance {sim.constraint_tolerance:g} m^2 at t = {t:.3f} s '
@@ -266,7 +268,8 @@ class FormationSimulator:
         if status in STOP_CHECKS:
             raise SimulationStopped(stop_message(
                 STOP_CHECKS[status], int(self.memory.worst_cable[0]),
-                float(self.memory.worst_value[0]), self.t, self.scenario.simulation))
+                float(self.memory.worst_value[0]), self.t, self.scenario.simulation,
+                self.scenario.n_uavs))
 
     def _command_arrays(self, rotor_speeds: list[np.ndarray],
                         saturated: list[np.ndarray] | None) -> tuple[np.ndarray, np.ndarray]:

@@ -16,14 +16,14 @@ from typing import NamedTuple
 import numpy as np
 
 from multilift_sim.formulations import Formulation, make_formulation
-from multilift_sim.physics.layout import (STATUS_ATTITUDE, STATUS_NOT_FINITE,
+from multilift_sim.physics.layout import (STATUS_QUATERNION, STATUS_NOT_FINITE,
                                           STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
 from multilift_sim.scenario import Scenario
 from multilift_sim.schedules import event_array, wind_series
 from multilift_sim.sensors.arrays import sensor_arrays
 from multilift_sim.start import cable_reach, initial_state, swing_sampling
 from multilift_sim.statistics import RunStatistics
-from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
+from multilift_sim.statistics.layout import (CHECK_QUATERNION, CHECK_G, CHECK_G_DOT,
                                              CHECK_NON_FINITE)
 
 
@@ -124,4 +124,4 @@ def stacked(name: str, values: Sequence) -> np.ndarray:
 
 # a stopped formation's status -> the check's code (the words: simulation.stop_message)
 STOP_CHECKS = {STATUS_NOT_FINITE: CHECK_NON_FINITE, STATUS_OFF_CONSTRAINT: CHECK_G,
-               STATUS_OFF_RATE: CHECK_G_DOT, STATUS_ATTITUDE: CHECK_ATTITUDE}
+               STATUS_OFF_RATE: CHECK_G_DOT, STATUS_QUATERNION: CHECK_QUATERNION}

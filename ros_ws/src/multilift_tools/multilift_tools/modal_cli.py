@@ -20,7 +20,7 @@ from multilift_sim.analysis.modal import ModalAnalysis, scenario_modal_analysis
 from multilift_sim.analysis.modes import MODE_KINDS, motion_shares
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.kinematics import euler_from_quaternion, rotation_matrix
-from multilift_sim.physics.layout import payload_slot
+from multilift_sim.physics.layout import seed_payload_slot
 from multilift_sim.scenario import ScenarioError, load
 
 
@@ -58,7 +58,7 @@ def modal_report(analysis: ModalAnalysis, name: str) -> str:
              f'  coordinates     {analysis.basis.shape[0]}, of them {analysis.basis.shape[1]} '
              'independent' + (' (dependent: ' + ', '.join(names[k] for k in analysis.dependent)
                               if analysis.dependent else ' (null-space basis')
-             + (f'; the UAVs\' {payload_slot(n)} held)' if analysis.held_uavs else ')')]
+             + (f'; the UAVs\' {seed_payload_slot(n)} held)' if analysis.held_uavs else ')')]
     if params.rigid_payload:
         lines.append(f'  payload         a rigid body of {params.payload_mass:g} kg, J_p '
                      + ', '.join(f'{j:.4g}' for j in params.payload_inertia) + ' kg m^2, level; '

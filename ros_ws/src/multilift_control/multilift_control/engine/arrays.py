@@ -92,7 +92,7 @@ FormationMemory = _joined('FormationMemory', PhysicsMemory, ControlMemory)
 class TickRecord(NamedTuple):
     """What ticks leave for a bag: (ticks, B, ...) each; a tick's row k holds the state at the
     tick and the answers to it, and the tension of the integration that starts there."""
-    states: np.ndarray            # (ticks, B, state_size): 2(6n + 3), + 7 with a rigid payload
+    states: np.ndarray            # (ticks, B, state_size): docs/conventions.md' x
     measured: np.ndarray          # (ticks, B, n, UAV_STATE_SIZE)
     speeds: np.ndarray            # (ticks, B, n, rotors) [rad/s]
     saturated: np.ndarray         # (ticks, B, n, rotors) bool

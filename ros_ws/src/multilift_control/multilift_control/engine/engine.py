@@ -156,7 +156,7 @@ class Engine:
     # ------------------------------------------------------------------------- state views
     @property
     def state(self) -> np.ndarray:
-        """The formation states (B, 2 (6n + 3); a rigid payload adds its attitude, 7) at the
+        """The formation states (B, len(x): docs/conventions.md) at the
         current tick (docs/conventions.md, docs/rigid_payload.md)."""
         return self.memory.state
 
@@ -200,7 +200,7 @@ class Engine:
             return None
         return stop_message(check, int(self.memory.worst_cable[b]),
                             float(self.memory.worst_value[b]), float(self.t[b]),
-                            self.scenarios[b].simulation)
+                            self.scenarios[b].simulation, self.scenarios[b].n_uavs)
 
     # ----------------------------------------------------------------------------- figures
     def summary(self, b: int = 0, wall_time: float | None = None) -> dict:

@@ -1,8 +1,10 @@
 """The formation's coordinates q_f at rest, for its analysis (seed Eq. 2.42, 2.47, 2.65-2.67):
-their names, the inertia M_f, the constraint residuals g and Jacobian G, and a packed state
-moved by (dq, dq_dot). World frame (z up), SI units, q_f of docs/conventions.md (6n + 3
-coordinates; a rigid-body payload's rotation vector after them: 6n + 6); the derivation is in
-the package docstring (multilift_sim/analysis/__init__.py).
+their names, the inertia M_f, the constraint residuals g and Jacobian G, a packed state moved
+by (dq, dq_dot) and its accelerations in q_f. World frame (z up), SI units. q_f is the seed's
+minimal coordinates (Eq. 2.41, `physics.layout` SEED_*: per UAV r_i and its ZYX angles eta_i,
+then r_p: 6n + 3; a rigid-body payload's rotation vector after them: 6n + 6), which the state
+(translations, then each body's quaternion and body rates) maps to and from here; the
+derivation is in the package docstring (multilift_sim/analysis/__init__.py).
 """
 from __future__ import annotations
 
@@ -13,18 +15,21 @@ from numpy.typing import ArrayLike
 
 from multilift_sim.constraints import cable_residuals, constraint_jacobian
 from multilift_sim.formation_params import FormationParams, StateLayout
-from multilift_sim.kinematics import rotation_matrix
+from multilift_sim.kinematics import (euler_rate_matrix, euler_rate_matrix_dot,
+                                      euler_rate_matrix_inverse, rotation_matrix)
 from multilift_sim.multirotor import euler_mass_matrix
-from multilift_sim.physics.layout import EULER, POSITION, n_coordinates, payload_slot, uav_slot
-from multilift_sim.physics.rigid_payload import payload_rotation
+from multilift_sim.physics import attitude
+from multilift_sim.physics.layout import (BODY_RATES, POSITION, SEED_EULER, attitude_slot,
+                                          seed_coordinates, seed_payload_slot, seed_uav_slot,
+                                          uav_attitude_slot)
 
 ROTATION_NAMES = ('rx_p', 'ry_p', 'rz_p')  # a rigid payload's rotation vector, payload frame
 
 
 def quaternion_rotation(quaternion: ArrayLike) -> np.ndarray:
-    """R_p (3, 3), payload frame -> world, of a unit quaternion (w, x, y, z)."""
+    """R (3, 3), body -> world, of a unit quaternion (w, x, y, z) (physics.attitude's)."""
     state = np.concatenate((np.zeros(1), np.asarray(quaternion, dtype=float)))
-    return payload_rotation(state, 1)
+    return attitude.quaternion_rotation(state, 1)
 
 
 def cable_offsets(params: FormationParams, uavs: np.ndarray, payload: np.ndarray,
@@ -84,7 +89,7 @@ def coordinate_names(n_uavs: int, rigid_payload: bool = False) -> tuple[str, ...
 def _columns(n: int, rigid_payload: bool) -> tuple[int, int, int]:
     """The analysis' coordinates (coordinate_names): (their count, r_p's column, a rigid
     payload's rotation vector's first column: q_f's length)."""
-    return (len(coordinate_names(n, rigid_payload)), payload_slot(n), n_coordinates(n))
+    return (len(coordinate_names(n, rigid_payload)), seed_payload_slot(n), seed_coordinates(n))
 
 
 def mass_matrix(params: FormationParams, uav_euler: ArrayLike) -> np.ndarray:
@@ -95,7 +100,7 @@ def mass_matrix(params: FormationParams, uav_euler: ArrayLike) -> np.ndarray:
     size, p, rotation = _columns(n, params.rigid_payload)
     mass = np.zeros((size, size))
     for i, uav in enumerate(params.uavs):
-        r, e = uav_slot(i) + POSITION, uav_slot(i) + EULER
+        r, e = seed_uav_slot(i) + POSITION, seed_uav_slot(i) + SEED_EULER
         mass[r:r + 3, r:r + 3] = uav.mass * np.eye(3)
         mass[e:e + 3, e:e + 3] = euler_mass_matrix(uav.inertia, euler[i])
     mass[p:p + 3, p:p + 3] = params.payload_mass * np.eye(3)
@@ -122,7 +127,7 @@ def formation_jacobian(params: FormationParams, x: np.ndarray) -> np.ndarray:
     size, p, turn = _columns(n, params.rigid_payload)
     jacobian = np.zeros((n, size))
     for i in range(n):
-        r, e = uav_slot(i) + POSITION, uav_slot(i) + EULER
+        r, e = seed_uav_slot(i) + POSITION, seed_uav_slot(i) + SEED_EULER
         jacobian[i, r:r + 3] = -2.0 * offsets[i]
         jacobian[i, p:p + 3] = 2.0 * offsets[i]
         if attached:
@@ -145,18 +150,51 @@ def formation_residuals(params: FormationParams, x: np.ndarray) -> np.ndarray:
     return np.einsum('ij,ij->i', offsets, offsets) - np.asarray(params.cable_lengths) ** 2
 
 
+def seed_coordinates_of(layout: StateLayout, x: np.ndarray) -> np.ndarray:
+    """q_f (6n + 3,) of a state x (or (..., 6n + 3) of a stack): per UAV r_i [m] and the ZYX
+    angles eta_i [rad] of its quaternion, then r_p [m] (a rigid payload's attitude not
+    included)."""
+    x = np.asarray(x, dtype=float)
+    n = layout.n_uavs
+    out = np.empty(x.shape[:-1] + (seed_coordinates(n),))
+    euler = layout.uav_euler(x)
+    for i in range(n):
+        r, e = seed_uav_slot(i) + POSITION, seed_uav_slot(i) + SEED_EULER
+        out[..., r:r + 3] = layout.uav_positions(x)[..., i, :]
+        out[..., e:e + 3] = euler[..., i, :]
+    out[..., seed_payload_slot(n):] = layout.payload_position(x)
+    return out
+
+
 def displaced_state(layout: StateLayout, x: np.ndarray, dq: np.ndarray,
                     dq_dot: np.ndarray) -> np.ndarray:
     """The packed state x moved by dq (q_f [m, rad], a rigid payload's rotation vector theta
     [rad], payload frame, after it) and dq_dot (q_f_dot [m/s, rad/s], then omega_p [rad/s]):
-    x + (dq, dq_dot) for a point payload; a rigid one's attitude q (x) Exp(theta) (a body-frame
-    rotation, the quaternion kept unit) and body rates omega_p + dq_dot's last three."""
-    if not layout.rigid_payload:
-        return x + np.concatenate((dq, dq_dot))
-    nq = layout.n_coordinates
+    the translations by theirs; each UAV's ZYX angles eta_i (of its quaternion) and Euler rates
+    eta_dot_i = W^-1 omega_i by theirs, stored back as its quaternion and body rates omega_i =
+    W eta_dot_i (Eq. 2.7); a rigid payload's attitude q (x) Exp(theta) (a body-frame rotation,
+    the quaternion kept unit) and body rates omega_p + dq_dot's last three."""
+    n = layout.n_uavs
     out = np.array(x, dtype=float)
-    layout.coordinates(out)[:] += dq[:nq]
-    layout.rates(out)[:] += dq_dot[:nq]
+    for i in range(n):
+        r = seed_uav_slot(i) + POSITION
+        layout.uav_positions(out)[i] += dq[r:r + 3]
+        layout.uav_velocities(out)[i] += dq_dot[r:r + 3]
+    p = seed_payload_slot(n)
+    layout.payload_position(out)[:] += dq[p:p + 3]
+    layout.payload_velocity(out)[:] += dq_dot[p:p + 3]
+    euler = layout.uav_euler(x)
+    euler_rates = np.einsum('ijk,ik->ij', euler_rate_matrix_inverse(euler),
+                            layout.uav_body_rates(x))
+    angles = [seed_uav_slot(i) + SEED_EULER + k for i in range(n) for k in range(3)]
+    euler = euler + dq[angles].reshape(n, 3)
+    euler_rates = euler_rates + dq_dot[angles].reshape(n, 3)
+    layout.set_uav_euler(out, euler)
+    layout.uav_body_rates(out)[:] = np.einsum('ijk,ik->ij', euler_rate_matrix(euler),
+                                              euler_rates)
+    if not layout.rigid_payload:
+        return out
+    nq = seed_coordinates(n)
     theta = np.asarray(dq[nq:nq + 3], dtype=float)
     angle = float(np.linalg.norm(theta))
     w, v = layout.payload_quaternion(x)[0], layout.payload_quaternion(x)[1:]
@@ -165,4 +203,33 @@ def displaced_state(layout: StateLayout, x: np.ndarray, dq: np.ndarray,
     layout.payload_quaternion(out)[:] = np.concatenate((
         [w * turn_w - v @ turn_v], w * turn_v + turn_w * v + np.cross(v, turn_v)))
     layout.payload_body_rates(out)[:] += dq_dot[nq:nq + 3]
+    return out
+
+
+def coordinate_accelerations(layout: StateLayout, x: np.ndarray,
+                             acc: np.ndarray) -> np.ndarray:
+    """q_f_ddot [m/s^2, rad/s^2] (and a rigid payload's alpha_p [rad/s^2], payload frame, after
+    it) at state x from the DAE's acc there (`FormationModel.accelerations_from_wrenches`:
+    q_ddot, then the attitude blocks' rates): each UAV's eta_ddot = W^-1 (omega_dot -
+    W_dot eta_dot) (Eq. 2.8) with eta_dot = W^-1 omega."""
+    n = layout.n_uavs
+    nq = layout.n_coordinates
+    out = np.empty(len(coordinate_names(n, layout.rigid_payload)))
+    positions = acc[:nq]
+    for i in range(n):
+        r = seed_uav_slot(i) + POSITION
+        out[r:r + 3] = layout.uav_positions(positions)[i]
+    p = seed_payload_slot(n)
+    out[p:p + 3] = layout.payload_position(positions)
+    euler = layout.uav_euler(x)
+    inverse = euler_rate_matrix_inverse(euler)
+    euler_rates = np.einsum('ijk,ik->ij', inverse, layout.uav_body_rates(x))
+    turning = euler_rate_matrix_dot(euler, euler_rates)
+    for i in range(n):
+        rate = uav_attitude_slot(n, i) - nq + BODY_RATES   # omega_dot_i in acc
+        e = seed_uav_slot(i) + SEED_EULER
+        out[e:e + 3] = inverse[i] @ (acc[rate:rate + 3] - turning[i] @ euler_rates[i])
+    if layout.rigid_payload:
+        rate = attitude_slot(n) - nq + BODY_RATES            # alpha_p in acc
+        out[seed_coordinates(n):] = acc[rate:rate + 3]
     return out

@@ -12,13 +12,14 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from multilift_sim.analysis.coordinates import (displaced_state, formation_jacobian,
-                                                formation_residuals, mass_matrix)
+from multilift_sim.analysis.coordinates import (coordinate_accelerations, displaced_state,
+                                                formation_jacobian, formation_residuals,
+                                                mass_matrix)
 from multilift_sim.analysis.equilibrium import Equilibrium, scenario_equilibrium
 from multilift_sim.analysis.modes import MODE_KINDS, mode_kind, motion_shares, real_shapes
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
-from multilift_sim.physics.layout import PAYLOAD_BODY_RATES, POSITION, payload_slot, uav_slot
+from multilift_sim.physics.layout import POSITION, seed_payload_slot, seed_uav_slot
 from multilift_sim.scenario import Scenario
 
 
@@ -32,7 +33,7 @@ def default_dependent_coordinates(jacobian: np.ndarray,
     column-pivoted QR of G over the free coordinates.
     """
     n = jacobian.shape[0]
-    altitudes = tuple(uav_slot(i) + POSITION + 2 for i in range(n))
+    altitudes = tuple(seed_uav_slot(i) + POSITION + 2 for i in range(n))
     rows = np.linalg.norm(jacobian, axis=1)                     # 2 l_i on the manifold
     if not held and np.min(np.abs(jacobian[np.arange(n), altitudes]) / rows) > 1e-3:
         return altitudes
@@ -141,11 +142,10 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
                                 baumgarte_alpha=0.0, baumgarte_beta=0.0)
     model = FormationModel(still)
     layout = model.layout
-    nq = layout.n_coordinates
     x_e = np.asarray(equilibrium.state, dtype=float)
     jacobian = formation_jacobian(still, x_e)
     size = jacobian.shape[1]                     # 6n + 3, a rigid payload's 6n + 6
-    held = tuple(range(payload_slot(params.n_uavs))) if hold_uavs else ()
+    held = tuple(range(seed_payload_slot(params.n_uavs))) if hold_uavs else ()
     if basis == 'elimination':
         dependent = (default_dependent_coordinates(jacobian, held) if dependent is None
                      else tuple(dependent))
@@ -160,11 +160,9 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
     def acceleration(dq: np.ndarray, dq_dot: np.ndarray) -> np.ndarray:
         """q_ddot (and a rigid payload's alpha_p [rad/s^2], = theta_ddot at rest) at x_e
         moved by (dq, dq_dot) (displaced_state)."""
-        acc = model.accelerations_from_wrenches(displaced_state(layout, x_e, dq, dq_dot),
-                                                equilibrium.wrenches)[0]
-        if not layout.rigid_payload:
-            return acc
-        return np.concatenate((acc[:nq], acc[nq + PAYLOAD_BODY_RATES:nq + PAYLOAD_BODY_RATES + 3]))
+        moved = displaced_state(layout, x_e, dq, dq_dot)
+        return coordinate_accelerations(
+            layout, moved, model.accelerations_from_wrenches(moved, equilibrium.wrenches)[0])
 
     still_rates = np.zeros(size)
     j_q = np.empty((size, n_free))
@@ -230,7 +228,7 @@ def mode_state(analysis: ModalAnalysis, mode: int, amplitude: float,
     x = displaced_state(layout, x, amplitude * analysis.shapes[mode].real, still)
     lengths = np.asarray(params.cable_lengths)
     free = np.ones(size, dtype=bool)
-    free[:payload_slot(params.n_uavs)] = not analysis.held_uavs
+    free[:seed_payload_slot(params.n_uavs)] = not analysis.held_uavs
     for _ in range(iterations):
         residual = formation_residuals(params, x)
         if np.max(np.abs(residual) / lengths ** 2) < 1e-15:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.linalg
 
-from multilift_sim.physics.layout import EULER, POSITION, payload_slot, uav_slot
+from multilift_sim.physics.layout import POSITION, SEED_EULER, seed_payload_slot, seed_uav_slot
 
 if TYPE_CHECKING:
     from multilift_sim.analysis.modal import ModalAnalysis
@@ -23,12 +23,13 @@ def motion_groups(n_uavs: int, rigid_payload: bool) -> dict[str, list[int]]:
     a mode is named by: the payload's swing x, swing y (world), heave (z); a rigid payload's
     roll, pitch, yaw (its rotation about its own x, y, z axes); the UAVs' translation and
     attitude (all UAVs together)."""
-    p = payload_slot(n_uavs)
+    p = seed_payload_slot(n_uavs)
     groups = {'swing x': [p], 'swing y': [p + 1], 'heave': [p + 2]}
     if rigid_payload:
         groups.update({'roll': [p + 3], 'pitch': [p + 4], 'yaw': [p + 5]})
-    groups['UAVs'] = [uav_slot(i) + POSITION + k for i in range(n_uavs) for k in range(3)]
-    groups['UAV attitudes'] = [uav_slot(i) + EULER + k for i in range(n_uavs) for k in range(3)]
+    groups['UAVs'] = [seed_uav_slot(i) + POSITION + k for i in range(n_uavs) for k in range(3)]
+    groups['UAV attitudes'] = [seed_uav_slot(i) + SEED_EULER + k for i in range(n_uavs)
+                               for k in range(3)]
     return groups
 
 

@@ -177,14 +177,16 @@ class ReducedSingleLiftModel:
         return seed_to_world_vector(uav), seed_to_world_vector(uav + offset)
 
     def to_formation_state(self, state: ArrayLike) -> np.ndarray:
-        """The packed world-frame DAE state (length 18, docs/conventions.md) of a seed state."""
+        """The packed world-frame DAE state (docs/conventions.md) of a seed state: its Euler
+        rates become body rates omega = W(eta) eta_dot (Eq. 2.7)."""
         state = np.asarray(state, dtype=float)
         q, q_dot = state[:N_COORDINATES], state[N_COORDINATES:]
+        eta = seed_to_world_euler(q[3:6])
         return StateLayout(1).pack(
-            seed_to_world_vector(q[:3]), seed_to_world_euler(q[3:6]),
+            seed_to_world_vector(q[:3]), eta,
             seed_to_world_vector(self.payload_position(q)),
             uav_velocities=seed_to_world_vector(q_dot[:3]),
-            uav_euler_rates=seed_to_world_euler(q_dot[3:6]),
+            uav_body_rates=euler_rate_matrix(eta) @ seed_to_world_euler(q_dot[3:6]),
             payload_velocity=seed_to_world_vector(self.payload_velocity(q, q_dot)))
 
 

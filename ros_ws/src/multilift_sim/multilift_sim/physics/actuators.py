@@ -23,6 +23,7 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.formation_dae import integrate_period as rigid_period
 from multilift_sim.physics.layout import (ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT,
+                                          FORMATION_SUBSTEPS,
                                           WRENCH_COLUMNS)
 from multilift_sim.physics.slack_cables import integrate_period as slack_period
 
@@ -94,6 +95,12 @@ def instant(actuators):
 
 
 @jit
+def substeps(formation):
+    """RK4 sub-steps per physics step of a formation (its FORMATION_SUBSTEPS, at least 1)."""
+    return max(1, int(formation[FORMATION_SUBSTEPS]))
+
+
+@jit
 def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, uavs, gusts,
                     formation, taut, released, slack, dt, steps):
     """One control period of `steps` RK4 steps of dt [s] from state x under rotor `commands`
@@ -102,15 +109,21 @@ def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, u
     again). `rotors` (n, rotors) holds each rotor's
     speed [rad/s] at x (NaN: never commanded, it starts at its first command) and is moved to
     the period's end; with instant rotors (`instant`) it is not kept (they are their
-    commands). Returns (the state at the end, the multipliers [N/m] at x, g [m^2] and
-    g_dot [m^2/s] at the end); x is not written."""
+    commands). Each of the `steps` physics steps is taken as FORMATION_SUBSTEPS (k >= 1) RK4
+    steps of dt / k (`substeps`): the same period k times finer, for a part that needs a
+    faster rate than the physics' (k = 1: dt itself, to the bit). Returns (the state at the
+    end, the multipliers [N/m] at x, g [m^2] and g_dot [m^2/s] at the end); x is not
+    written."""
     n, count = commands.shape
     wrenches = np.empty((n, WRENCH_COLUMNS))
+    k = substeps(formation)
+    h = dt / k          # dt / 1.0 is dt: one sub-step leaves every bit as it was
     if instant(actuators):  # the rotors are their commands (`rotors` not kept)
         rotor_wrenches(allocation, commands, effectiveness, wrenches)
         if slack:
-            return slack_period(x, wrenches, uavs, gusts, formation, taut, released, dt, steps)
-        return rigid_period(x, wrenches, uavs, gusts, formation, taut, dt, steps)
+            return slack_period(x, wrenches, uavs, gusts, formation, taut, released, h,
+                                steps * k)
+        return rigid_period(x, wrenches, uavs, gusts, formation, taut, h, steps * k)
     for i in range(n):
         for r in range(count):
             if math.isnan(rotors[i, r]):
@@ -120,15 +133,15 @@ def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, u
     first = np.zeros(n)
     g = np.zeros(n)
     g_dot = np.zeros(n)
-    for step in range(steps):
-        held_speeds(rotors, commands, actuators, step * dt, dt, speeds)
+    for step in range(steps * k):
+        held_speeds(rotors, commands, actuators, step * h, h, speeds)
         rotor_wrenches(allocation, speeds, effectiveness, wrenches)
         if slack:
             state, multipliers, g, g_dot = slack_period(state, wrenches, uavs, gusts,
-                                                        formation, taut, released, dt, 1)
+                                                        formation, taut, released, h, 1)
         else:
             state, multipliers, g, g_dot = rigid_period(state, wrenches, uavs, gusts,
-                                                        formation, taut, dt, 1)
+                                                        formation, taut, h, 1)
         if step == 0:
             first[:] = multipliers
     rotor_speeds_at(rotors, commands, actuators, steps * dt, rotors)

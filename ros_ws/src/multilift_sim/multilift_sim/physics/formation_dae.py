@@ -2,17 +2,19 @@
 gusts, the solve for q_ddot and the cable multipliers, RK4 over a control period, the
 constraint residuals. World frame (z up), SI units; the array slots are `physics.layout`'s.
 
-Arguments shared by the functions: ``x`` the state (2 (6n + 3),); ``wrenches`` (n,
+Arguments shared by the functions: ``x`` the state (docs/conventions.md: the translations'
+(q, q_dot), 2 (3n + 3), then the bodies' attitude blocks); ``wrenches`` (n,
 WRENCH_COLUMNS) the body wrenches (u_T [N], tau [N m], FLU), held; ``uavs`` (n, UAV_COLUMNS),
 ``gusts`` (k, GUST_COLUMNS) and ``formation`` (FORMATION_SCALARS,) the constants;
 ``taut`` (n,) bool: which cables are constraints (a slack cable has multiplier 0 and leaves
 UAV i and the payload free of each other); ``cables`` (n, CABLE_COLUMNS) and ``work``
-(WORK_ROWS, 2 (6n + 3)) scratch.
+(WORK_ROWS, len(x)) scratch.
 
 The equations (dynamics.py's docstring): with f the unconstrained forces,
 ``Lambda = (G M^-1 G^T)^-1 (G M^-1 f + G_dot q_dot + 2 alpha_f g_dot + beta_f^2 g)`` and
 ``q_ddot = M^-1 (f - G^T Lambda)`` (Eq. 2.60/2.70 with the signs gathered), never forming
-the (6n+3)^2 matrices: each UAV's attitude on its own, and the n x n cable system by the
+the mass matrix: each UAV's attitude on its own (its quaternion and body rates), and the n x n
+cable system by the
 Woodbury identity (`cable_multipliers`).
 """
 import numpy as np
@@ -23,15 +25,17 @@ from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  
                                               payload_force_per_mass, rotational_compliance,
                                               uav_attach_motion, uav_free_motion)
 from multilift_sim.physics.nullspace import nullspace_solve, project, translational_masses
-from multilift_sim.physics.rigid_payload import (normalize_quaternion, rigid_residuals,
-                                                 rigid_solve)
+from multilift_sim.physics.attitude import normalize_quaternion
+from multilift_sim.physics.rigid_payload import rigid_residuals, rigid_solve
 from multilift_sim.physics.layout import (
-    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_RHS, CABLE_THRUST,
+    BODY_ATTITUDE, BODY_RATES, CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET,
+    CABLE_RHS, CABLE_THRUST,
     FORMATION_BETA_SQ, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
     FORMATION_PAYLOAD_MASS, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
     FORMATION_TWO_ALPHA, POSITION, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
-from multilift_sim.physics.state_slots import attitude_slot, payload_slot, rates_slot, uav_slot
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
+                                               uav_attitude_slot, uav_slot)
 
 
 @jit
@@ -98,14 +102,15 @@ def inverse_delta(uavs, i, offset_sq, k0, k1, k2):
 
 @jit
 def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
-    """q_ddot into acc (6n + 3,) [m/s^2, rad/s^2] and the cable multipliers Lambda into
-    multipliers (n,) [N/m] at state x (seed Eq. 2.60, 2.70), only the `taut` cables
-    constrained. Rotor speeds enter as the held body wrenches."""
+    """q_ddot into acc[:3n + 3] [m/s^2], the attitude blocks' rates after it (each UAV's
+    quaternion rate and omega_dot [rad/s^2], then a rigid payload's), and the cable
+    multipliers Lambda into multipliers (n,) [N/m] at state x (seed Eq. 2.60, 2.70), only the
+    `taut` cables constrained. Rotor speeds enter as the held body wrenches."""
     if formation[FORMATION_NULL_SPACE] != 0.0:  # the `nullspace` formulation (every cable taut)
         nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
         return
     if x.shape[0] > attitude_slot(uavs.shape[0]):
-        # a rigid-body payload (its attitude after q_f_dot: physics.rigid_payload)
+        # a rigid-body payload (its attitude block after the UAVs': physics.rigid_payload)
         rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
         return
     n = uavs.shape[0]
@@ -168,7 +173,8 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
         acc[r + 2] = cables[i, CABLE_THRUST + 2] + pull * dz - gravity
         if cables[i, CABLE_MOMENT] != 0.0 or cables[i, CABLE_MOMENT + 1] != 0.0 or \
                 cables[i, CABLE_MOMENT + 2] != 0.0:  # the pull's moment on the UAV's attitude
-            add_cable_torque(x, i, uavs, acc, 2.0 * multiplier, cables[i, CABLE_MOMENT],
+            add_cable_torque(uavs, i, acc, uav_attitude_slot(n, i) - nq + BODY_RATES,
+                             2.0 * multiplier, cables[i, CABLE_MOMENT],
                              cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
         sum_x += multiplier * dx
         sum_y += multiplier * dy
@@ -182,24 +188,25 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
 @jit
 def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, work, cables):
     """One classic RK4 step of h [s] from x with the wrenches held, into out (which may be
-    x); the multipliers [N/m] of its first stage (at x) into multipliers (n,). A rigid
-    payload's attitude block after q_f_dot steps with the rest (its rate from `solve` at
-    acc[6n + 3:]), its quaternion scaled back to unit length at the end."""
+    x); the multipliers [N/m] of its first stage (at x) into multipliers (n,). The bodies'
+    attitude blocks after q_dot (each UAV's, a rigid payload's) step with the rest (their
+    rates from `solve` at acc[3n + 3:]), every quaternion scaled back to unit length at the
+    end (`attitude.normalize_quaternion`)."""
     n = uavs.shape[0]
     nq = rates_slot(n)
-    attitude = attitude_slot(n)
+    bodies = uav_attitude_slot(n, 0)  # the first attitude block: 2 (3n + 3)
     size = x.shape[0]
-    extra = size - attitude  # a rigid payload's attitude (physics.rigid_payload), or none
+    extra = size - bodies  # the attitude blocks
     half, sixth = 0.5 * h, h / 6.0
     k1, k2, k3, k4 = work[WORK_K1], work[WORK_K2], work[WORK_K3], work[WORK_K4]
     stage, acc = work[WORK_STAGE], work[WORK_ACC]
     later = work[WORK_MULTIPLIERS, :n]
     solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
-    for j in range(nq):  # k = (q_dot, q_ddot): the state derivative
+    for j in range(nq):  # k = (q_dot, q_ddot, the blocks' rates): the state derivative
         k1[j] = x[nq + j]
         k1[nq + j] = acc[j]
     for j in range(extra):
-        k1[attitude + j] = acc[nq + j]
+        k1[bodies + j] = acc[nq + j]
     for k in (WORK_K2, WORK_K3, WORK_K4):  # stage k from x + (h/2 k1, h/2 k2, h k3)
         step, previous = (h if k == WORK_K4 else half), work[k - 1]
         for j in range(size):
@@ -210,11 +217,11 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
             derivative[j] = stage[nq + j]
             derivative[nq + j] = acc[j]
         for j in range(extra):
-            derivative[attitude + j] = acc[nq + j]
+            derivative[bodies + j] = acc[nq + j]
     for j in range(size):
         out[j] = x[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
-    if extra:
-        normalize_quaternion(out, attitude)
+    for j in range(bodies, size, BODY_ATTITUDE):
+        normalize_quaternion(out, j)
 
 
 @jit

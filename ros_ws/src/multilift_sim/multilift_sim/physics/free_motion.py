@@ -1,20 +1,22 @@
 """Each body's motion without the cables, on one formation's arrays: the air at a point (the
 seed's 1-cosine gusts, Eq. 2.55), the payload's drag in it (Eq. 2.53) and each UAV's attitude
-and thrust (Eq. 2.6-2.8, 2.20, 2.28). Both formulations of the DAE build on these
+(its quaternion and body rates, `physics.attitude`; Eq. 2.28) and thrust (Eq. 2.6, 2.20). Both
+formulations of the DAE build on these
 (`formation_dae.solve`, `nullspace.nullspace_solve`). World frame (z up), SI units; the slots
 are `physics.layout`'s.
 """
 import math
 
-import numpy as np
-
 from multilift_sim.kernels import jit
+from multilift_sim.physics.attitude import (quaternion_axis_z, quaternion_rate,
+                                           quaternion_rotation)
 from multilift_sim.physics.layout import (
-    EULER, FORMATION_DRAG, FORMATION_INV_PAYLOAD_MASS, FORMATION_WIND, GUST_CENTER,
+    BODY_QUATERNION, BODY_RATES, FORMATION_DRAG, FORMATION_INV_PAYLOAD_MASS, FORMATION_WIND,
+    GUST_CENTER,
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, POSITION,
     UAV_ATTACH, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_MASS, WRENCH_THRUST,
     WRENCH_TORQUE)
-from multilift_sim.physics.state_slots import rates_slot, uav_slot
+from multilift_sim.physics.state_slots import rates_slot, uav_attitude_slot, uav_slot
 
 
 @jit
@@ -61,15 +63,6 @@ def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
 
 
 @jit
-def body_rates(s_phi, c_phi, s_theta, c_theta, phi_dot, theta_dot, psi_dot):
-    """omega = W(eta) eta_dot [rad/s], body FLU (Eq. 2.7), from the sines and cosines of roll
-    and pitch and the Euler rates."""
-    c_theta_psi_dot = c_theta * psi_dot
-    return (phi_dot - s_theta * psi_dot, c_phi * theta_dot + s_phi * c_theta_psi_dot,
-            c_phi * c_theta_psi_dot - s_phi * theta_dot)
-
-
-@jit
 def body_acceleration(uavs, i, torque_x, torque_y, torque_z, omega_x, omega_y, omega_z):
     """UAV i's omega_dot = J^-1 (tau - omega x J omega) [rad/s^2], body FLU, per principal
     axis (omega_dot_x = tau_x / I_xx - (I_zz - I_yy) / I_xx omega_y omega_z, cyclically),
@@ -81,48 +74,34 @@ def body_acceleration(uavs, i, torque_x, torque_y, torque_z, omega_x, omega_y, o
 
 @jit
 def uav_free_motion(x, i, wrenches, uavs, formation, acc):
-    """UAV i's motion without its cable at state x: its attitude's eta_ddot [rad/s^2] into acc's
-    EULER slots of UAV i (Euler's equation pulled back to eta, Eq. 2.7-2.8, 2.28), and returns
-    its translational acceleration [m/s^2], world, from its thrust along R e_z (Eq. 2.6, 2.20)
-    and its own drag in the steady wind, gravity excluded. Both formulations call it
-    (`solve`, `physics.nullspace`)."""
-    nq = rates_slot(uavs.shape[0])
+    """UAV i's motion without its cable at state x: its attitude block's rate (the quaternion's
+    q_dot = q (x) (0, omega) / 2 and Euler's equation J omega_dot = tau - omega x J omega,
+    Eq. 2.28 in body rates) into acc at its block's place (`uav_attitude_slot` - (3n + 3): acc
+    holds q_ddot, then the attitude blocks' rates), and returns its translational acceleration
+    [m/s^2], world, from its thrust along R e_z (Eq. 2.6, 2.20) and its own drag in the steady
+    wind, gravity excluded. Both formulations call it (`solve`, `physics.nullspace`)."""
+    n = uavs.shape[0]
+    nq = rates_slot(n)
     mass = uavs[i, UAV_MASS]
     r = uav_slot(i) + POSITION
-    e = uav_slot(i) + EULER
-    phi, theta, psi = x[e], x[e + 1], x[e + 2]
+    base = uav_attitude_slot(n, i)
     vx, vy, vz = x[nq + r], x[nq + r + 1], x[nq + r + 2]
-    phi_dot, theta_dot, psi_dot = x[nq + e], x[nq + e + 1], x[nq + e + 2]
-    thrust = wrenches[i, WRENCH_THRUST]
-    torque_x, torque_y = wrenches[i, WRENCH_TORQUE], wrenches[i, WRENCH_TORQUE + 1]
-    torque_z = wrenches[i, WRENCH_TORQUE + 2]
-    s_phi, c_phi = math.sin(phi), math.cos(phi)
-    s_theta, c_theta = math.sin(theta), math.cos(theta)
-    s_psi, c_psi = math.sin(psi), math.cos(psi)
-
-    # Attitude: omega = W eta_dot (Eq. 2.7), Euler's equation J omega_dot = tau - omega x
-    # J omega per axis (omega_dot_x = tau_x / I_xx - (I_zz - I_yy) / I_xx omega_y omega_z,
-    # cyclically), then eta_ddot = W^-1 (omega_dot - W_dot eta_dot) (Eq. 2.8) -- the same
-    # as M_eta^-1 (W^T tau - C_eta eta_dot), see multirotor.py; W_dot from
-    # kinematics.euler_rate_matrix_dot.
-    c_theta_psi_dot = c_theta * psi_dot
-    omega_x, omega_y, omega_z = body_rates(s_phi, c_phi, s_theta, c_theta, phi_dot, theta_dot,
-                                           psi_dot)
-    s_theta_theta_psi_dot = s_theta * theta_dot * psi_dot
-    rate_x, rate_y, rate_z = body_acceleration(uavs, i, torque_x, torque_y, torque_z, omega_x,
-                                               omega_y, omega_z)
-    w_eta_ddot_x = rate_x + c_theta_psi_dot * theta_dot
-    w_eta_ddot_y = (rate_y - phi_dot * omega_z + s_phi * s_theta_theta_psi_dot)
-    w_eta_ddot_z = (rate_z + phi_dot * omega_y + c_phi * s_theta_theta_psi_dot)
-    yaw_part = s_phi * w_eta_ddot_y + c_phi * w_eta_ddot_z         # W^-1 of Eq. 2.8
-    acc[e] = w_eta_ddot_x + s_theta / c_theta * yaw_part
-    acc[e + 1] = c_phi * w_eta_ddot_y - s_phi * w_eta_ddot_z
-    acc[e + 2] = yaw_part / c_theta
+    omega_x = x[base + BODY_RATES]
+    omega_y = x[base + BODY_RATES + 1]
+    omega_z = x[base + BODY_RATES + 2]
+    rate = base - nq  # this block's derivative in acc
+    (acc[rate + BODY_QUATERNION], acc[rate + BODY_QUATERNION + 1],
+     acc[rate + BODY_QUATERNION + 2], acc[rate + BODY_QUATERNION + 3]) = quaternion_rate(
+        x, base, omega_x, omega_y, omega_z)
+    (acc[rate + BODY_RATES], acc[rate + BODY_RATES + 1],
+     acc[rate + BODY_RATES + 2]) = body_acceleration(
+        uavs, i, wrenches[i, WRENCH_TORQUE], wrenches[i, WRENCH_TORQUE + 1],
+        wrenches[i, WRENCH_TORQUE + 2], omega_x, omega_y, omega_z)
 
     # Unconstrained translational acceleration: thrust along R e_z (Eq. 2.6, 2.20).
     # Gravity is common to every body (in `solve` it cancels in a_p - a_i; added at the end).
-    thrust_per_mass = thrust / mass
-    axis_x, axis_y, axis_z = thrust_direction(s_phi, c_phi, s_theta, c_theta, s_psi, c_psi)
+    thrust_per_mass = wrenches[i, WRENCH_THRUST] / mass
+    axis_x, axis_y, axis_z = quaternion_axis_z(x, base)
     thrust_ax = axis_x * thrust_per_mass
     thrust_ay = axis_y * thrust_per_mass
     thrust_az = axis_z * thrust_per_mass
@@ -155,25 +134,6 @@ def thrust_axis(roll, pitch, yaw):
 
 
 @jit
-def uav_rotation(phi, theta, psi):
-    """R_i = Rz(psi) Ry(theta) Rx(phi) (3, 3), body FLU -> world (Eq. 2.6); its third column
-    `thrust_direction`. (kinematics.rotation_matrix: the numpy form over stacks, the tests'
-    oracle.)"""
-    s_phi, c_phi = math.sin(phi), math.cos(phi)
-    s_theta, c_theta = math.sin(theta), math.cos(theta)
-    s_psi, c_psi = math.sin(psi), math.cos(psi)
-    r = np.empty((3, 3))
-    r[0, 0] = c_psi * c_theta
-    r[0, 1] = c_psi * s_theta * s_phi - s_psi * c_phi
-    r[1, 0] = s_psi * c_theta
-    r[1, 1] = s_psi * s_theta * s_phi + c_psi * c_phi
-    r[2, 0] = -s_theta
-    r[2, 1] = c_theta * s_phi
-    r[0, 2], r[1, 2], r[2, 2] = thrust_direction(s_phi, c_phi, s_theta, c_theta, s_psi, c_psi)
-    return r
-
-
-@jit
 def attached_off_centre(uavs, i):
     """Whether UAV i's cable holds it off its centre of mass (UAV_ATTACH not zero)."""
     return (uavs[i, UAV_ATTACH] != 0.0 or uavs[i, UAV_ATTACH + 1] != 0.0
@@ -186,12 +146,9 @@ def uav_attach_motion(x, i, wrenches, uavs, out):
     into out (3, 3): its offset o = R_i a_i [m], rate o_dot = w x o [m/s] and acceleration
     without the cable R_i (omega_dot_0 x a_i) + w x (w x o) [m/s^2] (w = R_i omega_i; omega_dot_0
     from the rotor torque alone, `body_acceleration`); returns R_i (3, 3)."""
-    nq = rates_slot(uavs.shape[0])
-    e = uav_slot(i) + EULER
-    phi, theta = x[e], x[e + 1]
-    rotation = uav_rotation(phi, theta, x[e + 2])
-    omega = body_rates(math.sin(phi), math.cos(phi), math.sin(theta), math.cos(theta),
-                       x[nq + e], x[nq + e + 1], x[nq + e + 2])
+    base = uav_attitude_slot(uavs.shape[0], i)
+    rotation = quaternion_rotation(x, base)
+    omega = (x[base + BODY_RATES], x[base + BODY_RATES + 1], x[base + BODY_RATES + 2])
     rate = body_acceleration(uavs, i, wrenches[i, WRENCH_TORQUE], wrenches[i, WRENCH_TORQUE + 1],
                              wrenches[i, WRENCH_TORQUE + 2], omega[0], omega[1], omega[2])
     a = (uavs[i, UAV_ATTACH], uavs[i, UAV_ATTACH + 1], uavs[i, UAV_ATTACH + 2])
@@ -233,16 +190,19 @@ def rotational_compliance(uavs, i, k0, k1, k2):
 
 
 @jit
-def add_cable_torque(x, i, uavs, acc, pull, k0, k1, k2):
-    """UAV i's eta_ddot in acc plus what the cable's moment pull k_i [N m] (pull = 2 lambda_i)
-    adds: W^-1 J^-1 (pull k_i) (Eq. 2.8; the torque enters omega_dot linearly)."""
-    e = uav_slot(i) + EULER
-    s_phi, c_phi = math.sin(x[e]), math.cos(x[e])
-    s_theta, c_theta = math.sin(x[e + 1]), math.cos(x[e + 1])
-    w0 = pull * k0 * uavs[i, UAV_INV_INERTIA]
-    w1 = pull * k1 * uavs[i, UAV_INV_INERTIA + 1]
-    w2 = pull * k2 * uavs[i, UAV_INV_INERTIA + 2]
-    yaw_part = s_phi * w1 + c_phi * w2
-    acc[e] += w0 + s_theta / c_theta * yaw_part
-    acc[e + 1] += c_phi * w1 - s_phi * w2
-    acc[e + 2] += yaw_part / c_theta
+def cable_turn(uavs, i, pull, k0, k1, k2):
+    """J_i^-1 (pull k_i) [rad/s^2 per N m of pull k_i, body FLU]: what the cable's moment pull
+    k_i (pull = 2 lambda_i [N/m], k_i [m^2]) adds to UAV i's omega_dot (or, for an impulse,
+    to omega; for a Newton step's shift, the body-frame turn), as 3 floats."""
+    return (pull * k0 * uavs[i, UAV_INV_INERTIA], pull * k1 * uavs[i, UAV_INV_INERTIA + 1],
+            pull * k2 * uavs[i, UAV_INV_INERTIA + 2])
+
+
+@jit
+def add_cable_torque(uavs, i, rates, at, pull, k0, k1, k2):
+    """rates[at:at + 3] (UAV i's omega_dot in an acc, or its omega in a state) plus
+    `cable_turn`: the torque enters Euler's equation linearly (Eq. 2.28)."""
+    t0, t1, t2 = cable_turn(uavs, i, pull, k0, k1, k2)
+    rates[at] += t0
+    rates[at + 1] += t1
+    rates[at + 2] += t2

@@ -1,10 +1,14 @@
 """The slots of every packed array the physics functions read or write: the one place they are
 named (numba freezes these module-level integers into the compiled code).
 
-- the formation state ``x = (q_f, q_f_dot)`` (docs/conventions.md): per UAV i a block of
-  UAV_COORDINATES at ``UAV_COORDINATES * i`` (POSITION: r_i [m], EULER: eta_i [rad], ZYX roll,
-  pitch, yaw; world frame, z up), then the payload's r_p [m] at PAYLOAD; the rates follow
-  at the same offsets from n_coordinates(n) ([m/s], [rad/s]);
+- the formation state x (docs/conventions.md): the translations as a point-mass DAE
+  (q, q_dot), q = (r_1, ..., r_n, r_p) [m] (UAV i's POSITION block at `uav_slot(i)`, r_p at
+  `payload_slot(n)`), q_dot their velocities [m/s] from `n_coordinates(n)`; then every body's
+  attitude block (BODY_*: its unit quaternion, body -> world, and its body rates [rad/s]),
+  UAV i's at `uav_attitude_slot(n, i)`, a rigid payload's after the UAVs' at
+  `attitude_slot(n)` (the length of a point payload's state);
+- the seed's generalised coordinates q_f (Eq. 2.41, SEED_*: per UAV r_i and ZYX eta_i, then
+  r_p), which the analysis linearises in (multilift_sim.analysis.coordinates);
 - a UAV's constants row (UAV_*, UAV_COLUMNS columns, one row per UAV) and its rotors'
   actuator row (ACTUATOR_*);
 - a gust's row (GUST_*, seed Eq. 2.55);
@@ -18,42 +22,70 @@ named (numba freezes these module-level integers into the compiled code).
 from __future__ import annotations
 
 # -- the state x -----------------------------------------------------------------------------
-UAV_COORDINATES = 6         # coordinates of one UAV in q_f: r_i (3), eta_i (3)
+UAV_COORDINATES = 3         # coordinates of one UAV in q: r_i (3)
 POSITION = 0                # r_i [m] within a UAV's block
-EULER = 3                   # eta_i = (phi, theta, psi) [rad] within a UAV's block
 PAYLOAD_COORDINATES = 3     # r_p [m]
+# a body's attitude block (each UAV's, then a rigid payload's; issue 31, item 6), appended to x
+# after q_dot and stepped with it in RK4, each quaternion scaled back to unit length at the
+# end of a step: its unit quaternion (w, x, y, z), body -> world, then its angular velocity
+# omega [rad/s] in the body frame (FLU for a UAV)
+BODY_QUATERNION = 0         # (w, x, y, z) (4 slots)
+BODY_RATES = 4              # omega [rad/s], body frame (3)
+BODY_ATTITUDE = 7           # the block's length
+PAYLOAD_QUATERNION = BODY_QUATERNION    # a rigid payload's block: the same slots
+PAYLOAD_BODY_RATES = BODY_RATES
+PAYLOAD_ATTITUDE = BODY_ATTITUDE
 
 
 # The offsets below are plain functions, each written from the constants alone (no calls), so
 # that physics.state_slots compiles these same functions for the kernels (numba calls no plain
 # function); numpy code reads the state through formation_params.StateLayout's views.
 def uav_slot(i: int) -> int:
-    """Offset of UAV i's block (from 0) in q_f (and of its rates in q_f_dot)."""
+    """Offset of UAV i's position r_i (from 0) in q (and of its velocity in q_dot)."""
     return UAV_COORDINATES * i
 
 
 def payload_slot(n_uavs: int) -> int:
-    """Offset of r_p in q_f (and of v_p in q_f_dot) for n UAVs."""
+    """Offset of r_p in q (and of v_p in q_dot) for n UAVs."""
     return UAV_COORDINATES * n_uavs
 
 
 def n_coordinates(n_uavs: int) -> int:
-    """Length of q_f: 6n + 3 (the rates q_f_dot start there in x)."""
+    """Length of q: 3n + 3 (the velocities q_dot start there in x)."""
     return UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES
 
 
+def uav_attitude_slot(n_uavs: int, i: int) -> int:
+    """Offset of UAV i's attitude block (BODY_*) in x: after q and q_dot."""
+    return 2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES) + BODY_ATTITUDE * i
+
+
 def attitude_slot(n_uavs: int) -> int:
-    """Offset of a rigid payload's attitude block (after q_f_dot): 2 (6n + 3), the length of a
-    point payload's state."""
-    return 2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
+    """Offset of a rigid payload's attitude block (after the UAVs' blocks): the length of a
+    point payload's state, 2 (3n + 3) + 7n."""
+    return 2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES) + BODY_ATTITUDE * n_uavs
 
 
-# a rigid-body payload's attitude (issue 20; physics.rigid_payload), appended to x after
-# q_f_dot, at 2 (6n + 3): its unit quaternion (w, x, y, z), payload frame -> world, then its
-# angular velocity omega_p [rad/s] in the payload frame. A point payload has none.
-PAYLOAD_QUATERNION = 0      # (w, x, y, z) (4 slots)
-PAYLOAD_BODY_RATES = 4      # omega_p [rad/s], payload frame (3)
-PAYLOAD_ATTITUDE = 7        # the block's length
+# -- the seed's generalised coordinates q_f (Eq. 2.41): the analysis' minimal coordinates -----
+# (multilift_sim.analysis: per UAV r_i [m] and ZYX eta_i [rad], then r_p [m]; a rigid payload's
+# rotation vector after them), which the state maps to and from (analysis.coordinates)
+SEED_UAV_COORDINATES = 6    # r_i (3), eta_i (3)
+SEED_EULER = 3              # eta_i = (phi, theta, psi) [rad] within a UAV's block
+
+
+def seed_uav_slot(i: int) -> int:
+    """Offset of UAV i's block (r_i, eta_i) in q_f."""
+    return SEED_UAV_COORDINATES * i
+
+
+def seed_payload_slot(n_uavs: int) -> int:
+    """Offset of r_p in q_f for n UAVs."""
+    return SEED_UAV_COORDINATES * n_uavs
+
+
+def seed_coordinates(n_uavs: int) -> int:
+    """Length of q_f: 6n + 3."""
+    return SEED_UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES
 
 
 # -- a UAV's constants (one row per UAV) ------------------------------------------------------
@@ -112,7 +144,9 @@ FORMATION_PAYLOAD_INERTIA = 10  # a rigid payload's principal moments J_p [kg m^
 FORMATION_PROJECTION_STEPS = 13  # the null-space form's Newton steps onto g = 0 after each RK4
 #                                 step (physics.nullspace.project); 0: no projection
 FORMATION_PROJECTION_TOLERANCE = 14  # |g_i| / l_i^2 the projection accepts
-FORMATION_SCALARS = 15
+FORMATION_SUBSTEPS = 15      # RK4 sub-steps per physics step (>= 1; the formation's parts
+#                                 stepped at that multiple of the physics rate: stiff cables)
+FORMATION_SCALARS = 16
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
 CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots; from the attach points)
@@ -124,14 +158,14 @@ CABLE_PAYLOAD_MOMENT = 11   # c_i = b_i x R_p^T d_i [m^2], a rigid payload's fra
 #                             arm there (3; physics.rigid_payload)
 CABLE_COLUMNS = 14
 
-# -- an RK4 step's scratch (rows of a (WORK_ROWS, 2 (6n + 3)) array) ---------------------------
+# -- an RK4 step's scratch (rows of a (WORK_ROWS, len(x)) array) ---------------------------
 WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives (consecutive rows)
 WORK_STAGE = 4              # the stage's state
-WORK_ACC = 5                # q_ddot of the stage (its first 6n + 3 entries)
+WORK_ACC = 5                # the stage's q_ddot, then its attitude blocks' rates
 WORK_MULTIPLIERS = 6        # Lambda of the later stages (its first n entries)
 WORK_ROWS = 7
 
-# -- a slack step's scratch: states (rows of (SLACK_STATES, 2 (6n + 3))), per cable values
+# -- a slack step's scratch: states (rows of (SLACK_STATES, len(x))), per cable values
 # (rows of (SLACK_CABLE_ROWS, n)) and flags (rows of a bool (SLACK_FLAGS, n)) ------------------
 SLACK_END = 0               # the state at the end of the (rest of the) step
 SLACK_EVENT = 1             # the state at the located event (the last guard evaluated)
@@ -149,8 +183,8 @@ SLACK_FLAGS = 3
 # -- a UAV's measured state: what the controllers read, one row of (n, MEASURED_COLUMNS) -------
 MEASURED_POSITION = 0       # r_i [m], world (3 slots)
 MEASURED_VELOCITY = 3       # r_i_dot [m/s], world (3)
-MEASURED_EULER = 6          # eta_i = (roll, pitch, yaw) [rad] (3)
-MEASURED_BODY_RATES = 9     # omega_i = W(eta_i) eta_i_dot [rad/s], body FLU (3)
+MEASURED_EULER = 6          # eta_i = (roll, pitch, yaw) [rad] of its quaternion (3)
+MEASURED_BODY_RATES = 9     # omega_i [rad/s], body FLU (3)
 MEASURED_COLUMNS = 12
 
 # -- a UAV's odometry: its measured state (the MEASURED_* slots), then the rest of what its
@@ -166,4 +200,4 @@ STATUS_FINISHED = 1         # reached its duration (the state at t_max is the la
 STATUS_NOT_FINITE = 2       # stopped: the state became non-finite (Algorithm 1)
 STATUS_OFF_CONSTRAINT = 3   # stopped: a taut cable's |g| left constraint_tolerance (Algorithm 1)
 STATUS_OFF_RATE = 4         # stopped: a taut cable's |g_dot| left constraint_rate_tolerance
-STATUS_ATTITUDE = 5         # stopped: a UAV pitched beyond what its Euler angles represent
+STATUS_QUATERNION = 5       # stopped: a body's attitude quaternion lost its unit norm

@@ -1,4 +1,5 @@
-"""What the controllers measure of each UAV, from the formation state (seed Eq. 2.7), and the
+"""What the controllers measure of each UAV, from the formation state (its ZYX angles from its
+quaternion, `quaternion_euler`; its body rates), and the
 rest of what the simulator's messages carry of it (its attitude as R and as a quaternion, its
 body-frame velocity): the one place of these equations (`euler_rotation`, `euler_quaternion`;
 kinematics.rotation_matrix and .quaternion_from_euler call them over stacks, msgvalues
@@ -7,37 +8,58 @@ to elementary rotations and scipy)."""
 import math
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.layout import (EULER, MEASURED_BODY_RATES, MEASURED_EULER,
+from multilift_sim.physics.layout import (BODY_QUATERNION, BODY_RATES, MEASURED_BODY_RATES,
+                                          MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_QUATERNION,
                                           ODOMETRY_ROTATION, POSITION)
-from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
+from multilift_sim.physics.state_slots import (payload_slot, rates_slot, uav_attitude_slot,
+                                               uav_slot)
+
+# cos(pitch) below which `quaternion_euler` reads an attitude as gimbal-locked (pitch within
+# ~1e-7 rad of +-90 deg): roll and yaw from R's rounding would be good to only ~1e-16 / cos
+GIMBAL_LOCK = 1e-7
 
 
 @jit
 def measured_states(x, n, out):
     """Every UAV's measured state into out (n, MEASURED_COLUMNS or more; only the MEASURED_*
-    slots are written) from the formation state x (2 (6n + 3),): position [m] and velocity
-    [m/s] (world), ZYX Euler angles [rad] and the body rates omega = W(eta) eta_dot [rad/s]
-    (Eq. 2.7, body FLU)."""
+    slots are written) from the formation state x (docs/conventions.md): position [m] and
+    velocity [m/s] (world), the ZYX Euler angles [rad] of its quaternion (`quaternion_euler`,
+    Eq. 2.6) and its body rates omega [rad/s] (body FLU, the state's own)."""
     nq = rates_slot(n)
     for i in range(n):
-        base = uav_slot(i)
+        r = uav_slot(i) + POSITION
         for axis in range(3):
-            out[i, MEASURED_POSITION + axis] = x[base + POSITION + axis]
-            out[i, MEASURED_VELOCITY + axis] = x[nq + base + POSITION + axis]
-        phi, theta, psi = x[base + EULER], x[base + EULER + 1], x[base + EULER + 2]
-        phi_dot = x[nq + base + EULER]
-        theta_dot = x[nq + base + EULER + 1]
-        psi_dot = x[nq + base + EULER + 2]
-        out[i, MEASURED_EULER] = phi
-        out[i, MEASURED_EULER + 1] = theta
-        out[i, MEASURED_EULER + 2] = psi
-        s_phi, c_phi = math.sin(phi), math.cos(phi)
-        s_theta, c_theta = math.sin(theta), math.cos(theta)
-        out[i, MEASURED_BODY_RATES] = phi_dot - s_theta * psi_dot
-        out[i, MEASURED_BODY_RATES + 1] = c_phi * theta_dot + s_phi * c_theta * psi_dot
-        out[i, MEASURED_BODY_RATES + 2] = -s_phi * theta_dot + c_phi * c_theta * psi_dot
+            out[i, MEASURED_POSITION + axis] = x[r + axis]
+            out[i, MEASURED_VELOCITY + axis] = x[nq + r + axis]
+        base = uav_attitude_slot(n, i)
+        (out[i, MEASURED_EULER], out[i, MEASURED_EULER + 1],
+         out[i, MEASURED_EULER + 2]) = quaternion_euler(
+            x[base + BODY_QUATERNION], x[base + BODY_QUATERNION + 1],
+            x[base + BODY_QUATERNION + 2], x[base + BODY_QUATERNION + 3])
+        for axis in range(3):
+            out[i, MEASURED_BODY_RATES + axis] = x[base + BODY_RATES + axis]
+
+
+@jit
+def quaternion_euler(w, qx, qy, qz):
+    """The ZYX Euler angles (roll phi, pitch theta, yaw psi) [rad] of the unit quaternion
+    (w, x, y, z), body -> world, R = Rz(psi) Ry(theta) Rx(phi) (Eq. 2.6): roll and yaw in
+    (-pi, pi], pitch in [-pi/2, pi/2] from atan2 of -R_20 and cos(pitch) = |(R_00, R_10)|
+    (full precision near +-90 deg; `euler_quaternion` the inverse). Within GIMBAL_LOCK of
+    +-90 deg pitch, where only roll -+ yaw is defined (and rounding of the others would
+    dominate it), yaw is 0 and roll all of it: atan2(-R_12, R_11)."""
+    r20 = 2.0 * (qx * qz - w * qy)
+    r00 = 1.0 - 2.0 * (qy * qy + qz * qz)
+    r10 = 2.0 * (qx * qy + w * qz)
+    cos_pitch = math.sqrt(r00 * r00 + r10 * r10)
+    pitch = math.atan2(-r20, cos_pitch)
+    if cos_pitch < GIMBAL_LOCK:
+        return (math.atan2(-2.0 * (qy * qz - w * qx), 1.0 - 2.0 * (qx * qx + qz * qz)), pitch,
+                0.0)
+    return (math.atan2(2.0 * (qy * qz + w * qx), 1.0 - 2.0 * (qx * qx + qy * qy)), pitch,
+            math.atan2(r10, r00))
 
 
 @jit
@@ -59,7 +81,7 @@ def payload_velocity(x, n):
 @jit
 def odometry_states(states, n, out):
     """Every UAV's odometry row into out (K, n, ODOMETRY_COLUMNS) for K formation states
-    (K, 2 (6n + 3)) (FormationSimulator.snapshot: K = 1; the headless bag: a chunk's ticks):
+    (K, len(x)) (FormationSimulator.snapshot: K = 1; the headless bag: a chunk's ticks):
     its measured state (`measured_states`), then the rest (`odometry_rows`)."""
     for k in range(states.shape[0]):
         measured_states(states[k], n, out[k])
@@ -143,3 +165,11 @@ def euler_quaternions(angles, out):
     for k in range(angles.shape[0]):
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = euler_quaternion(angles[k, 0], angles[k, 1],
                                                                       angles[k, 2])
+
+
+@jit
+def quaternion_eulers(quaternions, out):
+    """`quaternion_euler` of each row (w, x, y, z) of quaternions (m, 4) into out (m, 3) [rad]."""
+    for k in range(quaternions.shape[0]):
+        out[k, 0], out[k, 1], out[k, 2] = quaternion_euler(
+            quaternions[k, 0], quaternions[k, 1], quaternions[k, 2], quaternions[k, 3])

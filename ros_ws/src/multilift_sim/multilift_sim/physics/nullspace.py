@@ -174,7 +174,8 @@ def translational_masses(uavs, formation):
 
 @jit
 def nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers):
-    """q_ddot into acc (6n + 3,) and Lambda into multipliers (n,) [N/m] at state x by Eq.
+    """q_ddot into acc[:3n + 3] (the attitude blocks' rates after it) and Lambda into multipliers
+    (n,) [N/m] at state x by Eq.
     2.71-2.72 with Eq. 2.57 (every cable a constraint; see the module docstring)."""
     n = uavs.shape[0]
     p = payload_slot(n)
@@ -230,8 +231,8 @@ def nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers):
 
 @jit
 def project(x, uavs, masses, tolerance, max_steps):
-    """x (2 (6n + 3),) moved onto the constraint manifold in place: positions by Newton steps
-    dq = -M^-1 G^T (G M^-1 G^T)^-1 g until |g_i| <= tolerance l_i^2 (at most max_steps), then
+    """x (docs/conventions.md) moved onto the constraint manifold in place: positions by Newton
+    steps dq = -M^-1 G^T (G M^-1 G^T)^-1 g until |g_i| <= tolerance l_i^2 (at most max_steps), then
     velocities dv = -M^-1 G^T (G M^-1 G^T)^-1 G v (exact: g_dot = G v is linear in v), with
     M_t = diag(`masses`) (3n + 3,) [kg] (`translational_masses`). Only the translations move
     (the attitude columns of G are zero)."""

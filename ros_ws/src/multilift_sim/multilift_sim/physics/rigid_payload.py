@@ -1,5 +1,6 @@
 """A rigid-body payload on the formation's cables (issue 20): the DAE's solve and residuals when
-x carries the payload's attitude (`layout.PAYLOAD_ATTITUDE` after q_f_dot). World frame (z up),
+x carries the payload's attitude (`layout.PAYLOAD_ATTITUDE` after the UAVs' blocks). World frame (z
+up),
 SI units; the slots are `physics.layout`'s; docs/rigid_payload.md writes the equations out.
 
 Cable i holds the payload at b_i (`UAV_PAYLOAD_ATTACH`, payload frame) and UAV i at its centre
@@ -23,8 +24,6 @@ the Woodbury identity leaves a 6 x 6 system, S = W^-1 + sum_i U_i U_i^T / delta_
 payload's 3 x 3 (`formation_dae.cable_multipliers`) with the rotation's three rows added.
 With every b_i = 0 it is the point payload's DAE (c_i = 0) and the attitude spins free.
 """
-import math
-
 import numpy as np
 
 from multilift_sim.kernels import jit
@@ -32,31 +31,16 @@ from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_ce
                                               cable_moment_arm, cross, payload_force_per_mass,
                                               rotational_compliance, uav_attach_motion,
                                               uav_free_motion)
+from multilift_sim.physics.attitude import quaternion_rate
+from multilift_sim.physics.attitude import quaternion_rotation as payload_rotation
 from multilift_sim.physics.layout import (
-    CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT, CABLE_RHS,
+    BODY_RATES, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT, CABLE_RHS,
     CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_GRAVITY, FORMATION_PAYLOAD_INERTIA,
     FORMATION_PAYLOAD_MASS, FORMATION_TWO_ALPHA, PAYLOAD_BODY_RATES,
     PAYLOAD_QUATERNION, POSITION, UAV_LENGTH_SQ, UAV_MASS, UAV_PAYLOAD_ATTACH)
-from multilift_sim.physics.state_slots import attitude_slot, payload_slot, rates_slot, uav_slot
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
+                                               uav_attitude_slot, uav_slot)
 from multilift_sim.physics.nullspace import dense_solve
-
-
-@jit
-def payload_rotation(x, base):
-    """R_p (3, 3), payload frame -> world, of the unit quaternion (w, x, y, z) at x[base:]."""
-    w, qx = x[base + PAYLOAD_QUATERNION], x[base + PAYLOAD_QUATERNION + 1]
-    qy, qz = x[base + PAYLOAD_QUATERNION + 2], x[base + PAYLOAD_QUATERNION + 3]
-    r = np.empty((3, 3))
-    r[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
-    r[0, 1] = 2.0 * (qx * qy - w * qz)
-    r[0, 2] = 2.0 * (qx * qz + w * qy)
-    r[1, 0] = 2.0 * (qx * qy + w * qz)
-    r[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
-    r[1, 2] = 2.0 * (qy * qz - w * qx)
-    r[2, 0] = 2.0 * (qx * qz - w * qy)
-    r[2, 1] = 2.0 * (qy * qz + w * qx)
-    r[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
-    return r
 
 
 @jit
@@ -92,16 +76,6 @@ def world_rates(x, base, rotation):
                 + rotation[k, 1] * x[base + PAYLOAD_BODY_RATES + 1]
                 + rotation[k, 2] * x[base + PAYLOAD_BODY_RATES + 2])
     return w
-
-
-@jit
-def quaternion_rate(x, base, o0, o1, o2):
-    """q (x) (0, omega) / 2 [1/s] of the payload's quaternion q at x[base:] and a rate omega
-    = (o0, o1, o2) [rad/s], payload frame: q_dot, as 4 floats (w, x, y, z)."""
-    qw, qx = x[base + PAYLOAD_QUATERNION], x[base + PAYLOAD_QUATERNION + 1]
-    qy, qz = x[base + PAYLOAD_QUATERNION + 2], x[base + PAYLOAD_QUATERNION + 3]
-    return (0.5 * (-qx * o0 - qy * o1 - qz * o2), 0.5 * (qw * o0 + qy * o2 - qz * o1),
-            0.5 * (qw * o1 + qz * o0 - qx * o2), 0.5 * (qw * o2 + qx * o1 - qy * o0))
 
 
 @jit
@@ -179,8 +153,9 @@ def rigid_multipliers(cables, formation, taut, out):
 
 @jit
 def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
-    """q_ddot into acc[:6n + 3] [m/s^2, rad/s^2], the attitude block's rate (quaternion rate,
-    then alpha_p [rad/s^2], payload frame) into acc[6n + 3:6n + 10], and Lambda into
+    """q_ddot into acc[:3n + 3] [m/s^2], the UAVs' attitude blocks' rates after it, the
+    payload's block's rate (quaternion rate, then alpha_p [rad/s^2], payload frame) last, and
+    Lambda into
     multipliers (n,) [N/m] at state x (see the module docstring); only `taut` cables pull.
     cables (n, CABLE_COLUMNS) scratch: each cable's row (`rigid_cable_row`; zeros when slack)."""
     n = uavs.shape[0]
@@ -240,8 +215,9 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cab
         acc[r + 1] = cables[i, CABLE_THRUST + 1] + pull * d1
         acc[r + 2] = cables[i, CABLE_THRUST + 2] + pull * d2 - gravity
         if lam != 0.0 and attached_off_centre(uavs, i):  # the pull's moment on the UAV
-            add_cable_torque(x, i, uavs, acc, 2.0 * lam, cables[i, CABLE_MOMENT],
-                             cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
+            add_cable_torque(uavs, i, acc, uav_attitude_slot(n, i) - nq + BODY_RATES, 2.0 * lam,
+                             cables[i, CABLE_MOMENT], cables[i, CABLE_MOMENT + 1],
+                             cables[i, CABLE_MOMENT + 2])
         pull0 += lam * d0
         pull1 += lam * d1
         pull2 += lam * d2
@@ -253,12 +229,13 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cab
     acc[p + 1] = drag1 - scale * pull1
     acc[p + 2] = drag2 - scale * pull2 - gravity
     # the attitude block: q_dot = q (x) (0, omega) / 2, alpha = alpha_0 - 2 J^-1 sum lambda c
-    (acc[nq + PAYLOAD_QUATERNION], acc[nq + PAYLOAD_QUATERNION + 1],
-     acc[nq + PAYLOAD_QUATERNION + 2], acc[nq + PAYLOAD_QUATERNION + 3]) = quaternion_rate(
+    rate = base - nq  # the block's derivative in acc
+    (acc[rate + PAYLOAD_QUATERNION], acc[rate + PAYLOAD_QUATERNION + 1],
+     acc[rate + PAYLOAD_QUATERNION + 2], acc[rate + PAYLOAD_QUATERNION + 3]) = quaternion_rate(
         x, base, omega[0], omega[1], omega[2])
-    acc[nq + PAYLOAD_BODY_RATES] = alpha0[0] - 2.0 * turn0 / inertia[0]
-    acc[nq + PAYLOAD_BODY_RATES + 1] = alpha0[1] - 2.0 * turn1 / inertia[1]
-    acc[nq + PAYLOAD_BODY_RATES + 2] = alpha0[2] - 2.0 * turn2 / inertia[2]
+    acc[rate + PAYLOAD_BODY_RATES] = alpha0[0] - 2.0 * turn0 / inertia[0]
+    acc[rate + PAYLOAD_BODY_RATES + 1] = alpha0[1] - 2.0 * turn1 / inertia[1]
+    acc[rate + PAYLOAD_BODY_RATES + 2] = alpha0[2] - 2.0 * turn2 / inertia[2]
 
 
 @jit
@@ -277,15 +254,3 @@ def rigid_residuals(x, uavs, g, g_dot):
         d0, d1, d2, v0, v1, v2, _, _, _ = cable_geometry(x, uavs, i, rotation, w, base, attach)
         g[i] = d0 * d0 + d1 * d1 + d2 * d2 - uavs[i, UAV_LENGTH_SQ]
         g_dot[i] = 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
-
-
-@jit
-def normalize_quaternion(x, base):
-    """The payload's quaternion at x[base:] scaled back to unit length (after an RK4 step, so
-    R_p stays orthonormal)."""
-    norm = 0.0
-    for k in range(4):
-        norm += x[base + PAYLOAD_QUATERNION + k] * x[base + PAYLOAD_QUATERNION + k]
-    norm = math.sqrt(norm)
-    for k in range(4):
-        x[base + PAYLOAD_QUATERNION + k] /= norm

@@ -14,17 +14,19 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.formation_dae import (cable_multipliers, inverse_delta, residuals,
                                                  rk4_step, solve)
 from multilift_sim.physics.free_motion import (add_cable_torque, attached_off_centre,
-                                              cable_moment_arm, uav_attach_motion)
+                                              cable_moment_arm, cable_turn, uav_attach_motion)
 from multilift_sim.physics.layout import (
-    CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT, CABLE_RHS,
+    BODY_RATES, CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET, CABLE_PAYLOAD_MOMENT,
+    CABLE_RHS,
     FORMATION_INV_PAYLOAD_MASS, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
-    PAYLOAD_BODY_RATES, PAYLOAD_QUATERNION, POSITION, SLACK_CABLE_ROWS,
+    PAYLOAD_BODY_RATES, POSITION, SLACK_CABLE_ROWS,
     SLACK_END, SLACK_EVENT, SLACK_FLAGS, SLACK_G_DOT_END, SLACK_G_END, SLACK_MULTIPLIERS,
     SLACK_SNAPPING, SLACK_SOLUTION, SLACK_STATES, SLACK_TARGET, UAV_LENGTH_SQ,
     UAV_MASS, WORK_ACC, WORK_ROWS, WRENCH_COLUMNS)
-from multilift_sim.physics.state_slots import attitude_slot, payload_slot, rates_slot, uav_slot
-from multilift_sim.physics.rigid_payload import (normalize_quaternion, payload_rotation,
-                                                 quaternion_rate, rigid_cable_row,
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
+                                               uav_attitude_slot, uav_slot)
+from multilift_sim.physics.attitude import turn_quaternion
+from multilift_sim.physics.rigid_payload import (payload_rotation, rigid_cable_row,
                                                  rigid_multipliers, world_rates)
 from multilift_sim.physics.taut_event import EVENT_TOLERANCE, taut_event
 
@@ -74,13 +76,12 @@ def mass_metric_solve(x, uavs, formation, taut, rhs, out, cables):
 
 @jit
 def move_along_cables(x, uavs, formation, z, start, cables):
-    """x[start:] moved by -M^-1 G^T z (the rows of `cables`, `mass_metric_solve`'s): UAV i by
-    +2 z_i d_i / m_i and, held off its centre, its attitude by W^-1 J_i^-1 (2 z_i k_i) (Eq.
-    2.8's map of a body rotation to eta); the payload by -2 sum_i z_i d_i / m_p and, a rigid
-    one, turned by -2 J_p^-1 sum_i z_i c_i (payload frame). start = 0 moves the positions
-    [m] and angles [rad] (a rigid payload's quaternion q -> q (x) (1, turn / 2), back to unit
-    length: to first order, as the projection's Newton steps are), start = 6n + 3 the
-    velocities [m/s] and rates [rad/s]."""
+    """x moved by -M^-1 G^T z (the rows of `cables`, `mass_metric_solve`'s): UAV i by
+    +2 z_i d_i / m_i and, held off its centre, turned by J_i^-1 (2 z_i k_i) (body FLU); the
+    payload by -2 sum_i z_i d_i / m_p and, a rigid one, turned by -2 J_p^-1 sum_i z_i c_i
+    (payload frame). start = 0 moves the positions [m] and attitudes (each quaternion q ->
+    q (x) (1, turn / 2), back to unit length: to first order, as the projection's Newton steps
+    are), start = 3n + 3 the velocities [m/s] and body rates [rad/s]."""
     n = uavs.shape[0]
     p = start + payload_slot(n)
     inv_payload_mass = formation[FORMATION_INV_PAYLOAD_MASS]
@@ -91,8 +92,15 @@ def move_along_cables(x, uavs, formation, z, start, cables):
             x[r + k] += pull / uavs[i, UAV_MASS]
             x[p + k] -= pull * inv_payload_mass
         if attached_off_centre(uavs, i):  # the impulse's moment about UAV i's centre
-            add_cable_torque(x, i, uavs, x[start:], 2.0 * z[i], cables[i, CABLE_MOMENT],
-                             cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
+            base = uav_attitude_slot(n, i)
+            if start == 0:
+                t0, t1, t2 = cable_turn(uavs, i, 2.0 * z[i], cables[i, CABLE_MOMENT],
+                                        cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
+                turn_quaternion(x, base, t0, t1, t2)
+            else:
+                add_cable_torque(uavs, i, x, base + BODY_RATES, 2.0 * z[i],
+                                 cables[i, CABLE_MOMENT], cables[i, CABLE_MOMENT + 1],
+                                 cables[i, CABLE_MOMENT + 2])
     if x.shape[0] > attitude_slot(n):  # a rigid payload's rotation
         base = attitude_slot(n)
         turn0 = turn1 = turn2 = 0.0
@@ -104,10 +112,7 @@ def move_along_cables(x, uavs, formation, z, start, cables):
         turn1 *= -2.0 / formation[FORMATION_PAYLOAD_INERTIA + 1]
         turn2 *= -2.0 / formation[FORMATION_PAYLOAD_INERTIA + 2]
         if start == 0:
-            rate = quaternion_rate(x, base, turn0, turn1, turn2)
-            for k in range(4):
-                x[base + PAYLOAD_QUATERNION + k] += rate[k]
-            normalize_quaternion(x, base)
+            turn_quaternion(x, base, turn0, turn1, turn2)
         else:
             x[base + PAYLOAD_BODY_RATES] += turn0
             x[base + PAYLOAD_BODY_RATES + 1] += turn1
@@ -257,7 +262,7 @@ def integrate_period(x, wrenches, uavs, gusts, formation, taut, released, dt, st
     (the state at the end, the multipliers [N/m] at x after the taut set's update there,
     g [m^2] and g_dot [m^2/s] at the end). taut (n,) bool is updated; x is not written."""
     n = uavs.shape[0]
-    size = x.shape[0]  # 2 (6n + 3), and a rigid payload's attitude
+    size = x.shape[0]  # 2 (3n + 3), the UAVs' attitudes and a rigid payload's
     work = np.empty((WORK_ROWS, size))
     states = np.empty((SLACK_STATES, size))
     values = np.empty((SLACK_CABLE_ROWS, n))

@@ -18,20 +18,22 @@ from multilift_sim.physics.actuators import actuated_period
 from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
-from multilift_sim.physics.layout import (CABLE_COLUMNS, EULER, FORMATION_WIND,
-                                          STATUS_ATTITUDE, STATUS_FINISHED,
+from multilift_sim.physics.attitude import quaternion_norm_error
+from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_WIND,
+                                          STATUS_FINISHED, STATUS_QUATERNION,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
                                           STATUS_OFF_RATE, STATUS_RUNNING,
                                           WRENCH_COLUMNS)
-from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
+                                               uav_attitude_slot)
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.sensors.sensing import sensed_states
-from multilift_sim.statistics.accumulators import (run_add_commands, run_add_compression,
-                                                   run_add_thrust_margin,
-                                                   run_add_gust_speed, run_add_slack,
-                                                   run_add_tensions, run_check)
-from multilift_sim.statistics.layout import (CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT,
-                                             CHECK_NON_FINITE)
+from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
+                                                   run_add_compression, run_add_gust_speed,
+                                                   run_add_slack, run_add_tensions,
+                                                   run_add_thrust_margin, run_check)
+from multilift_sim.statistics.layout import (CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE,
+                                             CHECK_QUATERNION)
 
 
 @jit
@@ -70,11 +72,22 @@ def period_formation(constants, series, tick):
 
 
 @jit
+def stop_quaternion(a, m, b, body):
+    """Formation b stopped as STATUS_QUATERNION: body `body` (UAV i, or n the rigid payload)
+    in worst_cable, its quaternion's | |q| - 1 | in worst_value."""
+    n = a.uavs.shape[1]
+    m.status[b], m.worst_cable[b] = STATUS_QUATERNION, body
+    m.worst_value[b] = quaternion_norm_error(
+        m.state[b], uav_attitude_slot(n, body) if body < n else attitude_slot(n))
+
+
+@jit
 def check(a, m, b):
     """Algorithm 1, lines 10-13, at formation b's current state (its g, g_dot), the run's
     figures accumulated (`statistics.accumulators.run_check`, then the gust at the payload):
-    its status becomes STATUS_NOT_FINITE, _ATTITUDE (the UAV in worst_cable, its pitch in
-    worst_value), _OFF_CONSTRAINT or _OFF_RATE (the cable in worst_cable, its |g| or |g_dot|
+    its status becomes STATUS_NOT_FINITE, _QUATERNION (the body in worst_cable: UAV i, or n
+    the rigid payload; its | |q| - 1 | in worst_value), _OFF_CONSTRAINT or _OFF_RATE (the cable in
+    worst_cable, its |g| or |g_dot|
     in worst_value) when Algorithm 1 stops it."""
     t = m.tick[b] * a.period_ns[b] * 1e-9
     x = m.state[b]
@@ -83,9 +96,8 @@ def check(a, m, b):
     if status == CHECK_NON_FINITE:
         m.status[b] = STATUS_NOT_FINITE
         return
-    if status == CHECK_ATTITUDE:  # the UAV in worst_cable, its pitch [rad] in worst_value
-        m.status[b], m.worst_cable[b] = STATUS_ATTITUDE, cable
-        m.worst_value[b] = x[uav_slot(cable) + EULER + 1]
+    if status == CHECK_QUATERNION:  # the body in worst_cable, | |q| - 1 | in worst_value
+        stop_quaternion(a, m, b, cable)
         return
     payload = payload_slot(a.uavs.shape[1])
     gust_x, gust_y, gust_z = air_velocity(x[payload], x[payload + 1], a.gusts[b])
@@ -108,8 +120,15 @@ def advance(a, m, b, speeds, saturated, tension):
     controller's held: `physics.events.held_commands`; RK4 through the rotors' actuators:
     `physics.actuators`), the events of the new tick applied (`physics.events`), then checked
     (`check`); the tension T_i = 2 l_i lambda_i [N] at the tick it started from into
-    tension. The second half of a tick, whoever answered."""
+    tension. The second half of a tick, whoever answered. A state whose quaternion is no
+    attitude (`statistics.accumulators.quaternion_fault`: set from outside; the model's own
+    stay unit) is not integrated: the formation stops as STATUS_QUATERNION."""
     n = speeds.shape[0]
+    body = quaternion_fault(m.state[b], n)
+    if body >= 0:  # a state given from outside that no attitude is: not integrated (the
+        stop_quaternion(a, m, b, body)  # step's renormalisation would hide it), stopped
+        tension[:] = 0.0
+        return
     period = a.period_ns[b] * 1e-9
     held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
                   m.held_saturated[b])
@@ -176,7 +195,7 @@ def tension_at(a, m, b, speeds, tension):
     wrenches = np.empty((n, WRENCH_COLUMNS))
     rotor_wrenches(a.allocation[b], speeds, m.effectiveness[b], wrenches)
     x = m.state[b]
-    acc = np.empty(x.shape[0] - rates_slot(n))  # q_ddot (+ a body's)
+    acc = np.empty(x.shape[0] - rates_slot(n))  # q_ddot, then the attitude blocks' rates
     multipliers = np.empty(n)
     formation = period_formation(a.formation[b], a.wind_series[b], m.tick[b])
     solve(x, wrenches, a.uavs[b], a.gusts[b], formation, m.taut[b], acc, multipliers,

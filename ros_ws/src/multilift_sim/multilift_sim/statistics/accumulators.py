@@ -14,15 +14,17 @@ import math
 import numpy as np
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.layout import EULER, POSITION, UAV_COORDINATES
-from multilift_sim.physics.state_slots import payload_slot, uav_slot
+from multilift_sim.physics.attitude import quaternion_norm_error
+from multilift_sim.physics.layout import POSITION, UAV_COORDINATES
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, uav_attitude_slot,
+                                               uav_slot)
 from multilift_sim.statistics.layout import (
-    CHECK_ATTITUDE, CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, FORMATION_MAX_ABS,
-    FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ, PITCH_LIMIT,
-    RUN_COMPRESSED_TIME, RUN_LEAST_THRUST_MARGIN, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
-    RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION, RUN_MIN_TENSION,
-    RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
-    RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
+    CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, CHECK_QUATERNION, FORMATION_MAX_ABS,
+    FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ,
+    QUATERNION_NORM_TOLERANCE, RUN_COMPRESSED_TIME, RUN_LEAST_THRUST_MARGIN, RUN_MAX_ABS_G,
+    RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION,
+    RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME,
+    RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
 from multilift_sim.statistics.swing import swing_at
 
 
@@ -131,17 +133,18 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
     time.
 
     Returns (status, cable): CHECK_NON_FINITE (the state is not finite; nothing accumulated),
-    CHECK_ATTITUDE (UAV `cable` pitched beyond PITCH_LIMIT, where the state's Euler angles
-    stop representing its attitude; nothing accumulated), CHECK_G or CHECK_G_DOT (the first
+    CHECK_QUATERNION (body `cable`'s quaternion, UAV `cable` or the rigid payload's at n, is
+    more than QUATERNION_NORM_TOLERANCE off unit length: no attitude; nothing accumulated;
+    `quaternion_fault`), CHECK_G or CHECK_G_DOT (the first
     cable of the largest |g| or |g_dot| is over its tolerance; |g| is checked first), else
     CHECK_OK; cable: that cable (from 0), else -1.
     """
     for value in state:
         if not math.isfinite(value):
             return CHECK_NON_FINITE, -1
-    for i in range(g.shape[0]):  # cos(pitch) < cos(limit): beyond it on either side, or past 90
-        if math.cos(state[uav_slot(i) + EULER + 1]) < math.cos(PITCH_LIMIT):
-            return CHECK_ATTITUDE, i
+    body = quaternion_fault(state, g.shape[0])
+    if body >= 0:
+        return CHECK_QUATERNION, body
     peak, worst, peak_rate, worst_rate = -1.0, -1, -1.0, -1
     for i in range(g.shape[0]):
         abs_g, abs_g_dot = (abs(g[i]), abs(g_dot[i])) if taut[i] else (0.0, 0.0)
@@ -181,6 +184,19 @@ def run_check(run: np.ndarray, state: np.ndarray, g: np.ndarray, g_dot: np.ndarr
     if peak_rate > rate_tolerance:
         return CHECK_G_DOT, worst_rate
     return CHECK_OK, -1
+
+
+@jit
+def quaternion_fault(state: np.ndarray, n: int) -> int:
+    """The first body whose attitude quaternion is more than QUATERNION_NORM_TOLERANCE off
+    unit length in a state of n UAVs (UAV i as i, a rigid payload as n), else -1."""
+    for i in range(n):
+        if quaternion_norm_error(state, uav_attitude_slot(n, i)) > QUATERNION_NORM_TOLERANCE:
+            return i
+    if state.shape[0] > attitude_slot(n) and quaternion_norm_error(
+            state, attitude_slot(n)) > QUATERNION_NORM_TOLERANCE:
+        return n
+    return -1
 
 
 @jit

@@ -68,8 +68,9 @@ CHECK_OK = 0
 CHECK_NON_FINITE = 1        # the formation state is not finite
 CHECK_G = 2                 # a taut cable's |g| exceeds the constraint tolerance
 CHECK_G_DOT = 3             # a taut cable's |g_dot| exceeds the rate tolerance
-CHECK_ATTITUDE = 4          # a UAV's attitude left what its ZYX Euler angles represent
-# the largest |pitch| the state's ZYX Euler angles (seed Eq. 2.6) carry a UAV to [rad]: their
-# rates (Eq. 2.7's W(eta)^-1) hold 1/cos(pitch), which diverges at 90 deg; a run stops
-# there, named, rather than fly on numbers that only look finite
-PITCH_LIMIT = 1.5533430342749532  # 89 deg
+CHECK_QUATERNION = 4        # a body's attitude quaternion lost its unit norm
+# how far a body's |q| may be from 1 before the state no longer represents an attitude: each
+# RK4 step scales every quaternion back to unit length, so |q| - 1 is rounding (~1e-16) in any
+# state the model made; past this a state is broken (a tumble itself never is: a unit
+# quaternion represents every attitude)
+QUATERNION_NORM_TOLERANCE = 1e-9

@@ -160,7 +160,7 @@ class SimulatorMessages:
 
 def state_rows(states: np.ndarray, n: int, measured: np.ndarray | None = None
                ) -> tuple[np.ndarray, np.ndarray]:
-    """The numbers `SimulatorMessages.state_of` takes, for K formation states (K, 2 (6n + 3))
+    """The numbers `SimulatorMessages.state_of` takes, for K formation states (K, len(x))
     of n UAVs at once: (the FormationSnapshot rows (K, 12 n + 6) without the rotor speeds,
     every UAV's odometry row (K, n, 13)). One call of physics.measurement.odometry_states,
     which `FormationSimulator.snapshot` calls too: the same bits tick by tick

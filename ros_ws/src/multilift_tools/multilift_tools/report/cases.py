@@ -19,7 +19,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from multilift_sim.physics.layout import n_coordinates
+from multilift_sim.physics.layout import seed_coordinates
 from multilift_sim.scenario import load
 from multilift_tools.report.seed import MULTI, SWING, TWIN
 from multilift_tools.report.single_lift import single_lift_table
@@ -100,7 +100,7 @@ def _modal_case(figures: Path, progress: _ProgressFile) -> dict:
         out[name] = {'periods': [float(p) for p in analysis.pendulum_periods],
                      'rigid': analysis.rigid_count,
                      'unstable': len(analysis.indices('unstable')),
-                     'free': int(analysis.basis.shape[1]), 'coordinates': n_coordinates(n),
+                     'free': int(analysis.basis.shape[1]), 'coordinates': seed_coordinates(n),
                      'dependent': [names[k] for k in analysis.dependent],
                      'tilt_deg': [float(t) for t in tilt],
                      'tensions': [float(t) for t in analysis.equilibrium.tensions]}

@@ -16,12 +16,13 @@ from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (
     ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, FORMATION_BETA_SQ,
-    FORMATION_DRAG, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
-    FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS, FORMATION_PROJECTION_STEPS,
-    FORMATION_PROJECTION_TOLERANCE, FORMATION_SCALARS, FORMATION_SUBSTEPS, FORMATION_TWO_ALPHA,
-    FORMATION_WIND, GUST_CENTER, GUST_COLUMNS, GUST_DIRECTION, GUST_GRADIENT_DISTANCE,
-    GUST_REFERENCE_SPEED, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_LENGTH_SQ,
-    UAV_ATTACH, UAV_MASS, UAV_PAYLOAD_ATTACH)
+    FORMATION_DRAG, FORMATION_ELASTIC, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
+    FORMATION_NULL_SPACE, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
+    FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE, FORMATION_SCALARS,
+    FORMATION_SUBSTEPS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_COLUMNS,
+    GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, UAV_ATTACH,
+    UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA,
+    UAV_LENGTH_SQ, UAV_MASS, UAV_PAYLOAD_ATTACH)
 from multilift_sim.wind.gusts import Gust
 
 
@@ -45,6 +46,11 @@ class FormationParams:
     payload_attach_points: tuple[tuple[float, float, float], ...] | None = None
     # where each cable holds its UAV, a_i [m] in its body frame FLU (None: every centre of mass)
     uav_attach_points: tuple[tuple[float, float, float], ...] | None = None
+    # elastic cables (`cable_model: elastic`, physics.elastic_cables): each cable's axial
+    # stiffness k_i [N/m] and damping c_i [N s/m] (None: the seed's rigid cables)
+    cable_stiffness: tuple[float, ...] | None = None
+    cable_damping: tuple[float, ...] | None = None
+    substeps: int = 1                        # RK4 sub-steps per physics step (FORMATION_SUBSTEPS)
 
     def __post_init__(self) -> None:
         uavs = tuple(self.uavs)
@@ -273,7 +279,11 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     formation[FORMATION_NULL_SPACE] = 0.0  # the multipliers' form (nullspace.NullSpaceModel: 1)
     formation[FORMATION_PROJECTION_STEPS] = 0.0   # no projection (nullspace.NullSpaceModel's)
     formation[FORMATION_PROJECTION_TOLERANCE] = 0.0
-    formation[FORMATION_SUBSTEPS] = 1.0   # one RK4 step per physics step
+    formation[FORMATION_SUBSTEPS] = float(params.substeps)   # RK4 steps per physics step
+    elastic = params.cable_stiffness is not None
+    formation[FORMATION_ELASTIC] = 1.0 if elastic else 0.0
+    uavs[:, UAV_CABLE_STIFFNESS] = params.cable_stiffness if elastic else 0.0
+    uavs[:, UAV_CABLE_DAMPING] = (params.cable_damping or 0.0) if elastic else 0.0
     formation[FORMATION_PAYLOAD_INERTIA:FORMATION_PAYLOAD_INERTIA + 3] = (
         params.payload_inertia if params.rigid_payload else 0.0)
     uavs[:, UAV_PAYLOAD_ATTACH:UAV_PAYLOAD_ATTACH + 3] = (

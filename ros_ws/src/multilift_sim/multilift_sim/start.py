@@ -31,11 +31,13 @@ def swing_sampling(n_uavs: int) -> int:
 
 
 def initial_state(scenario: Scenario) -> np.ndarray:
-    """Initial formation state on the constraint manifold, at rest."""
+    """Initial formation state on the constraint manifold, at rest (elastic cables: each
+    stretched by its share of the hanging payload's weight, `start_lengths`)."""
     if scenario.n_uavs == 1:
         uav = scenario.uavs[0]
         return initial_state_single_lift(np.asarray(uav.position, dtype=float),
-                                         np.array([0.0, 0.0, uav.yaw]), uav.cable_length,
+                                         np.array([0.0, 0.0, uav.yaw]),
+                                         start_lengths(scenario)[0],
                                          scenario.payload.alpha, scenario.payload.beta)
     formation = scenario.formation
     uavs, payload = formation_start(scenario)
@@ -54,8 +56,29 @@ def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     f = scenario.formation
     uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position, f.offsets,
                              f.distance, f.half_angle)
-    return hanging_payload(uavs, [u.cable_length for u in scenario.uavs],
-                           scenario.payload.attach_points, uav_offsets(scenario))
+    return hanging_payload(uavs, start_lengths(scenario), scenario.payload.attach_points,
+                           uav_offsets(scenario))
+
+
+def start_lengths(scenario: Scenario) -> np.ndarray:
+    """Each cable's length at the start [m]: l_i; an elastic one (cable_model: elastic)
+    stretched by T_i / k_i, T_i its share of the payload's weight hanging at rest (the statics
+    sum_i T_i e_i = m_p g e_z over the unit cables e_i, solved on the unstretched hang; the
+    stretch moves it by a share of k's compliance, second order)."""
+    lengths = np.array([u.cable_length for u in scenario.uavs], dtype=float)
+    if scenario.cable_model != 'elastic':
+        return lengths
+    weight = scenario.payload.mass * scenario.simulation.gravity
+    if scenario.n_uavs == 1:
+        tensions = np.array([weight])
+    else:
+        f = scenario.formation
+        uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position,
+                                 f.offsets, f.distance, f.half_angle)
+        uavs, payload = hanging_payload(uavs, lengths)
+        directions = (uavs - payload) / lengths[:, None]             # e_i, (n, 3)
+        tensions, *_ = np.linalg.lstsq(directions.T, [0.0, 0.0, weight], rcond=None)
+    return lengths + tensions / np.array([u.cable_stiffness for u in scenario.uavs])
 
 
 def uav_offsets(scenario: Scenario) -> np.ndarray | None:

@@ -100,7 +100,9 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         sensor_draws=sensors.draws,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
-        tolerances=np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance]),
+        # (elastic cables are no constraints: Algorithm 1's check of g does not apply)
+        tolerances=(np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance])
+                    if scenario.cable_model != 'elastic' else np.full(2, math.inf)),
         swing_every=swing_sampling(n), reach=cable_reach(scenario))
     memory = dict(
         state=state, taut=np.ones(n, dtype=bool), rotors=np.full(rotors, math.nan),

@@ -24,14 +24,14 @@ from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  
                                               attached_off_centre, cable_moment_arm,
                                               payload_force_per_mass, rotational_compliance,
                                               uav_attach_motion, uav_free_motion)
+from multilift_sim.physics.elastic_cables import elastic_solve
 from multilift_sim.physics.nullspace import nullspace_solve, project, translational_masses
 from multilift_sim.physics.attitude import normalize_quaternion
 from multilift_sim.physics.rigid_payload import rigid_residuals, rigid_solve
 from multilift_sim.physics.layout import (
     BODY_ATTITUDE, BODY_RATES, CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET,
-    CABLE_RHS, CABLE_THRUST,
-    FORMATION_BETA_SQ, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE,
-    FORMATION_PAYLOAD_MASS, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
+    CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_ELASTIC, FORMATION_GRAVITY,
+    FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
     FORMATION_TWO_ALPHA, POSITION, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
@@ -106,6 +106,9 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     quaternion rate and omega_dot [rad/s^2], then a rigid payload's), and the cable
     multipliers Lambda into multipliers (n,) [N/m] at state x (seed Eq. 2.60, 2.70), only the
     `taut` cables constrained. Rotor speeds enter as the held body wrenches."""
+    if formation[FORMATION_ELASTIC] != 0.0:  # elastic ropes, no constraint (elastic_cables)
+        elastic_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers)
+        return
     if formation[FORMATION_NULL_SPACE] != 0.0:  # the `nullspace` formulation (every cable taut)
         nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
         return

@@ -96,7 +96,9 @@ UAV_GYRO = 5                # (I_zz - I_yy)/I_xx, (I_xx - I_zz)/I_yy, (I_yy - I_
 UAV_DRAG = 8                # c_d [N s^2/m^2]: the UAV's quadratic drag in the wind; 0: none
 UAV_PAYLOAD_ATTACH = 9      # b_i [m]: where its cable holds a rigid payload, payload frame (3)
 UAV_ATTACH = 12             # a_i [m]: where its cable holds the UAV, body FLU; 0: its centre (3)
-UAV_COLUMNS = 15
+UAV_CABLE_STIFFNESS = 15    # k_i [N/m]: its cable's axial stiffness (`cable_model: elastic`)
+UAV_CABLE_DAMPING = 16      # c_i [N s/m]: its cable's axial damping (`cable_model: elastic`)
+UAV_COLUMNS = 17
 
 # -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
@@ -146,7 +148,9 @@ FORMATION_PROJECTION_STEPS = 13  # the null-space form's Newton steps onto g = 0
 FORMATION_PROJECTION_TOLERANCE = 14  # |g_i| / l_i^2 the projection accepts
 FORMATION_SUBSTEPS = 15      # RK4 sub-steps per physics step (>= 1; the formation's parts
 #                                 stepped at that multiple of the physics rate: stiff cables)
-FORMATION_SCALARS = 16
+FORMATION_ELASTIC = 16      # 1: the cables are elastic ropes (physics.elastic_cables: no
+#                             multipliers, each pulls k stretch + c stretch rate when taut)
+FORMATION_SCALARS = 17
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
 CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots; from the attach points)

@@ -19,7 +19,8 @@ class ScenarioError(ValueError):
     """A scenario that cannot be run; the message says where and why."""
 
 
-CABLE_MODELS = ('rigid', 'slack')  # the seed's two-way rod; pulls only (multilift_sim.slack)
+CABLE_MODELS = ('rigid', 'slack', 'elastic')  # the seed's two-way rod; pulls only
+#                 (multilift_sim.slack); a rope that stretches (physics.elastic_cables)
 # `control.payload_feedback.input_shaping` (issue 20, not in the seed): each velocity step of the
 # mission split into impulses (time in periods T of the payload's pendulum, share of the step);
 # zero residual swing of an undamped pendulum of period T: zv (Singer & Seering 1990), zvd
@@ -42,6 +43,7 @@ class SimulationConfig:
     constraint_rate_tolerance: float  # eps_gdot of Algorithm 1 [m^2/s]
     command_timeout: float           # wall time the simulator waits for a rotor command [s]
     integrator: str = 'baumgarte'    # 'baumgarte' (Eq. 2.59-2.70) or 'nullspace' (Eq. 2.71-2.72)
+    substeps: int = 1                # RK4 steps per physics step (stiff parts: elastic cables)
 
     @property
     def physics_steps_per_tick(self) -> int:
@@ -66,6 +68,8 @@ class UavConfig:
     yaw: float                       # initial yaw [rad]
     # where its cable holds it, body FLU [m] (issue 20; default its centre of mass)
     attach_point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    cable_stiffness: float = 0.0     # k_i [N/m] of an elastic cable (cable_model: elastic)
+    cable_damping: float = 0.0       # c_i [N s/m] of an elastic cable
 
 
 @dataclass(frozen=True)
@@ -218,6 +222,11 @@ class Scenario:
             payload_attach_points=self.payload.attach_points,
             uav_attach_points=(tuple(u.attach_point for u in self.uavs)
                                if any(any(u.attach_point) for u in self.uavs) else None),
+            cable_stiffness=(tuple(u.cable_stiffness for u in self.uavs)
+                             if self.cable_model == 'elastic' else None),
+            cable_damping=(tuple(u.cable_damping for u in self.uavs)
+                           if self.cable_model == 'elastic' else None),
+            substeps=sim.substeps,
         )
 
     def with_duration(self, duration: float) -> 'Scenario':

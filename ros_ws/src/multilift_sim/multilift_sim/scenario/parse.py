@@ -26,6 +26,7 @@ from multilift_sim.scenario.config import (CABLE_MODELS, FORMATION_GEOMETRIES,
                                            Scenario, ScenarioError, SensorConfig,
                                            SimulationConfig, UavConfig,
                                            flies_a_period, one_period_rule)
+from multilift_sim.scenario.cables import base_rope, check_rope_stepping, uav_rope
 from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_controllers,
                                                 leader_controllers)
 from multilift_sim.scenario.limits import check_limits
@@ -65,8 +66,11 @@ def scenario_of(data: Any, where: str) -> Scenario:
         constraint_tolerance=s.positive('constraint_tolerance'),
         constraint_rate_tolerance=s.positive('constraint_rate_tolerance'),
         command_timeout=s.positive('command_timeout', 5.0),
-        integrator=s.text('integrator', 'baumgarte', choices=tuple(FORMULATIONS)))
+        integrator=s.text('integrator', 'baumgarte', choices=tuple(FORMULATIONS)),
+        substeps=s.number('substeps', 1, lambda v: v >= 1 and v == int(v),
+                          'must be an integer >= 1'))
     s.done()
+    sim = dataclasses.replace(sim, substeps=int(sim.substeps))
 
     v = top.section('vehicle')
     base_vehicle = dataclasses.asdict(vehicle_params(v, None))
@@ -91,6 +95,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: uavs: {len(uav_list)} entries but formation.n is '
                             f'{n_formation}')
     default_cable = top.positive('cable_length') if top.has('cable_length') else ...
+    rope = base_rope(top, cable_model)  # elastic cables' keys (scenario.cables), else None
     uavs = []
     for i, entry in enumerate(uav_list):
         u = Section(entry, f'uavs[{i}]', where)
@@ -102,11 +107,13 @@ def scenario_of(data: Any, where: str) -> Scenario:
         if i > 0 and u.has('position'):
             raise u.fail('position', u.data['position'],
                          'is not allowed: follower positions come from the formation geometry')
-        uavs.append(UavConfig(vehicle=vehicle, cable_length=u.positive('cable_length',
-                                                                       default_cable),
+        length = u.positive('cable_length', default_cable)
+        stiffness, damping = uav_rope(u, length, rope)
+        uavs.append(UavConfig(vehicle=vehicle, cable_length=length,
                               position=u.vector('position', [0.0, 0.0, 0.0]),
                               yaw=u.number('yaw', 0.0),
-                              attach_point=u.vector('attach_point', [0.0, 0.0, 0.0])))
+                              attach_point=u.vector('attach_point', [0.0, 0.0, 0.0]),
+                              cable_stiffness=stiffness, cable_damping=damping))
         u.done()
 
     p = top.section('payload')
@@ -225,6 +232,13 @@ def scenario_of(data: Any, where: str) -> Scenario:
                                 f'{sim.integrator!r}')
     if rigid and len(uavs) < 2:
         raise ScenarioError(f'{where}: payload.type: rigid_body needs n >= 2 UAVs')
+    if cable_model == 'elastic':
+        if rigid or off_centre or sim.integrator != 'baumgarte':
+            raise ScenarioError(f'{where}: cable_model: elastic is for a point payload on cables '
+                                'from the UAVs\' centres, simulation.integrator: baumgarte')
+        check_rope_stepping(where, [u.cable_stiffness for u in uavs],
+                            [u.cable_damping for u in uavs], [u.vehicle.mass for u in uavs],
+                            payload.mass, sim.physics_rate, sim.substeps)
     if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
         raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
                             f'baumgarte, got {sim.integrator!r}')

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import Path
 from typing import Any
 
 from multilift_sim.wind import WIND_MODELS
@@ -17,7 +16,6 @@ from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
 from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_rigid_body_inertia,
                                          solid_inertia)
 from multilift_sim.events import EVENT_KINDS
-from multilift_sim.parts import PartsError, import_part, resolve_part
 from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
 from multilift_sim.scenario.config import (CABLE_MODELS, FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
@@ -30,6 +28,7 @@ from multilift_sim.scenario.cables import base_rope, check_rope_stepping, uav_ro
 from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_controllers,
                                                 leader_controllers)
 from multilift_sim.scenario.limits import check_limits
+from multilift_sim.scenario.part_files import scenario_parts
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
                                             vehicle_params)
@@ -37,7 +36,7 @@ from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inerti
 
 def scenario_of(data: Any, where: str) -> Scenario:
     top = Section(data, '', where)
-    parts = _parts(top)  # first: the rest may name what they register
+    parts = scenario_parts(top)  # first: the rest may name what they register
     name = top.text('name')
     description = top.text('description', '')
     top.text('frame', 'world', choices=('world',))
@@ -264,24 +263,6 @@ def _controller_keys(c: Section, leader: Any, follower: Any) -> dict[str, Any]:
                 if c.has(key):
                     raise c.fail(key, c.raw(key), f'is a key of control.{kind}: {other.NAME}')
     return dict(fields, values=tuple(values))
-
-
-def _parts(top: Section) -> tuple[str, ...]:
-    """`parts:` imported (multilift_sim.parts), as absolute paths: files relative to the
-    scenario file's folder (a scenario given as text: the working directory's)."""
-    source = Path(top.where)
-    base = source.parent if source.is_file() else Path.cwd()
-    paths = []
-    for entry in top.sequence('parts', []):
-        if not isinstance(entry, str):
-            raise top.fail('parts', entry, 'must be a list of Python file paths')
-        try:
-            path = resolve_part(entry, base)
-            import_part(path)
-        except PartsError as exc:
-            raise top.fail('parts', entry, str(exc)) from None
-        paths.append(str(path))
-    return tuple(paths)
 
 
 def _payload_feedback(c: Section, mode: str) -> dict[str, float]:

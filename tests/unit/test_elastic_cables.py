@@ -44,8 +44,9 @@ def test_a_hovering_rope_stretches_by_the_payload_s_weight():
 
 def test_a_falling_single_lift_oscillates_at_the_two_body_frequency():
     """Rotors all but off (1 rad/s: 7e-6 N) from the start: in free fall gravity drops out of
-    the relative motion, so the stretch x obeys x'' = -k (1/m + 1/m_p) x from x(0) = m_p g / k at rest (the static stretch
-    it starts at), x(t) = x(0) cos(omega t) until the rope goes slack at a quarter period."""
+    the relative motion, so the stretch x obeys x'' = -k (1/m + 1/m_p) x from x(0) = m_p g / k
+    at rest (the static stretch it starts at), x(t) = x(0) cos(omega t) until the rope goes
+    slack at a quarter period."""
     k = 200.0
     data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
     data.update(cable_model='elastic', cable={'stiffness': k})

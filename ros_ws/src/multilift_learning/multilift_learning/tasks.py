@@ -69,10 +69,17 @@ def scenario_of(source: str | Scenario, overrides: dict[str, Any] | None = None,
     return scenario if duration is None else scenario.with_duration(duration)
 
 
-def task_scenario(scenario: Scenario, task_name: str) -> Scenario:
-    """The scenario as `task_name` flies it: for hover, a leader with a mission hovers at its
-    start for the whole duration (one segment at rest); otherwise unchanged."""
-    if task(task_name).name != 'hover' or scenario.control.mode != 'cascade':
+def task_scenario(scenario: Scenario, task_name: str, start: str = 'rest') -> Scenario:
+    """The scenario as `task_name` flies it: its cables slack-capable (`cable_model: slack`:
+    a cable pulls, never pushes); with start 'rest' the payload hangs still at its rest place
+    (no release swing; multilift_learning.options.STARTS); for hover, a leader with a mission
+    hovers at its start for the whole duration (one segment at rest)."""
+    task(task_name)
+    scenario = replace(scenario, cable_model='slack')
+    if start == 'rest':
+        scenario = replace(scenario, payload=replace(scenario.payload, swing=0.0, alpha=0.0,
+                                                     beta=0.0))
+    if task_name != 'hover' or scenario.control.mode != 'cascade':
         return scenario
     hold = MissionSegment(velocity=(0.0, 0.0, 0.0), end_time=scenario.simulation.duration)
     return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))

@@ -74,8 +74,8 @@ def test_a_tilt_beyond_the_limit_and_leaving_the_bound_terminate_with_their_reas
     euler = env.unwrapped.batch.engine.measured()[0, 0, 6:8]
     assert terminated and info['termination'].startswith('tilt limit')
     assert np.cos(euler[0]) * np.cos(euler[1]) < np.cos(np.radians(30.0))
-    # 30 deg (0.52 rad): at most 1 rad/s, reached after about 0.4 s (the rotors' torque)
-    assert 0.5 < len(rewards) * 0.01 < 1.0
+    # 30 deg (0.52 rad) at 1 rad/s at most, slower: the torque left at hover thrust
+    assert 0.53 < len(rewards) * 0.01 < 3.0
     env = gymnasium.make('multilift/Hover-v0', duration=5.0, target_radius=0.5, bound=0.01)
     env.reset(seed=3)
     _, info, terminated, _ = _fly(env, lambda e: np.zeros(e.action_space.shape), 5)
@@ -215,7 +215,7 @@ def test_the_sb3_adapter_steps_as_sb3_s_own_dummy_vec_env():
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     from multilift_learning.sb3 import SB3VecEnv
-    kwargs = {'duration': 0.5, 'action_mode': 'thrust_body_rates', 'tilt_limit_deg': 5.0}
+    kwargs = {'duration': 1.0, 'action_mode': 'thrust_body_rates', 'tilt_limit_deg': 5.0}
     ours = SB3VecEnv.make('multilift/Hover-v0', 3, **kwargs)
     theirs = DummyVecEnv([lambda: gymnasium.make('multilift/Hover-v0', **kwargs)] * 3)
     ours.seed(5)
@@ -223,7 +223,7 @@ def test_the_sb3_adapter_steps_as_sb3_s_own_dummy_vec_env():
     assert np.array_equal(ours.reset(), theirs.reset())
     rng = np.random.default_rng(0)
     ends = {'terminated': 0, 'truncated': 0}
-    for _ in range(100):
+    for _ in range(200):
         actions = rng.uniform(-0.3, 0.3, (3, 8))
         actions[0, 1] = 1.0
         a, reward_a, done_a, info_a = ours.step(actions)

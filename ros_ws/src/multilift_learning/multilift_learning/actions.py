@@ -7,9 +7,14 @@ its share of the payload's (omega_hover), held over one control period. Two mode
   omega = omega_hover + a (omega_max - omega_hover) for a >= 0, omega_hover + a (omega_hover -
   omega_min) below, each vehicle's rotor_speed_min and rotor_speed_max [rad/s].
 - `thrust_body_rates`, (n * 4,): per UAV (thrust, roll rate, pitch rate, yaw rate): the
-  collective thrust T = T_hover + a (T_max - T_hover) for a >= 0, T_hover (1 + a) below [N]
-  (T_hover = the weight share, T_max = k_T rotors omega_max^2), body rates a body_rate_limit
+  collective thrust T = max(T_hover + a (T_max - T_hover), 0) [N] (T_hover = the weight
+  share, T_max = k_T rotors omega_max^2: symmetric about hover, so zero-mean exploration
+  keeps the mean thrust; the twin-lift's 28.4 +- 3.9 N), body rates a body_rate_limit
   [rad/s] (FLU), held by the attitude-rate loop inside (compiled, `laws.body_rates`).
+
+The rotor_speeds mode keeps every speed a vehicle can fly (the baseline's answers round-trip
+to the bit), so it is asymmetric about hover (the twin-lift's omega_hover = 1970 rad/s of
+0..2100): zero-mean noise on its actions lowers the mean thrust.
 """
 from __future__ import annotations
 

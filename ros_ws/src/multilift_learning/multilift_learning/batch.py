@@ -136,7 +136,9 @@ class FormationBatch:
                              self.speed_min, self.speed_max)
             return speeds, (speeds <= self.speed_min) | (speeds >= self.speed_max)
         a = np.clip(a.reshape(self.batch, self.n, 4), -1.0, 1.0)
-        thrust = centred(a[:, :, 0], self.thrust_hover, 0.0, self.thrust_max)
+        # symmetric about hover (zero-mean exploration keeps the mean thrust), at least 0
+        span = self.thrust_max - self.thrust_hover
+        thrust = np.maximum(self.thrust_hover + a[:, :, 0] * span, 0.0)
         rates = np.ascontiguousarray(a[:, :, 1:] * self.options.body_rate_limit)
         speeds = np.empty((self.batch, self.n, self.rotors))
         saturated = np.empty(speeds.shape, dtype=bool)

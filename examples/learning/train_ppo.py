@@ -8,7 +8,8 @@ Writes DIR/policy.npz (`multilift_learning.policies.load`: layers, activation, t
 normalisation of SB3's VecNormalize), DIR/progress.csv (the learning curve: environment steps,
 wall time [s], steps per second, mean episode return and length of the last 100 episodes),
 DIR/evaluation.json (`evaluate`: the exported policy and the baseline on the same held-out
-episodes). The environments are one `FormationVectorEnv` (SAME_STEP autoreset) behind
+episodes). `--minutes M` stops learning after M minutes of wall time (the steps reached are
+recorded in policy.npz). The environments are one `FormationVectorEnv` (SAME_STEP autoreset) behind
 `multilift_learning.sb3.SB3VecEnv`; one torch thread.
 """
 from __future__ import annotations
@@ -54,12 +55,12 @@ def train(args: argparse.Namespace) -> MlpPolicy:
                           **arguments['options'])
     venv.seed(args.seed * 1000)
     venv = VecNormalize(VecMonitor(venv), norm_obs=True, norm_reward=True, clip_obs=10.0,
-                        gamma=0.99)
+                        gamma=args.gamma)
     model = PPO('MlpPolicy', venv, seed=args.seed, device='cpu', n_steps=args.rollout,
-                batch_size=args.batch, n_epochs=5, learning_rate=3e-4, gamma=0.99,
-                gae_lambda=0.95, clip_range=0.2, ent_coef=0.0,
+                batch_size=args.batch, n_epochs=args.epochs, learning_rate=3e-4,
+                gamma=args.gamma, gae_lambda=args.gae_lambda, clip_range=0.2, ent_coef=0.0,
                 policy_kwargs={'net_arch': [64, 64], 'activation_fn': torch.nn.Tanh,
-                               'log_std_init': -1.0}, verbose=0)
+                               'log_std_init': args.log_std}, verbose=0)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
@@ -70,8 +71,8 @@ def train(args: argparse.Namespace) -> MlpPolicy:
             super().__init__()
             self.writer = writer
 
-        def _on_step(self) -> bool:
-            return True
+        def _on_step(self) -> bool:  # False: out of --minutes, learning stops here
+            return args.minutes is None or time.perf_counter() - start < 60 * args.minutes
 
         def _on_rollout_end(self) -> None:
             episodes = list(self.model.ep_info_buffer)
@@ -87,6 +88,7 @@ def train(args: argparse.Namespace) -> MlpPolicy:
         writer = csv.writer(handle)
         writer.writerow(['steps', 'wall_s', 'steps_per_s', 'return_mean', 'length_mean'])
         model.learn(total_timesteps=args.steps, callback=Curve(writer))
+    args.steps = model.num_timesteps  # fewer where --minutes ran out
     return exported(model, venv, args, arguments)
 
 
@@ -141,8 +143,16 @@ def main() -> None:
     parser.add_argument('--action-mode', default='thrust_body_rates')
     parser.add_argument('--envs', type=int, default=32, help='environments in the batch')
     parser.add_argument('--rollout', type=int, default=256, help='steps per env per update')
-    parser.add_argument('--batch', type=int, default=1024, help='PPO minibatch')
+    parser.add_argument('--batch', type=int, default=512, help='PPO minibatch')
+    parser.add_argument('--epochs', type=int, default=10, help='PPO epochs per update')
+    parser.add_argument('--gamma', type=float, default=0.998,
+                        help='discount per tick (100 Hz: 0.998 looks 5 s ahead)')
+    parser.add_argument('--gae-lambda', type=float, default=0.98)
+    parser.add_argument('--log-std', type=float, default=-2.0,
+                        help='initial log standard deviation of the actions (-2: 0.14)')
     parser.add_argument('--eval-episodes', type=int, default=50)
+    parser.add_argument('--minutes', type=float, default=None,
+                        help='stop learning after this wall time (then export, evaluate)')
     args = parser.parse_args()
     if args.steps <= 0:
         parser.error(f'--steps must be > 0, got {args.steps}')

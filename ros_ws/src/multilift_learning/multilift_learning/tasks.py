@@ -85,6 +85,25 @@ def task_scenario(scenario: Scenario, task_name: str, start: str = 'rest') -> Sc
     return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))
 
 
+def task_scenario_yaml(source: str, task_name: str, start: str = 'rest',
+                       duration: float | None = None) -> str:
+    """The YAML of scenario `source` (a name or path) as `task_name` flies it (`task_scenario`,
+    with `duration` [s]): a file `multilift run` flies, so a policy trained on the task flies
+    the same physics through ROS (`policy_node`)."""
+    path, data = load_base(source)
+    scenario = task_scenario(scenario_of(source, duration=duration), task_name, start)
+    data = dict(data, cable_model='slack')
+    data['simulation'] = dict(data['simulation'], duration=scenario.simulation.duration)
+    if start == 'rest':
+        data['payload'] = {k: v for k, v in data['payload'].items()
+                           if k not in ('swing_deg', 'alpha_deg', 'beta_deg')}
+    if task_name == 'hover' and scenario.control.mode == 'cascade':
+        data['mission'] = dict(data['mission'], segments=[
+            {'velocity': [0.0, 0.0, 0.0], 'until': scenario.simulation.duration}])
+    header = f'# {path} as the learning task {task_name!r} flies it (multilift_learning.tasks)\n'
+    return header + yaml.safe_dump(data, sort_keys=False)
+
+
 class Targets:
     """The payload's target of B formations of one engine (`engine.arrays`) under `task`:
     `position(t)`, `velocity(t)` (B, 3) at each formation's time t (B,) [s]; `reset(which,

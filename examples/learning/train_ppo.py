@@ -31,7 +31,7 @@ import numpy as np  # noqa: E402
 import multilift_learning  # noqa: E402,F401 - registers the environments
 from multilift_learning.policies import MlpPolicy, save  # noqa: E402
 
-EVALUATION_SEED = 1_000_000  # held-out: training draws from seeds 0..999
+EVALUATION_SEED = 1_000_000  # held out: training seeds its streams with 1000 seed + k, k < envs
 
 
 def env_arguments(args: argparse.Namespace) -> dict:

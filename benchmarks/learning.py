@@ -3,9 +3,10 @@
 >= 50,000), random actions; and the same with the baseline policy's actions (the seed's
 controllers computed in the same compiled call per step). CPU time is printed beside wall
 time (on a busy machine the CPU figure is the fairer one). Then the baseline's return over
-whole episodes of each task, twin-lift and V.
+whole episodes of each task, twin-lift and V, and what a tick pays the baseline, hovering
+(action 0) and random actions (`reference_rewards`).
 
-    python benchmarks/learning.py [--envs 256] [--steps 2000]
+    python benchmarks/learning.py [--envs 256] [--steps 2000] [--rewards-only]
 """
 from __future__ import annotations
 
@@ -38,18 +39,50 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--envs', type=int, default=256)
     parser.add_argument('--steps', type=int, default=2000)
+    parser.add_argument('--rewards-only', action='store_true',
+                        help='only the per-tick rewards of the reference policies')
     args = parser.parse_args()
+    if args.rewards_only:
+        reference_rewards()
+        return
     envs = gymnasium.make_vec('multilift/Hover-v0', num_envs=args.envs)
     rng = np.random.default_rng(0)
-    hover = envs.batch.actions(np.broadcast_to(envs.batch.speed_hover,
-                                               (args.envs, envs.batch.n, envs.batch.rotors)))
-    for name, policy in (('random actions near hover',
-                          lambda: np.clip(hover + rng.normal(0, 0.02, hover.shape), -1, 1)),
+    for name, policy in (('random actions near hover (0.02 about action 0)',
+                          lambda: np.clip(rng.normal(0, 0.02, (args.envs, 8)), -1, 1)),
                          ('baseline policy (expert_actions)', envs.expert_actions)):
         wall, cpu = throughput(envs, args.steps, policy)
         print(f'Hover-v0 twin_lift, {args.envs} envs, {name}: {wall:,.0f} env steps/s wall, '
               f'{cpu:,.0f} per CPU s (target >= 50,000)')
     baseline_returns()
+    reference_rewards()
+
+
+def reference_rewards(episodes: int = 64, duration: float = 20.0) -> None:
+    """Twin-lift Hover-v0, `episodes` episodes of `duration` [s] (seeds 0..): the mean reward
+    per tick, the mean episode length and the share flown to the end, for the baseline, action
+    0 (hover) and uniform random actions, in each action mode."""
+    rng = np.random.default_rng(0)
+    for mode in ('rotor_speeds', 'thrust_body_rates'):
+        envs = gymnasium.make_vec('multilift/Hover-v0', num_envs=episodes, duration=duration,
+                                  action_mode=mode)
+        size = envs.single_action_space.shape[0]
+        policies = {'action 0 (hover)': lambda: np.zeros((episodes, size)),
+                    'uniform random actions': lambda: rng.uniform(-1, 1, (episodes, size))}
+        if mode == 'rotor_speeds':
+            policies = {'baseline (expert_actions)': envs.expert_actions, **policies}
+        for name, policy in policies.items():
+            envs.reset(seed=0)
+            alive = np.ones(episodes, dtype=bool)
+            total, ticks = np.zeros(episodes), np.zeros(episodes)
+            while alive.any():
+                _, reward, terminated, truncated, _ = envs.step(policy())
+                total += np.where(alive, reward, 0.0)
+                ticks += alive
+                alive &= ~(terminated | truncated)
+            flown = np.mean(ticks == round(duration * 100))
+            print(f'Hover-v0 twin_lift {mode}, {name}: {total.sum() / ticks.sum():.3f} per tick, '
+                  f'episodes of {ticks.mean() / 100:.2f} s on average, {flown:.0%} flown to '
+                  f'the end of {duration:g} s')
 
 
 def baseline_returns() -> None:

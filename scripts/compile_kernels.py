@@ -7,7 +7,7 @@ machine's two cores (a kernel one stage compiled is loaded from the cache by the
 - `laws`: every controller's compiled laws as the controller nodes call them (the runtimes);
 - `engine`: the engine's tick over B formations (`run --headless`, sweeps), after the two;
 - `learning`: the engine's calls the learning environments make (answers, commanded ticks,
-  references, attitude commands), after the first two;
+  references, attitude commands, their own attitude-rate loop), after the first two;
 - `rest`: the simulator's messages and a run of every kind, tick by tick (mostly loads).
 
 Run by scripts/setup with the workspace's environment (scripts/env.sh), MULTILIFT_KERNEL=jit.
@@ -80,6 +80,9 @@ def learning() -> None:
         envs = FormationVectorEnv(2, short, task)
         envs.reset(seed=0)
         envs.step(envs.expert_actions())
+    rates = FormationVectorEnv(2, short, 'hover', action_mode='thrust_body_rates')
+    rates.reset(seed=0)
+    rates.step(rates.action_space.sample() * 0.0)  # the attitude-rate loop (laws.body_rates)
     engine = Engine(short)
     engine.attitude_speeds(engine.measured()[:, :, :3] * 0.0, engine.measured()[:, :, 0] * 0.0)
 

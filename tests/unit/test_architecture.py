@@ -41,6 +41,7 @@ THIRD_PARTY = {
     'numba': 'python3-numba',
     'zstandard': 'python3-zstandard', 'tqdm': 'python3-tqdm', 'lark': 'python3-lark',
     'gymnasium': 'python3-gymnasium', 'pettingzoo': 'python3-pettingzoo',
+    'stable_baselines3': 'python3-stable-baselines3',
 }
 # ROS packages imported by their own name that are the ROS runtime (not messages)
 ROS_RUNTIME = frozenset({'rclpy', 'rosidl_runtime_py', 'rpyutils', 'rosbag2_py'})

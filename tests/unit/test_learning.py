@@ -33,6 +33,7 @@ def test_registered_on_import_and_gymnasium_s_checker_passes(env_id):
     check_env(env.unwrapped, skip_render_check=True)
     observation, info = env.reset(seed=0)
     assert observation.shape == (len(observation_names(2)),) == (38,)
+    assert observation.dtype == np.float32
     assert env.action_space.shape == (8,) and info['t'] == 0.0
 
 
@@ -157,7 +158,8 @@ def test_an_episode_recorded_is_the_run_s_bag_and_plots(tmp_path, capsys):
         _, _, terminated, truncated, _ = env.step(env.unwrapped.expert_action())
         done = terminated or truncated
     [bag] = env.bags
-    record_headless(scenario_io.load('twin_lift').with_duration(1.0), tmp_path / 'headless')
+    record_headless(task_scenario(scenario_io.load('twin_lift').with_duration(1.0), 'mission'),
+                    tmp_path / 'headless')
     episode, headless = load_run(bag), load_run(tmp_path / 'headless')
     assert np.array_equal(episode.t, headless.t) and len(episode.t) == 101
     assert np.abs(episode.uav_positions() - headless.uav_positions()).max() < 1e-9
@@ -189,7 +191,7 @@ def test_attitude_actions_are_the_controllers_inner_half():
     env = AttitudeActions(gymnasium.make('multilift/Mission-v0', duration=2.0))
     env.reset(seed=0)
     assert env.action_space.shape == (8,)
-    own = Engine(scenario_io.load('twin_lift').with_duration(2.0))
+    own = Engine(task_scenario(scenario_io.load('twin_lift').with_duration(2.0), 'mission'))
     record = own.new_record(1)
     done = False
     while not done:

@@ -2,31 +2,22 @@
 observations, rewards and episode ends out, every array with the batch axis first. The one
 place that defines them (`FormationEnv` is B = 1, `FormationVectorEnv` B = num_envs).
 
-Action, per formation: every rotor's speed, normalised, flat (n * rotors,) in [-1, 1]:
-omega = omega_min + (a + 1) / 2 (omega_max - omega_min) with each vehicle's rotor_speed_min
-and rotor_speed_max [rad/s], UAV by UAV (uav1's rotors first); held over one control period.
+Actions: `multilift_learning.actions` (0 = hover; rotor speeds, or collective thrust and body
+rates). Observations: `multilift_learning.observations` (float32, their scales).
 
-Observation, per formation, flat (OBSERVATION_PER_UAV n + OBSERVATION_PAYLOAD,), world frame z
-up, SI units; for each UAV i (uav1 first, `observation_names` names every slot):
-- position error [m]: its position less the payload's target plus its start offset from the
-  payload's rest place (where it would be, the formation kept, with the payload on target);
-- velocity less the target's [m/s];
-- roll, pitch, yaw [rad]; body rates [rad/s] (FLU);
-- cable direction, the unit vector from the payload to the UAV;
-- cable tension of the last tick over its static share m_p g / n (0 before the first tick);
-then the payload's position error [m] and velocity error [m/s].
-
-Reward, per tick: ALIVE - sum of weight * term (REWARD_WEIGHTS):
+Reward, per tick, in [0, 1]: exp(-cost), cost = sum of weight * term (REWARD_WEIGHTS):
 - tracking: |payload position error| [m];
 - swing: |horizontal payload velocity error| [m/s];
-- effort: mean over rotors of ((omega - omega_hover) / omega_max)^2, omega_hover the speed at
-  which a UAV's rotors carry its weight and its share of the payload's;
-- health: max over cables of |g_i| / constraint_tolerance (the seed's Eq. 2.59 residual).
+- effort: mean over rotors of ((omega - omega_hover) / omega_max)^2;
+- health: max over taut cables of |g_i| / constraint_tolerance (the seed's Eq. 2.59 residual);
+and 0 at a step that terminates the episode. Every tick pays at least 0, so ending an episode
+early never pays more than flying on.
 
-An episode terminates when Algorithm 1 stops the formation (non-finite state, |g| or |g_dot|
-beyond tolerance) or a UAV rolls or pitches past 90 deg (a crash: the world has no ground, its
-origin is the leader's start, docs/conventions.md); it is truncated at the scenario's
-duration.
+An episode terminates (`TERMINATIONS`, the reason in `info['termination']`) when Algorithm 1
+stops the formation (a physical failure: non-finite state, |g| or |g_dot| beyond tolerance),
+a UAV tilts beyond the tilt limit, a UAV or the payload is below the ground, or the payload
+leaves the bound about its target (multilift_learning.options); it is truncated at the
+episode's duration.
 """
 from __future__ import annotations
 
@@ -36,106 +27,140 @@ from multilift_control import laws
 from multilift_control.engine import Engine
 from multilift_control.laws.layout import (UAV_BODY_RATES, UAV_EULER, UAV_POSITION,
                                            UAV_VELOCITY)
+from multilift_learning.actions import centred, uncentred
+from multilift_learning.laws import body_rates
+from multilift_learning.observations import (finished_observation, observation_names,
+                                             observation_scales)
+from multilift_learning.options import GROUND_BELOW_REST, TaskOptions
 from multilift_learning.tasks import Targets, task, task_scenario
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario
 from multilift_sim.start import cable_reach
 from multilift_sim.statistics.swing import equilibrium_point
 
-OBSERVATION_PER_UAV = 16
-OBSERVATION_PAYLOAD = 6
-ALIVE = 1.0
 REWARD_WEIGHTS = {'tracking': 1.0, 'swing': 0.5, 'effort': 0.1, 'health': 1.0}
+# why an episode terminated, in the order they are checked (info['termination'])
+TERMINATIONS = ('physical failure', 'tilt limit', 'ground contact', 'bound')
 
-
-def observation_names(n: int) -> list[str]:
-    """The name of every observation slot of a formation of n UAVs."""
-    names = []
-    for i in range(1, n + 1):
-        names += [f'uav{i}.position_error.{a}' for a in 'xyz']
-        names += [f'uav{i}.velocity_error.{a}' for a in 'xyz']
-        names += [f'uav{i}.{a}' for a in ('roll', 'pitch', 'yaw')]
-        names += [f'uav{i}.body_rate.{a}' for a in 'xyz']
-        names += [f'uav{i}.cable_direction.{a}' for a in 'xyz']
-        names += [f'uav{i}.tension_ratio']
-    names += [f'payload.position_error.{a}' for a in 'xyz']
-    names += [f'payload.velocity_error.{a}' for a in 'xyz']
-    return names
+__all__ = ['FormationBatch', 'REWARD_WEIGHTS', 'TERMINATIONS', 'observation_names']
 
 
 class FormationBatch:
-    """B formations (`scenarios`, of the same shape) of task `task_name` on one Engine."""
+    """B formations (`scenarios`, of the same shape) of task `task_name` on one Engine, with
+    `options` (multilift_learning.options.TaskOptions; their duration already applied to the
+    scenarios)."""
 
-    def __init__(self, scenarios: list[Scenario], task_name: str, target_radius: float = 0.5):
+    def __init__(self, scenarios: list[Scenario], task_name: str,
+                 options: TaskOptions | None = None):
+        options = TaskOptions() if options is None else options
+        self.options = options
         kind = task(task_name)
         if kind.needs_mission and any(s.control.mode != 'cascade' for s in scenarios):
             raise ValueError(f'task {task_name!r} needs a scenario whose leader flies its '
                              'mission (control.mode: cascade)')
-        scenarios = [task_scenario(s, task_name) for s in scenarios]
+        scenarios = [task_scenario(s, task_name, options.start) for s in scenarios]
         self.scenarios = scenarios
         self.engine = Engine(scenarios)
         self.batch = self.engine.batch
-        self.n = self.engine.n_uavs
+        self.n = n = self.engine.n_uavs
         self.rotors = self.engine.arrays.allocation.shape[-1]
-        n = self.n
+        self.layout = StateLayout(n)
         limits = np.array([[(u.vehicle.rotor_speed_min, u.vehicle.rotor_speed_max)
                             for u in s.uavs] for s in scenarios])        # (B, n, 2)
         self.speed_min = limits[:, :, :1]                                # (B, n, 1)
-        self.speed_span = limits[:, :, 1:] - limits[:, :, :1]
         self.speed_max = limits[:, :, 1:]
         weight_share = np.array([[(u.vehicle.mass + s.payload.mass / n) * s.simulation.gravity
                                   for u in s.uavs] for s in scenarios])  # (B, n) [N]
         k_t = np.array([[u.vehicle.thrust_coefficient for u in s.uavs] for s in scenarios])
         self.speed_hover = np.sqrt(weight_share / (self.rotors * k_t))[:, :, None]
+        self.thrust_hover = weight_share                                 # (B, n) [N]
+        self.thrust_max = k_t * self.rotors * limits[:, :, 1] ** 2       # (B, n) [N]
         self.tension_share = np.array([s.payload.mass * s.simulation.gravity / n
                                        for s in scenarios])[:, None]     # (B, 1) [N]
         self.tolerance = np.array([s.simulation.constraint_tolerance for s in scenarios])
-        # the payload's rest place under the UAVs' start (not its start: a scenario may
-        # release it swinging), and each UAV's offset from it (B, n, 3) [m]
+        # the payload's rest place under the UAVs' start, and each UAV's offset from it
+        # (B, n, 3) [m]
         rest_place = laws.runnable(equilibrium_point)
         rest = np.array([rest_place(self.engine.positions[b], cable_reach(s))
                          for b, s in enumerate(scenarios)])
         self.start_offsets = self.engine.positions.copy() - rest[:, None, :]
+        self.ground = (rest[:, 2] - GROUND_BELOW_REST if options.ground_height is None
+                       else np.full(self.batch, float(options.ground_height)))   # (B,) [m]
         self.targets = Targets(task_name, self.engine, rest, self.start_offsets,
-                               target_radius)
+                               options.target_radius)
+        self.scales = observation_scales(n) if options.normalise else None
         self.tension = np.zeros((self.batch, n))
         self.rngs = [np.random.default_rng() for _ in range(self.batch)]
         self._expert_at: np.ndarray | None = None
         self._expert = np.zeros((self.batch, n * self.rotors))
+        self._rate_commands = laws.runnable(body_rates.body_rate_commands)
+
+    @property
+    def action_size(self) -> int:
+        """The length of one formation's action."""
+        return self.n * (self.rotors if self.options.action_mode == 'rotor_speeds' else 4)
 
     # -------------------------------------------------------------------------- episodes
     def seed(self, seeds: list[int | None]) -> None:
         self.rngs = [np.random.default_rng(s) for s in seeds]
 
     def reset(self, which: np.ndarray | None = None) -> None:
-        """The formations in `which` (all by default) back to their start, new targets."""
+        """The formations in `which` (all by default) back to their start, new targets; with
+        start_speed, every body of each given one common velocity (its own generator)."""
         which = np.ones(self.batch, dtype=bool) if which is None else which
         self.engine.reset(which)
         self.targets.reset(which, self.rngs)
+        if self.options.start_speed > 0:
+            state = self.engine.state
+            for b in np.flatnonzero(which):
+                direction = self.rngs[b].normal(size=3)
+                speed = self.options.start_speed * self.rngs[b].uniform() ** (1 / 3)
+                velocity = speed * direction / np.linalg.norm(direction)
+                self.layout.uav_velocities(state[b])[:] += velocity
+                self.layout.payload_velocity(state[b])[:] += velocity
         self.tension[which] = 0.0
         self._expert_at = None
 
-    def speeds(self, actions: np.ndarray) -> np.ndarray:
-        """Normalised actions (B, n * rotors) in [-1, 1] (clipped) -> rotor speeds (B, n,
-        rotors) [rad/s]."""
-        a = np.clip(np.asarray(actions, dtype=float).reshape(self.batch, self.n, self.rotors),
-                    -1.0, 1.0)
-        return self.speed_min + (a + 1.0) * 0.5 * self.speed_span
-
-    def at_limits(self, speeds: np.ndarray) -> np.ndarray:
-        """Which rotor speeds (B, n, rotors) [rad/s] sit at a vehicle limit (saturated)."""
-        return (speeds <= self.speed_min) | (speeds >= self.speed_max)
+    def speeds(self, actions: np.ndarray,
+               states: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Actions (B, action_size) in [-1, 1] (clipped) -> rotor speeds (B, n, rotors)
+        [rad/s] and which sit at a vehicle limit (saturated), in this batch's action mode; the
+        rate loop of thrust_body_rates at the measured `states` (B, n, UAV_STATE_SIZE), the
+        engine's own by default."""
+        a = np.asarray(actions, dtype=float)
+        if a.shape != (self.batch, self.action_size):
+            raise ValueError(f'actions must be ({self.batch}, {self.action_size}) in '
+                             f'action_mode {self.options.action_mode!r}, got {a.shape}')
+        if self.options.action_mode == 'rotor_speeds':
+            speeds = centred(a.reshape(self.batch, self.n, self.rotors), self.speed_hover,
+                             self.speed_min, self.speed_max)
+            return speeds, (speeds <= self.speed_min) | (speeds >= self.speed_max)
+        a = np.clip(a.reshape(self.batch, self.n, 4), -1.0, 1.0)
+        # symmetric about hover (zero-mean exploration keeps the mean thrust), at least 0
+        span = self.thrust_max - self.thrust_hover
+        thrust = np.maximum(self.thrust_hover + a[:, :, 0] * span, 0.0)
+        rates = np.ascontiguousarray(a[:, :, 1:] * self.options.body_rate_limit)
+        speeds = np.empty((self.batch, self.n, self.rotors))
+        saturated = np.empty(speeds.shape, dtype=bool)
+        self._rate_commands(self.engine.arrays.cascade, self.engine.memory.mixers,
+                            self.engine.measured() if states is None
+                            else np.ascontiguousarray(states, dtype=float),
+                            rates, thrust, speeds, saturated)
+        return speeds, saturated
 
     def actions(self, speeds: np.ndarray) -> np.ndarray:
-        """Rotor speeds (B, n, rotors) [rad/s] -> normalised actions (B, n * rotors)."""
-        a = 2.0 * (speeds - self.speed_min) / self.speed_span - 1.0
+        """Rotor speeds (B, n, rotors) [rad/s] -> `rotor_speeds` actions (B, n * rotors)."""
+        a = uncentred(speeds, self.speed_hover, self.speed_min, self.speed_max)
         return a.reshape(self.batch, self.n * self.rotors)
 
     def expert_actions(self) -> np.ndarray:
         """The scenario's own controllers' answer (seed Ch. 3: the leader's cascade, the
-        followers' virtual-constraint law) at each formation's current tick, as actions. The
-        controllers' memories advance once per tick: asked again before the next step, the
-        same actions come back."""
+        followers' virtual-constraint law) at each formation's current tick, as rotor_speeds
+        actions. The controllers' memories advance once per tick: asked again before the next
+        step, the same actions come back."""
+        if self.options.action_mode != 'rotor_speeds':
+            raise ValueError('the baseline answers in rotor speeds: action_mode '
+                             f'{self.options.action_mode!r} has no expert action')
         tick = self.engine.memory.tick
         if self._expert_at is None or not np.array_equal(self._expert_at, tick):
             speeds, _ = self.engine.answer()
@@ -143,22 +168,25 @@ class FormationBatch:
             self._expert_at = tick.copy()
         return self._expert.copy()
 
-    def step(self, actions: np.ndarray, which: np.ndarray | None = None) -> None:
-        """One control tick of every running formation (those in `which`) under `actions`."""
-        speeds = self.speeds(actions)
-        tension = self.engine.step_commanded(speeds, self.at_limits(speeds), which)
+    def step(self, actions: np.ndarray, which: np.ndarray | None = None) -> np.ndarray:
+        """One control tick of every running formation (those in `which`) under `actions`;
+        returns the rotor speeds commanded (B, n, rotors) [rad/s]."""
+        speeds, saturated = self.speeds(actions)
+        tension = self.engine.step_commanded(speeds, saturated, which)
         if which is None:
             self.tension[:] = tension
         else:
             self.tension[which] = tension[which]
+        return speeds
 
     # ----------------------------------------------------------------------- what they see
     def observe(self) -> tuple[np.ndarray, dict]:
-        """Observations (B, OBSERVATION_PER_UAV n + OBSERVATION_PAYLOAD) of the engine's
-        formations, and the pieces the reward uses."""
-        state, layout = self.engine.state, StateLayout(self.n)
-        return self.observation_of(self.engine.measured(), layout.payload_position(state),
-                                   layout.payload_velocity(state), self.tension, self.engine.t)
+        """Observations (B, size) float32 of the engine's formations, and the pieces the
+        reward and the ends use (float64)."""
+        state = self.engine.state
+        return self.observation_of(self.engine.measured(), self.layout.payload_position(state),
+                                   self.layout.payload_velocity(state), self.tension,
+                                   self.engine.t)
 
     def observation_of(self, measured: np.ndarray, payload: np.ndarray,
                        payload_velocity: np.ndarray, tension: np.ndarray,
@@ -179,28 +207,52 @@ class FormationBatch:
             (tension / self.tension_share)[:, :, None]], axis=2)
         position_error = payload - target
         velocity_error = payload_velocity - target_velocity
-        observation = np.concatenate([per_uav.reshape(self.batch, -1), position_error,
-                                      velocity_error], axis=1)
-        return observation, {'position_error': position_error, 'velocity_error': velocity_error,
-                             'measured': measured, 'payload': payload}
+        raw = np.concatenate([per_uav.reshape(self.batch, -1), position_error, velocity_error],
+                             axis=1)
+        return finished_observation(raw, self.scales), {
+            'position_error': position_error, 'velocity_error': velocity_error,
+            'measured': measured.copy(), 'payload': payload.copy()}
 
-    def reward(self, seen: dict, actions: np.ndarray) -> tuple[np.ndarray, dict]:
-        """Each formation's reward (B,) and its terms {name: (B,)} (REWARD_WEIGHTS)."""
-        speeds = self.speeds(actions)
+    def reward(self, seen: dict, speeds: np.ndarray,
+               terminated: np.ndarray) -> tuple[np.ndarray, dict]:
+        """Each formation's reward (B,) in [0, 1] for a tick flown at rotor `speeds` (B, n,
+        rotors) [rad/s], 0 where it `terminated`, and its terms {name: (B,)}."""
+        g = np.where(self.engine.memory.taut, np.abs(self.engine.memory.g), 0.0)
         terms = {
             'tracking': np.linalg.norm(seen['position_error'], axis=1),
             'swing': np.linalg.norm(seen['velocity_error'][:, :2], axis=1),
             'effort': np.mean(((speeds - self.speed_hover) / self.speed_max) ** 2,
                               axis=(1, 2)),
-            'health': np.abs(self.engine.memory.g).max(axis=1) / self.tolerance,
+            'health': g.max(axis=1) / self.tolerance,
         }
-        reward = ALIVE - sum(REWARD_WEIGHTS[name] * value for name, value in terms.items())
+        cost = sum(REWARD_WEIGHTS[name] * value for name, value in terms.items())
+        reward = np.where(terminated | ~np.isfinite(cost), 0.0, np.exp(-cost))
         return reward, terms
 
-    def ends(self, seen: dict) -> tuple[np.ndarray, np.ndarray]:
-        """(terminated, truncated) (B,) bool each."""
-        tilt = seen['measured'][:, :, UAV_EULER:UAV_EULER + 2]
-        crashed = (np.abs(tilt) > np.pi / 2).any(axis=(1, 2))
-        terminated = self.engine.stopped | crashed
+    def ends(self, seen: dict) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """(terminated, truncated) (B,) bool each, and each formation's reason for
+        terminating ('' where it did not: TERMINATIONS, a physical failure with Algorithm 1's
+        words)."""
+        measured = seen['measured']
+        roll, pitch = measured[:, :, UAV_EULER], measured[:, :, UAV_EULER + 1]
+        with np.errstate(invalid='ignore'):
+            tilted = (np.cos(roll) * np.cos(pitch) < np.cos(self.options.tilt_limit)).any(axis=1)
+            lowest = np.minimum(measured[:, :, UAV_POSITION + 2].min(axis=1),
+                                seen['payload'][:, 2])
+            grounded = lowest < self.ground
+            away = np.linalg.norm(seen['position_error'], axis=1) > self.options.bound
+        stopped = self.engine.stopped
+        ended = stopped | tilted | grounded | away
+        reasons = [''] * self.batch
+        for b in np.flatnonzero(ended):
+            if stopped[b]:
+                reasons[b] = f'physical failure: {self.engine.stop_reason(b)}'
+            elif tilted[b]:
+                reasons[b] = f'tilt limit: a UAV tilted beyond {self.options.tilt_limit_deg} deg'
+            elif grounded[b]:
+                reasons[b] = f'ground contact: below z = {self.ground[b]:.2f} m'
+            else:
+                reasons[b] = f'bound: the payload beyond {self.options.bound} m of its target'
+        terminated = ended
         truncated = self.engine.finished & ~terminated
-        return terminated, truncated
+        return terminated, truncated, reasons

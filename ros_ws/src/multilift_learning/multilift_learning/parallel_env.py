@@ -15,23 +15,22 @@ import gymnasium
 import numpy as np
 from pettingzoo import ParallelEnv
 
-from multilift_learning.batch import (OBSERVATION_PAYLOAD, OBSERVATION_PER_UAV,
-                                      FormationBatch, observation_names)
-from multilift_learning.tasks import scenario_of
+from multilift_learning.batch import observation_names
+from multilift_learning.env import formation_batch, spaces
+from multilift_learning.observations import OBSERVATION_PAYLOAD, OBSERVATION_PER_UAV
 from multilift_sim.scenario import Scenario
 
 
 class FormationParallelEnv(ParallelEnv):
-    """`FormationEnv`'s formation with an agent per UAV (same arguments)."""
+    """`FormationEnv`'s formation with an agent per UAV (same arguments; action_mode
+    rotor_speeds: each agent its rotors, thrust_body_rates: its thrust and body rates)."""
 
     metadata = {'name': 'multilift_formation_v0', 'render_modes': []}
 
     def __init__(self, scenario: str | Scenario = 'twin_lift', task: str = 'hover',
-                 overrides: dict[str, Any] | None = None, duration: float | None = None,
-                 target_radius: float = 0.5):
-        self.batch = FormationBatch([scenario_of(scenario, overrides, duration)], task,
-                                    target_radius)
-        n, rotors = self.batch.n, self.batch.rotors
+                 overrides: dict[str, Any] | None = None, **options):
+        self.batch = formation_batch([scenario], task, overrides, options)
+        n = self.batch.n
         self.possible_agents = [f'uav{i}' for i in range(1, n + 1)]
         self.agents: list[str] = []
         names = observation_names(n)
@@ -40,8 +39,12 @@ class FormationParallelEnv(ParallelEnv):
             agent: names[k * OBSERVATION_PER_UAV:(k + 1) * OBSERVATION_PER_UAV] + payload
             for k, agent in enumerate(self.possible_agents)}
         size = OBSERVATION_PER_UAV + OBSERVATION_PAYLOAD
-        self._observation_space = gymnasium.spaces.Box(-np.inf, np.inf, (size,), np.float64)
-        self._action_space = gymnasium.spaces.Box(-1.0, 1.0, (rotors,), np.float64)
+        whole_observation, _ = spaces(self.batch)
+        self._observation_space = gymnasium.spaces.Box(
+            whole_observation.low[:size], whole_observation.high[:size], (size,), np.float32)
+        self.action_per_agent = self.batch.action_size // n
+        self._action_space = gymnasium.spaces.Box(-1.0, 1.0, (self.action_per_agent,),
+                                                  np.float64)
         self._seeded = False  # the batch's random draws seeded (at the first reset)
 
     def observation_space(self, agent: str) -> gymnasium.spaces.Box:
@@ -68,13 +71,15 @@ class FormationParallelEnv(ParallelEnv):
     def step(self, actions: dict[str, np.ndarray]):
         flat = np.concatenate([np.asarray(actions[agent], dtype=float)
                                for agent in self.possible_agents])[None]
-        self.batch.step(flat)
+        speeds = self.batch.step(flat)
         observation, seen = self.batch.observe()
-        reward, terms = self.batch.reward(seen, flat)
-        terminated, truncated = self.batch.ends(seen)
+        terminated, truncated, reasons = self.batch.ends(seen)
+        reward, terms = self.batch.reward(seen, speeds, terminated)
         agents = self.agents
         observations = self._split(observation[0])
-        infos = {agent: {'reward_terms': {k: float(v[0]) for k, v in terms.items()}}
+        error = float(np.linalg.norm(seen['position_error'][0]))
+        infos = {agent: {'reward_terms': {k: float(v[0]) for k, v in terms.items()},
+                         'payload_error': error, 'termination': reasons[0]}
                  for agent in agents}
         result = (observations, {agent: float(reward[0]) for agent in agents},
                   {agent: bool(terminated[0]) for agent in agents},
@@ -86,7 +91,7 @@ class FormationParallelEnv(ParallelEnv):
     def expert_actions(self) -> dict[str, np.ndarray]:
         """The seed's controllers' answers, per agent (the baseline)."""
         flat = self.batch.expert_actions()[0]
-        rotors = self.batch.rotors
+        rotors = self.action_per_agent
         return {agent: flat[k * rotors:(k + 1) * rotors]
                 for k, agent in enumerate(self.possible_agents)}
 

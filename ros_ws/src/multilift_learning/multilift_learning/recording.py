@@ -2,13 +2,19 @@
 writes (`multilift_tools.headless_bag.EngineBag`: the same topics, messages and simulated-time
 stamps, so Foxglove opens it and `multilift plot` draws it), with the policy's rotor speeds as
 the UAVs' /uav{i}/rotor_cmd. A policy has no reference, set-points or formation errors: those
-topics are left out.
+topics are left out. Beside each bag's metadata.yaml, summary.json: the run's figures as a
+run writes them (`Engine.summary`: `sim.scenario` the scenario's name, which `multilift plot`
+reads) and `task`: its name, options, the payload's target [m] (world) at the episode's first
+and last tick, the episode's steps, return, termination reason ('' if none) and the payload's
+mean distance from its target [m].
 
     env = RecordEpisodes(gymnasium.make('multilift/Mission-v0'), 'episodes')
     # episodes/episode_0001, episode_0002, ... (rosbag2 directories, MCAP)
 """
 from __future__ import annotations
 
+import dataclasses
+import json
 from pathlib import Path
 
 import gymnasium
@@ -28,6 +34,7 @@ class RecordEpisodes(gymnasium.Wrapper):
         self.bags: list[Path] = []
         self._record = None
         self._count = 0
+        self._episode: dict = {}
 
     def reset(self, **kwargs):
         self._finish()
@@ -35,6 +42,8 @@ class RecordEpisodes(gymnasium.Wrapper):
         engine = self.env.unwrapped.batch.engine
         self._record = engine.new_record(int(engine.arrays.tick_count[0]))
         self._count = 0
+        self._episode = {'target_start': self._target(), 'return': 0.0, 'termination': '',
+                         'payload_error_sum': 0.0}
         return observation, info
 
     def step(self, action):
@@ -46,12 +55,16 @@ class RecordEpisodes(gymnasium.Wrapper):
         record.states[k, 0] = memory.state[0]
         record.g[k, 0], record.g_dot[k, 0] = memory.g[0], memory.g_dot[0]
         record.taut[k, 0], record.gust[k, 0] = memory.taut[0], memory.gust[0]
+        speeds, saturated = batch.speeds(np.asarray(action, dtype=float)[None])
         result = self.env.step(action)
-        speeds = batch.speeds(np.asarray(action, dtype=float)[None])
         record.speeds[k, 0] = speeds[0]
-        record.saturated[k, 0] = batch.at_limits(speeds)[0]
+        record.saturated[k, 0] = saturated[0]
         record.tension[k, 0] = batch.tension[0]
         self._count += 1
+        info = result[4]
+        self._episode['return'] += float(result[1])
+        self._episode['payload_error_sum'] += info['payload_error']
+        self._episode['termination'] = info.get('termination', '')
         if result[2] or result[3]:
             self._finish()
         return result
@@ -59,6 +72,11 @@ class RecordEpisodes(gymnasium.Wrapper):
     def close(self):
         self._finish()
         return super().close()
+
+    def _target(self) -> list[float]:
+        """The payload's target now [m], world."""
+        batch = self.env.unwrapped.batch
+        return batch.targets.at(batch.engine.t)[0][0].tolist()
 
     def _finish(self) -> None:
         """Write the episode flown so far (if any) to its bag."""
@@ -74,5 +92,16 @@ class RecordEpisodes(gymnasium.Wrapper):
                 bag.last()
         finally:
             writer.close()
+        episode = self._episode
+        summary = batch.engine.summary(0)
+        summary['task'] = {
+            'name': batch.targets.task.name,
+            'options': dataclasses.asdict(batch.options),
+            'target_start': episode['target_start'], 'target_end': self._target(),
+            'steps': self._count, 'return': episode['return'],
+            'termination': episode['termination'],
+            'payload_error_mean': episode['payload_error_sum'] / self._count}
+        (path / 'summary.json').write_text(json.dumps(summary, indent=1, sort_keys=True,
+                                                      default=float))
         self.bags.append(path)
         self._record, self._count = None, 0

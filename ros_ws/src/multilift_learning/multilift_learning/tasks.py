@@ -69,13 +69,39 @@ def scenario_of(source: str | Scenario, overrides: dict[str, Any] | None = None,
     return scenario if duration is None else scenario.with_duration(duration)
 
 
-def task_scenario(scenario: Scenario, task_name: str) -> Scenario:
-    """The scenario as `task_name` flies it: for hover, a leader with a mission hovers at its
-    start for the whole duration (one segment at rest); otherwise unchanged."""
-    if task(task_name).name != 'hover' or scenario.control.mode != 'cascade':
+def task_scenario(scenario: Scenario, task_name: str, start: str = 'rest') -> Scenario:
+    """The scenario as `task_name` flies it: its cables slack-capable (`cable_model: slack`:
+    a cable pulls, never pushes); with start 'rest' the payload hangs still at its rest place
+    (no release swing; multilift_learning.options.STARTS); for hover, a leader with a mission
+    hovers at its start for the whole duration (one segment at rest)."""
+    task(task_name)
+    scenario = replace(scenario, cable_model='slack')
+    if start == 'rest':
+        scenario = replace(scenario, payload=replace(scenario.payload, swing=0.0, alpha=0.0,
+                                                     beta=0.0))
+    if task_name != 'hover' or scenario.control.mode != 'cascade':
         return scenario
     hold = MissionSegment(velocity=(0.0, 0.0, 0.0), end_time=scenario.simulation.duration)
     return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))
+
+
+def task_scenario_yaml(source: str, task_name: str, start: str = 'rest',
+                       duration: float | None = None) -> str:
+    """The YAML of scenario `source` (a name or path) as `task_name` flies it (`task_scenario`,
+    with `duration` [s]): a file `multilift run` flies, so a policy trained on the task flies
+    the same physics through ROS (`policy_node`)."""
+    path, data = load_base(source)
+    scenario = task_scenario(scenario_of(source, duration=duration), task_name, start)
+    data = dict(data, cable_model='slack')
+    data['simulation'] = dict(data['simulation'], duration=scenario.simulation.duration)
+    if start == 'rest':
+        data['payload'] = {k: v for k, v in data['payload'].items()
+                           if k not in ('swing_deg', 'alpha_deg', 'beta_deg')}
+    if task_name == 'hover' and scenario.control.mode == 'cascade':
+        data['mission'] = dict(data['mission'], segments=[
+            {'velocity': [0.0, 0.0, 0.0], 'until': scenario.simulation.duration}])
+    header = f'# {path} as the learning task {task_name!r} flies it (multilift_learning.tasks)\n'
+    return header + yaml.safe_dump(data, sort_keys=False)
 
 
 class Targets:

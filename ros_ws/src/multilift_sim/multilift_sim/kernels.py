@@ -46,7 +46,8 @@ def _packages() -> dict[str, Path]:
 def kernel_modules() -> list[str]:
     """The names of every module of the kernels' subpackages (KERNEL_FOLDERS of every
     multilift_* package), found, not imported."""
-    return [f'{name}.{folder}.{path.stem}' for name, package in sorted(_packages().items())
+    return [f'{name}.{folder.replace("/", ".")}.{path.stem}'
+            for name, package in sorted(_packages().items())
             for folder in KERNEL_FOLDERS for path in sorted((package / folder).glob('*.py'))
             if path.stem != '__init__']
 

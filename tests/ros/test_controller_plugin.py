@@ -28,6 +28,7 @@ from multilift_control.laws.cascade import command
 from multilift_control.laws.layout import (CASCADE_THRUST_COEFFICIENT, REFERENCE_SIZE,
                                            UAV_POSITION, UAV_STATE_SIZE, UAV_VELOCITY)
 from multilift_control.laws.mixer import collective_thrust
+from multilift_sim.formation_params import StateLayout
 from multilift_sim import scenario as scenario_io
 from multilift_sim.kernels import jit
 from multilift_sim.start import formation_start
@@ -130,7 +131,9 @@ OFFSET_FOLLOWER = types.SimpleNamespace(
     shared=offset_shared, answer=offset_answer)
 
 
-if __name__.startswith('multilift_parts_'):  # imported by a scenario's `parts:`
+def register_parts() -> None:
+    """Called by a scenario's `parts:` naming this file (the runs' processes), not by pytest's
+    import."""
     controllers.register_leader(HOLD_LEADER)
     controllers.register_follower(OFFSET_FOLLOWER)
 
@@ -159,8 +162,8 @@ def _toy_yaml(path: Path, gains=(GAIN, GAIN), parts: bool = True) -> Path:
 def _equilibrium_error(scenario, state: np.ndarray) -> np.ndarray:
     """The payload's place minus where statics hangs it from the UAVs' places (two equal
     taut cables: below their midpoint by sqrt(l^2 - (d/2)^2)) [m]."""
-    first, second = state[0:3], state[6:9]
-    payload = state[12:15]
+    first, second = StateLayout(2).uav_positions(state)
+    payload = StateLayout(2).payload_position(state)
     half = np.linalg.norm(second - first) / 2
     length = scenario.uavs[0].cable_length
     hanging = (first + second) / 2 - np.array([0.0, 0.0, math.sqrt(length ** 2 - half ** 2)])
@@ -203,7 +206,8 @@ def test_a_leader_and_a_follower_defined_here_fly_headless(tmp_path):
     # at rest each cable pulls its UAV inward by T_h = (m_p g / 2) (d / 2) / h (d the UAVs'
     # distance, h the payload's depth below them), which a PD without an integral leaves as a
     # horizontal offset T_h / (m kp); the vertical share of the weight is fed forward
-    leader, follower, payload = state[0:3], state[6:9], state[12:15]
+    (leader, follower), payload = (StateLayout(2).uav_positions(state),
+                                   StateLayout(2).payload_position(state))
     inward = (follower - leader)[:2] / np.linalg.norm((follower - leader)[:2])
     depth = (leader[2] + follower[2]) / 2 - payload[2]
     pull = (scenario.payload.mass * G / 2) * (np.linalg.norm((follower - leader)[:2]) / 2) / depth
@@ -216,7 +220,7 @@ def test_a_leader_and_a_follower_defined_here_fly_headless(tmp_path):
                                -offset * inward, atol=0.005)
     # and the payload hangs where statics puts it, 0.5 m higher than it started
     assert np.linalg.norm(_equilibrium_error(scenario, state)) < 0.005
-    assert state[14] - payload_start[2] > 0.9 * CLIMB
+    assert payload[2] - payload_start[2] > 0.9 * CLIMB
 
 
 def test_the_toys_fly_through_ros_as_headless(multilift_run, tmp_path):

@@ -49,7 +49,11 @@ POSITION_OFFSET = types.SimpleNamespace(
     memory=lambda offset: np.zeros(0),           # it keeps nothing
     draws=lambda offset, n_uavs, samples, dt, rng: np.zeros((n_uavs, samples, 0)),  # none
     measure=measure_offset)
-if __name__.startswith('multilift_parts_'):  # imported by a scenario's `parts:`
+
+
+def register_parts() -> None:
+    """Called by a scenario's `parts:` naming this file (the runs' processes), not by pytest's
+    import."""
     sensors.register(POSITION_OFFSET)
 
 

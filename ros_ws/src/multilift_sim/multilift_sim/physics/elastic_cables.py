@@ -14,7 +14,7 @@ sub-steps (`simulation.substeps`, FORMATION_SUBSTEPS) until omega h <= ELASTIC_O
 import math
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.free_motion import payload_force_per_mass, uav_free_motion
+from multilift_sim.physics.free_motion import payload_motion, uav_free_motion
 from multilift_sim.physics.layout import (FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
                                           POSITION, UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS,
                                           UAV_LENGTH_SQ, UAV_MASS)
@@ -44,10 +44,8 @@ def elastic_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
     n = uavs.shape[0]
     p = payload_slot(n)
     nq = rates_slot(n)
-    px, py, pz = x[p], x[p + 1], x[p + 2]
-    pvx, pvy, pvz = x[nq + p], x[nq + p + 1], x[nq + p + 2]
-    drag_ax, drag_ay, drag_az = payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts,
-                                                       formation)
+    px, py, pz, pvx, pvy, pvz, drag_ax, drag_ay, drag_az = payload_motion(x, n, gusts,
+                                                                          formation)
     gravity = formation[FORMATION_GRAVITY]
     pull_x = pull_y = pull_z = 0.0   # the cables' pull on the payload [N]
     for i in range(n):

@@ -22,7 +22,8 @@ import numpy as np
 from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  # noqa: F401
                                               attached_off_centre, cable_moment_arm,
-                                              payload_force_per_mass, rotational_compliance,
+                                              payload_force_per_mass, payload_motion,
+                                              rotational_compliance,
                                               uav_attach_motion, uav_free_motion)
 from multilift_sim.physics.elastic_cables import elastic_solve
 from multilift_sim.physics.nullspace import nullspace_solve, project, translational_masses
@@ -120,10 +121,8 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     n = uavs.shape[0]
     p = payload_slot(n)
     nq = rates_slot(n)
-    px, py, pz = x[p], x[p + 1], x[p + 2]
-    pvx, pvy, pvz = x[nq + p], x[nq + p + 1], x[nq + p + 2]
-    drag_ax, drag_ay, drag_az = payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts,
-                                                       formation)
+    px, py, pz, pvx, pvy, pvz, drag_ax, drag_ay, drag_az = payload_motion(x, n, gusts,
+                                                                          formation)
     two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
     gravity = formation[FORMATION_GRAVITY]
     for i in range(n):

@@ -16,7 +16,8 @@ from multilift_sim.physics.layout import (
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, POSITION,
     UAV_ATTACH, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_MASS, WRENCH_THRUST,
     WRENCH_TORQUE)
-from multilift_sim.physics.state_slots import rates_slot, uav_attitude_slot, uav_slot
+from multilift_sim.physics.state_slots import (payload_slot, rates_slot, uav_attitude_slot,
+                                               uav_slot)
 
 
 @jit
@@ -60,6 +61,20 @@ def payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts, formation):
     scale = (-drag * formation[FORMATION_INV_PAYLOAD_MASS]
              * math.sqrt(rel_x * rel_x + rel_y * rel_y + rel_z * rel_z))
     return scale * rel_x, scale * rel_y, scale * rel_z
+
+
+@jit
+def payload_motion(x, n, gusts, formation):
+    """The payload's position [m], velocity [m/s] and drag over m_p [m/s^2] (world; gusts and
+    the steady wind included, gravity excluded) at state x of n UAVs: nine floats, what a
+    point payload's solve reads of it first."""
+    p = payload_slot(n)
+    nq = rates_slot(n)
+    px, py, pz = x[p], x[p + 1], x[p + 2]
+    pvx, pvy, pvz = x[nq + p], x[nq + p + 1], x[nq + p + 2]
+    drag_ax, drag_ay, drag_az = payload_force_per_mass(px, py, pz, pvx, pvy, pvz, gusts,
+                                                       formation)
+    return px, py, pz, pvx, pvy, pvz, drag_ax, drag_ay, drag_az
 
 
 @jit

@@ -156,6 +156,7 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
         check(cascade.position_force, c, cascade_memory, t, state, ref)
         check(cascade.attitude_from_force, force, yaw, c[CASCADE_MAX_TILT])
         check(free_motion.thrust_axis, *rng.uniform(-1.5, 1.5, size=3))  # the follower's
+        check(cascade.body_rates_and_gyro, c, state)
         check(cascade.attitude_torque, c, state, rng.uniform(-1, 1, size=3))
         check(cascade.attitude_command, c, m, state, rng.uniform(-0.3, 0.3, size=3),
               rng.uniform(10.0, 40.0))

@@ -100,17 +100,23 @@ def attitude_from_force(force, yaw, max_tilt):
 
 
 @jit
-def attitude_torque(constants, state, setpoint):
-    """Body torque [N m] (3,) driving the Euler angles to `setpoint` (roll, pitch, yaw) [rad]:
-    PD on each angle, J-scaled, plus the gyroscopic omega x J omega."""
+def body_rates_and_gyro(constants, state):
+    """(omega (3,) [rad/s], omega x J omega (3,) [N m]) of one UAV's state, body FLU, J its
+    CASCADE_INERTIA: what its attitude and rate loops both add to J omega_dot."""
     p = state[UAV_BODY_RATES]
     q = state[UAV_BODY_RATES + 1]
     r = state[UAV_BODY_RATES + 2]
     jp = constants[CASCADE_INERTIA] * p
     jq = constants[CASCADE_INERTIA + 1] * q
     jr = constants[CASCADE_INERTIA + 2] * r
-    gyro = (q * jr - r * jq, r * jp - p * jr, p * jq - q * jp)  # omega x J omega
-    rates = (p, q, r)
+    return (p, q, r), (q * jr - r * jq, r * jp - p * jr, p * jq - q * jp)
+
+
+@jit
+def attitude_torque(constants, state, setpoint):
+    """Body torque [N m] (3,) driving the Euler angles to `setpoint` (roll, pitch, yaw) [rad]:
+    PD on each angle, J-scaled, plus the gyroscopic omega x J omega."""
+    rates, gyro = body_rates_and_gyro(constants, state)
     torque = np.empty(3)
     for axis in range(3):
         error = wrap_angle(setpoint[axis] - state[UAV_EULER + axis])

@@ -15,8 +15,9 @@ in 1.3 s of 0.1 noise on its actions.)
 import numpy as np
 
 from multilift_control.laws import jit
+from multilift_control.laws.cascade import body_rates_and_gyro
 from multilift_control.laws.layout import (CASCADE_ATT_KD, CASCADE_INERTIA, CASCADE_SQUARE_MAX,
-                                           CASCADE_SQUARE_MIN, MIXER_WRENCH, UAV_BODY_RATES)
+                                           CASCADE_SQUARE_MIN, MIXER_WRENCH)
 from multilift_control.laws.mixer import rotor_speeds
 
 
@@ -24,14 +25,7 @@ from multilift_control.laws.mixer import rotor_speeds
 def rate_torque(constants, state, rates):
     """Body torque [N m] (3,) of one UAV driving its body rates (state's UAV_BODY_RATES) to
     `rates` (3,) [rad/s], FLU; constants: its CASCADE_* row."""
-    p = state[UAV_BODY_RATES]
-    q = state[UAV_BODY_RATES + 1]
-    r = state[UAV_BODY_RATES + 2]
-    jp = constants[CASCADE_INERTIA] * p
-    jq = constants[CASCADE_INERTIA + 1] * q
-    jr = constants[CASCADE_INERTIA + 2] * r
-    gyro = (q * jr - r * jq, r * jp - p * jr, p * jq - q * jp)  # omega x J omega
-    now = (p, q, r)
+    now, gyro = body_rates_and_gyro(constants, state)   # omega, omega x J omega
     torque = np.empty(3)
     for axis in range(3):
         accel = constants[CASCADE_ATT_KD + axis] * (rates[axis] - now[axis])

@@ -15,7 +15,7 @@ are (`parts-<digest>` inside the kernels' one, from the parts' names, order and 
 no cached caller of another registry is loaded and none is written where the shipped
 registries' code lives, and it recompiles every loaded compiled function that reaches the
 changed dispatcher (`callers`), lazily at its next call. Its users:
-`multilift_sim.events.compiled`, `multilift_sim.sensors.compiled`.
+`multilift_sim.physics.events` (EVENTS), `multilift_sim.sensors.sensing` (SENSORS).
 """
 from __future__ import annotations
 
@@ -30,6 +30,7 @@ from typing import Callable
 from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
 from multilift_sim import parts
 from multilift_sim.kernels import kernel_modules
+from multilift_sim.registry import Registry
 
 BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
 
@@ -45,8 +46,7 @@ class GeneratedDispatcher:
     step: str                        # the part's compiled function called
     caller_module: str               # the module whose compiled `caller` calls `function`
     caller: str
-    parts: Callable[[], dict]        # the registry as it is
-    shipped: Callable[[], tuple]     # the parts shipped, in their order
+    parts: Callable[[], Registry]    # the registry as it is
 
     def steps(self) -> list[Callable]:
         return [parts.python(getattr(part, self.step)) for part in self.parts().values()]
@@ -85,7 +85,11 @@ class GeneratedDispatcher:
 
     def is_shipped(self) -> bool:
         """Whether the registry holds the shipped parts only, in their order."""
-        return tuple(self.parts().values()) == self.shipped()
+        return tuple(self.parts().values()) == self.parts().shipped
+
+    def refresh(self) -> None:
+        """After the registry changed: see `refresh`."""
+        refresh(self)
 
 
 DISPATCHERS: list[GeneratedDispatcher] = []  # every kind of part compiled into the tick
@@ -127,7 +131,7 @@ def refresh(dispatcher: GeneratedDispatcher) -> None:
     if module is None:
         return
     if Dispatcher is not None:  # a part's own step too: its cached code names its module
-        shipped = {id(getattr(part, dispatcher.step)) for part in dispatcher.shipped()}
+        shipped = {id(getattr(part, dispatcher.step)) for part in dispatcher.parts().shipped}
         for part in dispatcher.parts().values():
             step = getattr(part, dispatcher.step)
             if isinstance(step, Dispatcher) and id(step) not in shipped:

@@ -134,8 +134,8 @@ def load() -> None:
 
 
 class Dispatched(Protocol):
-    """A registry with a compiled dispatcher (`events.compiled`, multilift_control's
-    `controllers.compiled`)."""
+    """A registry with a compiled dispatcher (`part_dispatch.GeneratedDispatcher`,
+    multilift_control's `controllers.compiled`)."""
 
     def shipped(self) -> bool:
         """Whether it holds its shipped parts only, in their order."""

@@ -95,9 +95,17 @@ class GeneratedDispatcher:
 DISPATCHERS: list[GeneratedDispatcher] = []  # every kind of part compiled into the tick
 
 
-def add(dispatcher: GeneratedDispatcher) -> GeneratedDispatcher:
-    """`dispatcher` known to the cache folder's choice (`cache_folder`), once."""
-    if all(d.label != dispatcher.label for d in DISPATCHERS):
+def declare(label: str, signature: str, step: str, caller: str,
+            parts: Callable[[], Registry]) -> GeneratedDispatcher:
+    """The dispatcher `signature` ('function(selector, arguments)') of the kind `label`,
+    calling the `step` of each part of `parts()`, for the compiled `caller` ('module.function'
+    calling it by that name); known to the cache folder's choice (`cache_folder`), once."""
+    function, arguments = signature.rstrip(')').split('(', 1)
+    selector, arguments = (a.strip() for a in arguments.split(',', 1))
+    caller_module, caller = caller.rsplit('.', 1)
+    dispatcher = GeneratedDispatcher(label, function, selector, arguments, step, caller_module,
+                                     caller, parts)
+    if all(d.label != label for d in DISPATCHERS):
         DISPATCHERS.append(dispatcher)
     return dispatcher
 

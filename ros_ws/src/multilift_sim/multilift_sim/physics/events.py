@@ -13,12 +13,10 @@ from multilift_sim import part_dispatch
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import EVENT_KIND, EVENT_TICK
 
-EVENTS = part_dispatch.add(part_dispatch.GeneratedDispatcher(
-    label='events', function='apply_event', selector='kind',
-    arguments='row, tick, effectiveness, taut, released, silent_until', step='apply',
-    caller_module=__name__, caller='apply_events', parts=lambda: registry.EVENT_KINDS))
-# the registry's compiled dispatcher, rebound when the registry changes (EVENTS.refresh)
-apply_event = EVENTS.compiled()
+EVENTS = part_dispatch.declare(
+    'events', 'apply_event(kind, row, tick, effectiveness, taut, released, silent_until)',
+    step='apply', caller=f'{__name__}.apply_events', parts=lambda: registry.EVENT_KINDS)
+apply_event = EVENTS.compiled()  # rebound when the registry changes (EVENTS.refresh)
 
 
 @jit

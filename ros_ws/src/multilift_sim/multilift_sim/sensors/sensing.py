@@ -9,12 +9,10 @@ from multilift_sim import sensors as registry
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import MEASURED_COLUMNS
 
-SENSORS = part_dispatch.add(part_dispatch.GeneratedDispatcher(
-    label='sensors', function='measure_sensor', selector='model',
-    arguments='constants, draws, memory, tick, truth, received', step='measure',
-    caller_module=__name__, caller='sensed_states', parts=lambda: registry.SENSOR_MODELS))
-# the registry's compiled dispatcher, rebound when the registry changes (SENSORS.refresh)
-measure_sensor = SENSORS.compiled()
+SENSORS = part_dispatch.declare(
+    'sensors', 'measure_sensor(model, constants, draws, memory, tick, truth, received)',
+    step='measure', caller=f'{__name__}.sensed_states', parts=lambda: registry.SENSOR_MODELS)
+measure_sensor = SENSORS.compiled()  # rebound when the registry changes (SENSORS.refresh)
 
 
 @jit

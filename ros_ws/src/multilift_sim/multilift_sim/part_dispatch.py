@@ -21,18 +21,14 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
-import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
 from multilift_sim import parts
 from multilift_sim.kernels import kernel_modules
 from multilift_sim.registry import Registry
-
-BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
 
 
 @dataclass

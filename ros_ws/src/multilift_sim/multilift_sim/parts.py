@@ -40,10 +40,10 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable, Protocol
 
-from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
+from multilift_sim import kernels  # sets NUMBA_CACHE_DIR, the kernels' folder
 
 ENTRY_POINTS = 'multilift.parts'
-BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
+BASE_CACHE = kernels.CACHE_DIR
 _entries: set[str] = set()
 
 

@@ -59,3 +59,9 @@ def anchored(data: Any, folder: Path) -> Any:
 def loads(text: str, where: str = '<string>') -> Scenario:
     """Validate a scenario given as YAML text (tests, tools)."""
     return scenario_of(yaml.safe_load(text), where)
+
+
+def from_mapping(data: Any, where: str = '<mapping>') -> Scenario:
+    """Validate a scenario given as the mapping a YAML file loads to (a sweep's edited copy:
+    no round trip through text)."""
+    return scenario_of(data, where)

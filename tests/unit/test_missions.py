@@ -17,7 +17,7 @@ from multilift_control import laws
 from multilift_control.laws.layout import (REFERENCE_ACCELERATION, REFERENCE_POSITION,
                                            REFERENCE_SIZE, REFERENCE_VELOCITY, REFERENCE_YAW)
 from multilift_control.laws.reference import mission_reference
-from multilift_control.mission import MissionPath
+from multilift_control.controllers import LeaderController
 from multilift_sim import scenario as scenario_io
 from multilift_sim.missions import MISSION_SOURCES
 from multilift_sim.missions.polynomials import evaluate, minimum_snap
@@ -42,7 +42,7 @@ def _load(mission: dict, where: str = '<string>'):
 
 
 def _reference(scenario):
-    path = MissionPath(scenario.mission)
+    path = LeaderController(scenario).path  # the leader's path (mission.tracks applied)
     law = laws.runnable(mission_reference)
     return lambda t: law(path.mission, path.segments, path.steps, float(t))
 
@@ -223,3 +223,32 @@ def test_the_reference_before_its_size_grew_is_the_same_for_segments():
     reference = _reference(scenario_io.load('single_lift'))
     assert all(reference(t)[REFERENCE_YAW] == 0.0 for t in (0.0, 12.0, 50.0, 130.0))
     assert reference(0.0).shape == (REFERENCE_SIZE,)
+
+
+def test_tracks_payload_brings_the_payload_to_the_waypoints():
+    """`mission.tracks: payload`: the waypoints are the payload's; the leader flies them moved
+    up by its cable (one UAV: the payload hangs straight below at rest), so once the swing has
+    died down the payload rests on the last waypoint, as the statics says."""
+    from multilift_control.headless import run_headless
+    waypoints = [{'time': 0.0, 'position': [0.0, 0.0, -2.5]},
+                 {'time': 5.0, 'position': [1.0, 0.5, -2.0]},
+                 {'time': 10.0, 'position': [2.0, 0.0, -2.0]}]
+    data = _scenario_data({'type': 'waypoints', 'tracks': 'payload', 'waypoints': waypoints})
+    data['simulation']['duration'] = 25.0
+    scenario = scenario_io.loads(yaml.safe_dump(data))
+    reference = _reference(scenario)
+    assert np.abs(reference(0.0)[:3] - (0.0, 0.0, 0.0)).max() < 1e-12  # the leader's start
+    payload, times = [], []
+    run_headless(scenario, on_tick=lambda sim, snapshot, _: (
+        payload.append(np.array(snapshot.payload_position)), times.append(sim.t_ns * 1e-9)))
+    payload, times = np.array(payload), np.array(times)
+    for waypoint in waypoints:
+        k = int(np.argmin(np.abs(times - waypoint['time'])))
+        assert np.linalg.norm(payload[k] - waypoint['position']) < 0.15
+    assert np.linalg.norm(payload[-1] - waypoints[-1]['position']) < 0.005
+
+
+def test_tracks_payload_with_segments_needs_the_payload_s_start():
+    with pytest.raises(ScenarioError, match=r'mission\.start: missing key \(with mission\.'
+                                            r'tracks: payload'):
+        _load({'tracks': 'payload', 'segments': [{'velocity': [0.1, 0, 0], 'duration': 5.0}]})

@@ -3,7 +3,7 @@ the scenario's mission source (multilift_sim.missions: the seed's velocity segme
 piecewise polynomial), world frame."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -65,10 +65,18 @@ class MissionPath:
     A source of the `polynomial` form (`mission.type` waypoints, file): `segments` holds its
     pieces (PIECE_* slots), `steps` is empty, MISSION_FORM is FORM_POLYNOMIAL; no filter, no
     shaper (validation refuses them).
+
+    With `offset` (3,) [m], world, every position of the path is moved by it (the velocities
+    and accelerations are the path's): `mission.tracks: payload`, whose path is the payload's,
+    flown by the leader at its offset from the payload at the formation's hanging rest
+    (`controllers.tracked_offset`).
     """
 
     def __init__(self, mission: MissionConfig,
-                 shaper: tuple[tuple[float, float], ...] = ((0.0, 1.0),), period: float = 0.0):
+                 shaper: tuple[tuple[float, float], ...] = ((0.0, 1.0),), period: float = 0.0,
+                 offset: np.ndarray | None = None):
+        if offset is not None:
+            mission = shifted(mission, np.asarray(offset, dtype=float))
         form = FORMS.index(source_of(mission).FORM)
         if form == FORM_POLYNOMIAL:
             self._polynomial(mission)
@@ -137,3 +145,17 @@ class MissionPath:
     def __call__(self, t: float) -> Reference:
         """The reference at simulated time t [s]."""
         return Reference.of(self._law(self.mission, self.segments, self.steps, float(t)))
+
+
+def shifted(mission: MissionConfig, offset: np.ndarray) -> MissionConfig:
+    """`mission` with every position moved by `offset` (3,) [m], world: its start and, for a
+    polynomial, each piece's constant term and its points."""
+    coefficients = np.array(mission.coefficients, dtype=float).reshape(
+        len(mission.coefficients), PIECE_AXES, -1)
+    if len(coefficients):
+        coefficients[:, :3, 0] += offset
+    return replace(
+        mission, start=tuple(float(v) for v in np.add(mission.start, offset)),
+        coefficients=tuple(tuple(tuple(float(c) for c in axis) for axis in piece)
+                           for piece in coefficients),
+        points=tuple(tuple(float(v) for v in np.add(p, offset)) for p in mission.points))

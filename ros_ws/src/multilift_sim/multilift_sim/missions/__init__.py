@@ -50,11 +50,15 @@ register, unregister, registered = (MISSION_SOURCES.register, MISSION_SOURCES.un
 def read_mission(top: Any, start: tuple[float, float, float]) -> Any:
     """The scenario's `mission:` (top: the file's `Section`) as a MissionConfig, read by the
     source its `type` names; `start` the leader's start position, world [m]."""
+    from multilift_sim.scenario.config import ScenarioError  # scenario imports this module
     m = top.section('mission')
     kind = m.text('type', DEFAULT_SOURCE, choices=tuple(MISSION_SOURCES))
     tracks = m.text('tracks', 'leader', choices=TRACKED)
     source = Path(top.where)
     folder = source.parent if source.is_file() else Path.cwd()
+    if tracks == 'payload' and kind == DEFAULT_SOURCE and not m.has('start'):
+        raise ScenarioError(f'{top.where}: mission.start: missing key (with mission.tracks: '
+                            f'payload the segments start at the payload\'s start position)')
     config = MISSION_SOURCES[kind].read(m, start, folder)
     m.done()
     return dataclasses.replace(config, type=kind, tracks=tracks)

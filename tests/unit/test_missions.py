@@ -252,3 +252,27 @@ def test_tracks_payload_with_segments_needs_the_payload_s_start():
     with pytest.raises(ScenarioError, match=r'mission\.start: missing key \(with mission\.'
                                             r'tracks: payload'):
         _load({'tracks': 'payload', 'segments': [{'velocity': [0.1, 0, 0], 'duration': 5.0}]})
+
+
+def test_a_vehicle_preset_fills_the_keys_not_given_and_a_key_given_overrides():
+    import math
+    data = _scenario_data({'type': 'waypoints', 'waypoints': WAYPOINTS})
+    data['vehicle'] = {'preset': 'crazyflie_2_1'}
+    data['payload']['mass'] = 0.01
+    data['uavs'][0]['cable_length'] = 0.5
+    vehicle = scenario_io.loads(yaml.safe_dump(data)).uavs[0].vehicle
+    # Förster 2015's C_T = 3.1582e-10 N/rpm^2 per (rad/s)^2, the datasheet's 27 g and 46 mm
+    assert vehicle.mass == 0.027 and vehicle.arm_length == 0.046
+    assert vehicle.thrust_coefficient == pytest.approx(3.1582e-10 * (60 / (2 * math.pi)) ** 2)
+    assert vehicle.rotor_speed_max == pytest.approx(21666.4475 * 2 * math.pi / 60, rel=1e-9)
+    data['vehicle']['mass'] = 0.030
+    assert scenario_io.loads(yaml.safe_dump(data)).uavs[0].vehicle.mass == 0.030
+    data['vehicle'] = {'preset': 'table_4_2'}  # the seed's, as the shipped scenarios write it
+    data['payload']['mass'] = 0.4
+    data['uavs'][0]['cable_length'] = 2.5
+    assert scenario_io.loads(yaml.safe_dump(data)).uavs[0].vehicle == \
+        scenario_io.load('single_lift').uavs[0].vehicle
+    data['vehicle'] = {'preset': 'crazyflie_3'}
+    with pytest.raises(ScenarioError, match=r'vehicle\.preset: .* must be one of table_4_2, '
+                                            r'crazyflie_2_1'):
+        scenario_io.loads(yaml.safe_dump(data))

@@ -31,7 +31,7 @@ from multilift_sim.scenario.limits import check_limits
 from multilift_sim.scenario.part_files import scenario_parts
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
-                                            vehicle_params)
+                                            preset_values, vehicle_params)
 
 
 def scenario_of(data: Any, where: str) -> Scenario:
@@ -72,8 +72,11 @@ def scenario_of(data: Any, where: str) -> Scenario:
     sim = dataclasses.replace(sim, substeps=int(sim.substeps))
 
     v = top.section('vehicle')
-    base_vehicle = dataclasses.asdict(vehicle_params(v, None))
-    base_source = inertia_source(v, tuple(base_vehicle['inertia']))
+    preset = preset_values(v)  # vehicle.preset: its values under the keys given
+    base_vehicle = dataclasses.asdict(vehicle_params(v, preset))
+    base_source = inertia_source(v, tuple(base_vehicle['inertia']),
+                                 'given' if preset is None or v.has('inertia')
+                                 else preset['inertia_source'])
     v.done()
     warnings = inertia_warning(where, 'vehicle.inertia', tuple(base_vehicle['inertia']),
                                base_source)

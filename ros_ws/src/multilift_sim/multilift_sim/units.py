@@ -94,7 +94,7 @@ SCENARIO_UNITS: dict[str, str] = {
     'mission.start': 'm', 'mission.reference_filter_time': 's',
     'mission.segments[].velocity': 'm/s', 'mission.segments[].duration': 's',
     'mission.segments[].until': 's',
-    'mission.type': NO_UNIT, 'mission.tracks': NO_UNIT, 'mission.file': NO_UNIT,
+    'vehicle.preset': NO_UNIT, 'mission.type': NO_UNIT, 'mission.tracks': NO_UNIT, 'mission.file': NO_UNIT,
     'mission.waypoints': NO_UNIT, 'mission.waypoints[].time': 's',
     'mission.waypoints[].position': 'm', 'mission.waypoints[].yaw': 'rad',
     'events[].time': 's', 'events[].type': NO_UNIT, 'events[].uav': NO_UNIT,

@@ -21,8 +21,10 @@ from typing import Any
 import numpy as np
 import yaml
 
-from multilift_control.laws.layout import (MISSION_FINAL, MISSION_START, REFERENCE_POSITION,
-                                           REFERENCE_VELOCITY, SEGMENT_ORIGIN)
+from multilift_control.laws.layout import (FORM_POLYNOMIAL, MISSION_FINAL, MISSION_FORM,
+                                           MISSION_START, PIECE_COEFFICIENTS, PIECE_ORDER,
+                                           REFERENCE_POSITION, REFERENCE_VELOCITY,
+                                           SEGMENT_ORIGIN)
 from multilift_sim import scenario as scenario_io
 from multilift_sim.registry import one_of
 from multilift_sim.scenario import MissionSegment, Scenario
@@ -123,8 +125,8 @@ class Targets:
 
     def reset(self, which: np.ndarray, rngs: list[np.random.Generator]) -> None:
         """New targets for the formations in `which` (B,) bool, each from its own generator;
-        for hover the leader's mission (its positions: start, end, each segment's origin)
-        moves with the target."""
+        for hover the leader's mission (its positions: start, end, each segment's origin or
+        each polynomial piece's constant term) moves with the target."""
         a = self.arrays
         for b in np.flatnonzero(which):
             offset = np.zeros(3)
@@ -137,7 +139,11 @@ class Targets:
             if self.task.name == 'hover':
                 a.mission[b, MISSION_START:MISSION_START + 3] += shift
                 a.mission[b, MISSION_FINAL:MISSION_FINAL + 3] += shift
-                a.segments[b, :, SEGMENT_ORIGIN:SEGMENT_ORIGIN + 3] += shift
+                if a.mission[b, MISSION_FORM] == FORM_POLYNOMIAL:  # each piece's constant
+                    for axis in range(3):
+                        a.segments[b, :, PIECE_COEFFICIENTS + axis * PIECE_ORDER] += shift[axis]
+                else:
+                    a.segments[b, :, SEGMENT_ORIGIN:SEGMENT_ORIGIN + 3] += shift
 
     def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(position, velocity) of each formation's target at its time t (B,) [s]."""

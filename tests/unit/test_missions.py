@@ -276,3 +276,18 @@ def test_a_vehicle_preset_fills_the_keys_not_given_and_a_key_given_overrides():
     with pytest.raises(ScenarioError, match=r'vehicle\.preset: .* must be one of table_4_2, '
                                             r'crazyflie_2_1'):
         scenario_io.loads(yaml.safe_dump(data))
+
+
+def test_a_learning_hover_of_a_waypoints_scenario_hovers_at_the_leader_s_start():
+    """The hover task replaces the mission by one held segment at the leader's start, whatever
+    the scenario's source (a waypoints mission would otherwise still be flown)."""
+    from multilift_learning.tasks import task_scenario, task_scenario_yaml
+    scenario = _load({'type': 'waypoints', 'waypoints': WAYPOINTS[1:]})
+    hover = task_scenario(scenario, 'hover')
+    assert hover.mission.type == 'segments' and hover.mission.knots == ()
+    reference = _reference(hover)
+    for t in (0.0, 5.0, 11.0):
+        assert np.array_equal(reference(t)[:3], scenario.uavs[0].position)
+    assert task_scenario(scenario_io.load('single_lift'), 'hover').mission.start == \
+        scenario_io.load('single_lift').mission.start
+    assert 'segments' in yaml.safe_load(task_scenario_yaml('cf2_payload', 'hover'))['mission']

@@ -27,7 +27,7 @@ from multilift_control.laws.layout import (FORM_POLYNOMIAL, MISSION_FINAL, MISSI
                                            SEGMENT_ORIGIN)
 from multilift_sim import scenario as scenario_io
 from multilift_sim.registry import one_of
-from multilift_sim.scenario import MissionSegment, Scenario
+from multilift_sim.scenario import MissionConfig, MissionSegment, Scenario
 from multilift_tools.campaign import edited, format_value, load_base, parse_key
 
 
@@ -84,7 +84,17 @@ def task_scenario(scenario: Scenario, task_name: str, start: str = 'rest') -> Sc
     if task_name != 'hover' or scenario.control.mode != 'cascade':
         return scenario
     hold = MissionSegment(velocity=(0.0, 0.0, 0.0), end_time=scenario.simulation.duration)
-    return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))
+    if _seed_mission(scenario):
+        return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))
+    # another source (waypoints, a file, the payload tracked): a segments mission from the
+    # leader's start
+    return replace(scenario, mission=MissionConfig(start=scenario.uavs[0].position,
+                                                   segments=(hold,)))
+
+
+def _seed_mission(scenario: Scenario) -> bool:
+    """Whether the scenario's mission is the default source's (segments) for the leader."""
+    return scenario.mission.type == 'segments' and scenario.mission.tracks == 'leader'
 
 
 def task_scenario_yaml(source: str, task_name: str, start: str = 'rest',
@@ -100,8 +110,10 @@ def task_scenario_yaml(source: str, task_name: str, start: str = 'rest',
         data['payload'] = {k: v for k, v in data['payload'].items()
                            if k not in ('swing_deg', 'alpha_deg', 'beta_deg')}
     if task_name == 'hover' and scenario.control.mode == 'cascade':
-        data['mission'] = dict(data['mission'], segments=[
-            {'velocity': [0.0, 0.0, 0.0], 'until': scenario.simulation.duration}])
+        hold = [{'velocity': [0.0, 0.0, 0.0], 'until': scenario.simulation.duration}]
+        data['mission'] = (dict(data['mission'], segments=hold)
+                           if _seed_mission(scenario_of(source))
+                           else {'start': list(scenario.mission.start), 'segments': hold})
     header = f'# {path} as the learning task {task_name!r} flies it (multilift_learning.tasks)\n'
     return header + yaml.safe_dump(data, sort_keys=False)
 

@@ -291,3 +291,13 @@ def test_a_learning_hover_of_a_waypoints_scenario_hovers_at_the_leader_s_start()
     assert task_scenario(scenario_io.load('single_lift'), 'hover').mission.start == \
         scenario_io.load('single_lift').mission.start
     assert 'segments' in yaml.safe_load(task_scenario_yaml('cf2_payload', 'hover'))['mission']
+
+
+def test_a_copy_validated_elsewhere_reads_the_file_beside_its_scenario(tmp_path):
+    """A sweep validates each run's copy of the scenario's mapping from elsewhere
+    (`scenario.anchored`): `mission.file` is made absolute against the scenario's folder."""
+    (tmp_path / 'path.csv').write_text('t,x,y,z\n0,0,0,0\n2,1,0,0\n')
+    data = scenario_io.anchored(_scenario_data({'type': 'file', 'file': 'path.csv'}), tmp_path)
+    assert data['mission']['file'] == str((tmp_path / 'path.csv').resolve())
+    scenario = scenario_io.loads(yaml.safe_dump(data))  # validated from the working directory
+    assert scenario.mission.knots == (0.0, 2.0)

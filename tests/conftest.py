@@ -186,6 +186,30 @@ def raw_messages(bag: Path) -> dict[str, list[bytes]]:
     return messages
 
 
+def flown_alike(multilift_run, scenario: str, folder: Path):
+    """`scenario` (a name or path) run through ROS (`multilift run --bag`) and headless
+    (`--headless --bag`) into `folder`/ros and `folder`/headless; both must exit 0 and agree on
+    every UAV's and the payload's position to 1e-9 m at the same stamps. Returns the two runs
+    (multilift_tools.bagdata.load_run), ROS first."""
+    import sys
+
+    import numpy as np
+
+    from multilift_tools.bagdata import load_run
+    bags = folder / 'ros', folder / 'headless'
+    run = multilift_run(str(scenario), bag=bags[0], startup_timeout=600)
+    assert run.wait(timeout=1200) == 0, run.output()[-2000:]
+    headless = subprocess.run([sys.executable, '-m', 'multilift_tools.cli', 'run', str(scenario),
+                               '--headless', '--bag', str(bags[1])], capture_output=True,
+                              text=True, timeout=1200)
+    assert headless.returncode == 0, headless.stderr[-2000:]
+    ros, flown = (load_run(bag) for bag in bags)
+    assert np.array_equal(ros.t, flown.t)
+    assert np.abs(ros.uav_positions() - flown.uav_positions()).max() < 1e-9
+    assert np.abs(ros.payload_position() - flown.payload_position()).max() < 1e-9
+    return ros, flown
+
+
 # -- waiting for conditions (tests never wait a fixed time) ----------------------------------------
 def wait_for(condition: Callable[[], T], timeout: float, what: str, poll: float = 0.1) -> T:
     """Poll `condition()` until it returns something truthy and return that; after `timeout`

@@ -20,7 +20,6 @@ from __future__ import annotations
 from math import factorial
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from multilift_sim.scenario.config import MissionConfig
 
@@ -80,6 +79,7 @@ def clamped_cubic(times: np.ndarray, points: np.ndarray) -> np.ndarray:
     """The clamped cubic spline (m, D, ORDER) through `points` (m + 1, D) at `times` (m + 1,)
     [s]: position, velocity and acceleration continuous, velocity 0 at both ends
     (scipy.interpolate.CubicSpline, bc_type='clamped'); coefficients past the cube are 0."""
+    from scipy.interpolate import CubicSpline  # on demand: loading a scenario imports no scipy
     spline = CubicSpline(np.asarray(times, dtype=float), np.asarray(points, dtype=float),
                          axis=0, bc_type='clamped')
     cubic = spline.c[::-1]  # (4, m, D), the lowest power first

@@ -152,9 +152,18 @@ def _v3_mixed(tmp_path, **formation) -> str:
     ({'reorganize': 'sometimes'}, 'formation.reorganize: \'sometimes\''),
 ])
 def test_bad_reorganisation_keys_are_one_line(tmp_path, formation, rule):
-    with pytest.raises(ScenarioError, match=None) as error:
+    with pytest.raises(ScenarioError) as error:
         scenario_io.load(_v3_mixed(tmp_path, **formation))
     assert rule in str(error.value) and '\n' not in str(error.value)
+
+
+def test_a_circle_cannot_reorganise(tmp_path):
+    data = yaml.safe_load((SCENARIOS / 'circle3.yaml').read_text())
+    data['formation']['reorganize'] = 'thrust_margin'
+    path = tmp_path / 'circle.yaml'
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ScenarioError, match="moves linear or V offsets, not a 'circle'"):
+        scenario_io.load(str(path))
 
 
 def test_a_formation_of_one_cannot_reorganise_and_the_command_says_so(tmp_path, capsys):

@@ -1,6 +1,6 @@
 """A sensor model is a registered part (issue 31): a toy model defined in this file only, a
 position sensor with a constant offset d, registers at test time, compiles into the one tick
-(multilift_sim.sensors.compiled) and flies headless (the engine's `fly`, the per-object
+(multilift_sim.sensors.sensing.SENSORS) and flies headless (the engine's `fly`, the per-object
 `run_headless`, equal to the bit) and through the ROS nodes (`multilift run` of a scenario
 whose `parts:` names this file: its processes import it and register the model), equal to the
 headless run to 1e-9 m. pytest's own import leaves the registry alone (`registered` adds the

@@ -1,5 +1,5 @@
 """An event kind is a registered part (issue 31): a toy kind defined in this file only,
-registered at test time, compiles into the one tick (multilift_sim.events.compiled) and flies
+registered at test time, compiles into the one tick (multilift_sim.physics.events.EVENTS) and flies
 in both paths (the engine's `fly`, the per-object `run_headless`), held to an expectation
 worked out here, not read from the code: every rotor of a single lift cut, the formation falls
 freely, its centre of mass at g. And no shipped kind is named beyond its own two modules."""

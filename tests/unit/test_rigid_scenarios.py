@@ -14,7 +14,7 @@ from conftest import SCENARIOS
 from multilift_control.headless import fly
 from multilift_sim import scenario as scenario_io
 from multilift_sim.dynamics import FormationModel
-from multilift_sim.payload_types import solid_inertia
+from multilift_sim.payloads.rigid_body import solid_inertia
 from multilift_sim.start import initial_state
 
 
@@ -68,7 +68,7 @@ def test_a_rigid_payload_needs_the_baumgarte_dae():
     data['cable_model'] = 'slack'  # slack cables on a body: tests/unit/test_slack_bodies.py
     assert scenario_io.loads(yaml.safe_dump(data)).cable_model == 'slack'
     data['simulation']['integrator'] = 'nullspace'
-    with pytest.raises(scenario_io.ScenarioError, match='rigid_body need simulation.integrator'):
+    with pytest.raises(scenario_io.ScenarioError, match='rigid_body needs simulation.integrator'):
         scenario_io.loads(yaml.safe_dump(data))
 
 

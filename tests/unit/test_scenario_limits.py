@@ -11,7 +11,7 @@ import yaml
 
 from conftest import SCENARIOS
 from multilift_sim import scenario as scenario_io
-from multilift_sim.payload_types import attach_margin, distance_outside
+from multilift_sim.payloads.rigid_body import attach_margin, distance_outside
 from multilift_sim.scenario.limits import MAX_MISSION_SPEED, max_mission_acceleration
 from multilift_tools import cli
 

@@ -249,9 +249,9 @@ def test_the_shipped_model_is_named_in_its_own_module_only():
     import re
     from pathlib import Path
 
-    from multilift_sim.sensors import SENSOR_MODELS, SHIPPED
+    from multilift_sim.sensors import SENSOR_MODELS
     sources = sorted((Path(__file__).resolve().parents[2] / 'ros_ws' / 'src').rglob('*.py'))
-    for model in SHIPPED:
+    for model in SENSOR_MODELS.shipped:
         pattern = re.compile(rf"""['"]{model.NAME}['"]""")
         naming = [p.name for p in sources if pattern.search(p.read_text())]
         assert naming == [f'{model.NAME}.py'], naming

@@ -31,6 +31,7 @@ from multilift_control.laws.layout import (FOLLOWER_ALTITUDE_OFFSET, FOLLOWER_BE
 from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_sim import formation_geometry  # the start places, world
 from multilift_sim.multirotor import MultirotorParams
+from multilift_sim.registry import one_of
 from multilift_sim.scenario import ControlConfig
 from multilift_sim.start import uav_offsets
 
@@ -102,8 +103,7 @@ class FormationFollower:
                  free_mode_gain: float | None = None):
         if not 1 <= index < constraints.n:
             raise ValueError(f'follower index must be within 1..{constraints.n - 1}, got {index}')
-        if own_thrust not in OWN_THRUST:
-            raise ValueError(f'own_thrust must be one of {OWN_THRUST}, got {own_thrust!r}')
+        one_of('own_thrust', own_thrust, OWN_THRUST)
         if free_mode_gain is not None and not (math.isfinite(free_mode_gain)
                                                and free_mode_gain >= 0):
             raise ValueError(f'free_mode_gain must be None or finite and >= 0 [1/s], got '

@@ -18,6 +18,7 @@ from multilift_control.laws.follower import virtual_forces as virtual_forces_law
 from multilift_control.laws.layout import ROW_AXIS, ROW_DISTANCE, ROW_FIRST, ROW_SECOND, ROW_SIZE
 from multilift_sim import formation_geometry  # start places and the V offsets v_1i, world
 from multilift_sim import kernels
+from multilift_sim.registry import one_of
 
 GEOMETRIES = formation_geometry.FORMATION_GEOMETRIES  # seed Table 3.1: the one registry
 
@@ -38,9 +39,7 @@ class FormationGeometry:
     half_angle: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.kind not in GEOMETRIES:
-            raise ValueError(f'FormationGeometry.kind must be one of {GEOMETRIES}, '
-                             f'got {self.kind!r}')
+        one_of('FormationGeometry.kind', self.kind, GEOMETRIES)
         if isinstance(self.n, bool) or not isinstance(self.n, int) or self.n < 2:
             raise ValueError(f'FormationGeometry.n must be an integer >= 2, got {self.n!r}')
         if self.kind == 'circle' and self.n < 3:
@@ -148,11 +147,10 @@ class VirtualConstraints:
         self.rows[:, ROW_AXIS] = self.axes if self.linear else ROW_DISTANCE
         for array in (self.pairs, self.axes, self.targets, self.rows):
             array.flags.writeable = False
-        self._residual = laws.runnable(rows_laws.residual)
-        self._jacobian = laws.runnable(rows_laws.jacobian)
-        self._rates = laws.runnable(rows_laws.rates)
-        self._jacobian_rate_product = laws.runnable(rows_laws.jacobian_rate_product)
-        self._free_follower_motions = laws.runnable(rows_laws.free_follower_motions)
+        (self._residual, self._jacobian, self._rates, self._jacobian_rate_product,
+         self._free_follower_motions) = map(laws.runnable, (
+            rows_laws.residual, rows_laws.jacobian, rows_laws.rates,
+            rows_laws.jacobian_rate_product, rows_laws.free_follower_motions))
         # one-time queries of a formation's set-up (a follower's rows, the linear rows'
         # constant Jacobian): the laws' own source run uncompiled, the same numbers without
         # loading two more compiled functions from numba's cache (about 0.2 s of a process's

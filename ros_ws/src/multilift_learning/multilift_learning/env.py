@@ -11,6 +11,7 @@ from multilift_learning.batch import REWARD_WEIGHTS, FormationBatch, observation
 from multilift_learning.observations import OBSERVATION_CLIP
 from multilift_learning.options import TaskOptions
 from multilift_learning.tasks import scenario_of
+from multilift_sim.registry import one_of
 from multilift_sim.scenario import Scenario
 
 
@@ -56,9 +57,7 @@ class FormationEnv(gymnasium.Env):
     def __init__(self, scenario: str | Scenario = 'twin_lift', task: str = 'hover',
                  overrides: dict[str, Any] | None = None, render_mode: str | None = None,
                  **options):
-        if render_mode not in (None, *self.metadata['render_modes']):
-            raise ValueError(f'render_mode {render_mode!r}: one of None, '
-                             f'{", ".join(self.metadata["render_modes"])}')
+        one_of('render_mode', render_mode, (None, *self.metadata['render_modes']))
         self.render_mode = render_mode
         self._history: list[tuple[float, np.ndarray, np.ndarray, np.ndarray]] = []
         self.batch = formation_batch([scenario], task, overrides, options)

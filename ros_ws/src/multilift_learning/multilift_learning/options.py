@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from multilift_sim.registry import one_of
+
 # the action modes (multilift_learning.batch): every rotor's speed, or per UAV a collective
 # thrust and three body rates with the attitude-rate loop inside (laws.body_rates)
 ACTION_MODES = ('rotor_speeds', 'thrust_body_rates')
@@ -44,11 +46,8 @@ class TaskOptions:
     start_speed: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.action_mode not in ACTION_MODES:
-            raise ValueError(f'action_mode {self.action_mode!r}: one of '
-                             f'{", ".join(ACTION_MODES)}')
-        if self.start not in STARTS:
-            raise ValueError(f'start {self.start!r}: one of {", ".join(STARTS)}')
+        one_of('action_mode', self.action_mode, ACTION_MODES)
+        one_of('start', self.start, STARTS)
         if not isinstance(self.normalise, bool):
             raise ValueError(f'normalise must be True or False, got {self.normalise!r}')
         _positive('duration', self.duration, allow_none=True)

@@ -24,6 +24,7 @@ import yaml
 from multilift_control.laws.layout import (MISSION_FINAL, MISSION_START, REFERENCE_POSITION,
                                            REFERENCE_VELOCITY, SEGMENT_ORIGIN)
 from multilift_sim import scenario as scenario_io
+from multilift_sim.registry import one_of
 from multilift_sim.scenario import MissionSegment, Scenario
 from multilift_tools.campaign import edited, format_value, load_base, parse_key
 
@@ -44,8 +45,7 @@ TASKS = {
 
 def task(name: str) -> Task:
     """The registered task `name` (ValueError naming the known ones otherwise)."""
-    if name not in TASKS:
-        raise ValueError(f'unknown task {name!r}: one of {", ".join(TASKS)}')
+    one_of('task', name, TASKS)
     return TASKS[name]
 
 

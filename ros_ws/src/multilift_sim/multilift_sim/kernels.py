@@ -67,6 +67,8 @@ def _sources_digest() -> str:
 # numba's on-disk cache of these sources: a folder named by their digest, so an edited kernel
 # never leaves a caller's cached code stale (`prune_cache` removes the other folders)
 os.environ.setdefault('NUMBA_CACHE_DIR', str(CACHE_ROOT / _sources_digest()))
+CACHE_DIR = Path(os.environ['NUMBA_CACHE_DIR'])  # as this process found it (a test may restore
+#                                                 the environment after the import)
 
 VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), jit or python: see the docstring
 PHYSICS = 'multilift_sim.physics.formation_dae'  # the physics' compiled module (the DAE)
@@ -79,7 +81,7 @@ def prune_cache(days: float = 7.0) -> list[Path]:
     """Remove the cache folders of other sources (digest-named folders under CACHE_ROOT) that
     no process has written for `days`; returns them. Folders in use by other checkouts of
     other sources stay."""
-    current = Path(os.environ['NUMBA_CACHE_DIR'])
+    current = CACHE_DIR
     cutoff = time.time() - days * 86400.0
     stale = [path for path in CACHE_ROOT.glob('*')
              if path.is_dir() and path != current and len(path.name) == 16

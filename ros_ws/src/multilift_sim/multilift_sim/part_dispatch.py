@@ -15,23 +15,20 @@ are (`parts-<digest>` inside the kernels' one, from the parts' names, order and 
 no cached caller of another registry is loaded and none is written where the shipped
 registries' code lives, and it recompiles every loaded compiled function that reaches the
 changed dispatcher (`callers`), lazily at its next call. Its users:
-`multilift_sim.events.compiled`, `multilift_sim.sensors.compiled`.
+`multilift_sim.physics.events` (EVENTS), `multilift_sim.sensors.sensing` (SENSORS).
 """
 from __future__ import annotations
 
 import hashlib
 import importlib.util
-import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
 from multilift_sim import parts
 from multilift_sim.kernels import kernel_modules
-
-BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
+from multilift_sim.registry import Registry
 
 
 @dataclass
@@ -45,8 +42,7 @@ class GeneratedDispatcher:
     step: str                        # the part's compiled function called
     caller_module: str               # the module whose compiled `caller` calls `function`
     caller: str
-    parts: Callable[[], dict]        # the registry as it is
-    shipped: Callable[[], tuple]     # the parts shipped, in their order
+    parts: Callable[[], Registry]    # the registry as it is
 
     def steps(self) -> list[Callable]:
         return [parts.python(getattr(part, self.step)) for part in self.parts().values()]
@@ -85,15 +81,27 @@ class GeneratedDispatcher:
 
     def is_shipped(self) -> bool:
         """Whether the registry holds the shipped parts only, in their order."""
-        return tuple(self.parts().values()) == self.shipped()
+        return tuple(self.parts().values()) == self.parts().shipped
+
+    def refresh(self) -> None:
+        """After the registry changed: see `refresh`."""
+        refresh(self)
 
 
 DISPATCHERS: list[GeneratedDispatcher] = []  # every kind of part compiled into the tick
 
 
-def add(dispatcher: GeneratedDispatcher) -> GeneratedDispatcher:
-    """`dispatcher` known to the cache folder's choice (`cache_folder`), once."""
-    if all(d.label != dispatcher.label for d in DISPATCHERS):
+def declare(label: str, signature: str, step: str, caller: str,
+            parts: Callable[[], Registry]) -> GeneratedDispatcher:
+    """The dispatcher `signature` ('function(selector, arguments)') of the kind `label`,
+    calling the `step` of each part of `parts()`, for the compiled `caller` ('module.function'
+    calling it by that name); known to the cache folder's choice (`cache_folder`), once."""
+    function, arguments = signature.rstrip(')').split('(', 1)
+    selector, arguments = (a.strip() for a in arguments.split(',', 1))
+    caller_module, caller = caller.rsplit('.', 1)
+    dispatcher = GeneratedDispatcher(label, function, selector, arguments, step, caller_module,
+                                     caller, parts)
+    if all(d.label != label for d in DISPATCHERS):
         DISPATCHERS.append(dispatcher)
     return dispatcher
 
@@ -127,7 +135,7 @@ def refresh(dispatcher: GeneratedDispatcher) -> None:
     if module is None:
         return
     if Dispatcher is not None:  # a part's own step too: its cached code names its module
-        shipped = {id(getattr(part, dispatcher.step)) for part in dispatcher.shipped()}
+        shipped = {id(getattr(part, dispatcher.step)) for part in dispatcher.parts().shipped}
         for part in dispatcher.parts().values():
             step = getattr(part, dispatcher.step)
             if isinstance(step, Dispatcher) and id(step) not in shipped:

@@ -40,10 +40,10 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable, Protocol
 
-from multilift_sim import kernels  # noqa: F401 - sets NUMBA_CACHE_DIR, the kernels' folder
+from multilift_sim import kernels  # sets NUMBA_CACHE_DIR, the kernels' folder
 
 ENTRY_POINTS = 'multilift.parts'
-BASE_CACHE = Path(os.environ['NUMBA_CACHE_DIR'])
+BASE_CACHE = kernels.CACHE_DIR
 _entries: set[str] = set()
 
 
@@ -134,8 +134,8 @@ def load() -> None:
 
 
 class Dispatched(Protocol):
-    """A registry with a compiled dispatcher (`events.compiled`, multilift_control's
-    `controllers.compiled`)."""
+    """A registry with a compiled dispatcher (`part_dispatch.GeneratedDispatcher`,
+    multilift_control's `controllers.compiled`)."""
 
     def shipped(self) -> bool:
         """Whether it holds its shipped parts only, in their order."""

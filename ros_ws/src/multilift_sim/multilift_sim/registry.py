@@ -9,6 +9,14 @@ from collections.abc import Callable, Iterable
 from typing import Any, Iterator
 
 
+def one_of(what: str, value: Any, choices: Iterable[Any]) -> None:
+    """Unless `value` is among `choices`: ValueError naming `what`, the value and the choices
+    (one wording for every parameter that names one of some things)."""
+    choices = tuple(choices)
+    if value not in choices:
+        raise ValueError(f'unknown {what} {value!r}: one of {", ".join(map(str, choices))}')
+
+
 class Registry(dict):
     """name -> part, in registration order."""
 

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from multilift_sim.cables import CABLE_MODELS
 from multilift_sim.dynamics import initial_state_single_lift
 from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
                                               swing_about_uav_axis)
@@ -66,7 +67,7 @@ def start_lengths(scenario: Scenario) -> np.ndarray:
     sum_i T_i e_i = m_p g e_z over the unit cables e_i, solved on the unstretched hang; the
     stretch moves it by a share of k's compliance, second order)."""
     lengths = np.array([u.cable_length for u in scenario.uavs], dtype=float)
-    if scenario.cable_model != 'elastic':
+    if CABLE_MODELS[scenario.cable_model].KEEPS_LENGTH:
         return lengths
     weight = scenario.payload.mass * scenario.simulation.gravity
     if scenario.n_uavs == 1:

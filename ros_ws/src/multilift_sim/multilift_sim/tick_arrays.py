@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from multilift_sim.cables import CABLE_MODELS
 from multilift_sim.formulations import Formulation, make_formulation
 from multilift_sim.physics.layout import (STATUS_QUATERNION, STATUS_NOT_FINITE,
                                           STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
@@ -83,6 +84,7 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
     constants, in the null-space form where it says so)."""
     n = scenario.n_uavs
     sim = scenario.simulation
+    cables = CABLE_MODELS[scenario.cable_model]
     if model is None:
         model = make_formulation(sim.integrator, scenario.formation_params(),
                                  scenario.cable_model)
@@ -94,15 +96,15 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         uavs=uavs, gusts=gusts, formation=formation, allocation=allocation, actuators=actuators,
         rotor_speed_max=np.array([u.vehicle.rotor_speed_max for u in scenario.uavs]),
         cable_lengths=np.array([u.cable_length for u in scenario.uavs], dtype=float),
-        slack=scenario.cable_model == 'slack', events=event_array(scenario),
+        slack=cables.SLACKENS, events=event_array(scenario),
         wind_series=wind_series(scenario), state_size=state.size,
         sensor_models=sensors.models, sensor_constants=sensors.constants,
         sensor_draws=sensors.draws,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
-        # (elastic cables are no constraints: Algorithm 1's check of g does not apply)
+        # (cables that stretch are no constraints: Algorithm 1's check of g does not apply)
         tolerances=(np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance])
-                    if scenario.cable_model != 'elastic' else np.full(2, math.inf)),
+                    if cables.KEEPS_LENGTH else np.full(2, math.inf)),
         swing_every=swing_sampling(n), reach=cable_reach(scenario))
     memory = dict(
         state=state, taut=np.ones(n, dtype=bool), rotors=np.full(rotors, math.nan),

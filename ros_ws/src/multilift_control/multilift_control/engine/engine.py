@@ -46,13 +46,11 @@ class Engine:
         self.arrays, self._initial = batch_arrays(self.scenarios)
         self.n_uavs = self.arrays.uavs.shape[1]
         self.layout = StateLayout(self.n_uavs)
-        self._run_ticks = laws.runnable(compiled.run_ticks)
-        self._start = laws.runnable(compiled.start)
-        self._measure_all = laws.runnable(compiled.measure_all)
-        self._answer_all = laws.runnable(compiled.answer_all)
-        self._run_commanded = laws.runnable(compiled.run_commanded)
-        self._attitude_commands = laws.runnable(compiled.attitude_commands)
-        self._mission_references = laws.runnable(compiled.mission_references)
+        (self._run_ticks, self._start, self._measure_all, self._answer_all,
+         self._run_commanded, self._attitude_commands, self._mission_references) = map(
+            laws.runnable, (compiled.run_ticks, compiled.start, compiled.measure_all,
+                            compiled.answer_all, compiled.run_commanded,
+                            compiled.attitude_commands, compiled.mission_references))
         rotors = self.arrays.allocation.shape[-1]
         self._tension = np.zeros((self.batch, self.n_uavs))
         self._measured = np.empty((self.batch, self.n_uavs, UAV_STATE_SIZE))

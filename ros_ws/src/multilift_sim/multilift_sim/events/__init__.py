@@ -1,7 +1,7 @@
 """Event kinds as registered parts (issue 31): one module per kind, `EVENT_KINDS` the registry
 (name -> module) that the scenario's validation, `schedules`, the physics' tick
-(`physics.events`, through `compiled`), the messages and the summary read; nothing else names
-a kind. docs/extending.md, "An event kind", adds one.
+(`physics.events`, through the dispatcher generated from it), the messages and the summary
+read; nothing else names a kind. docs/extending.md, "An event kind", adds one.
 
 A kind's module declares:
 - `NAME`, the scenario's `type:`, and `KEYS`, its keys besides `time` and `type`;
@@ -20,19 +20,26 @@ A kind's module declares:
   cable go (plots draw the cable detached from then on).
 
 A kind's index in the registry is the row's EVENT_KIND. `register` adds one (a test's toy
-kind, at test time: `registered`); the compiled dispatcher follows (`compiled.refresh`).
+kind, at test time: `registered`); the compiled dispatcher follows (`physics.events.EVENTS`).
 """
 from __future__ import annotations
 
-import contextlib
 from types import ModuleType
-from typing import Iterator
 
 from multilift_sim.events import cable_release, controller_silence, gust, rotor_effectiveness
+from multilift_sim.registry import Registry
 
-SHIPPED: tuple[ModuleType, ...] = (rotor_effectiveness, cable_release, controller_silence, gust)
-EVENT_KINDS: dict[str, ModuleType] = {kind.NAME: kind for kind in SHIPPED}
-REQUIRED = ('NAME', 'KEYS', 'parse', 'pack', 'apply', 'describe')
+
+def _changed() -> None:
+    from multilift_sim.physics import events  # numba's side, loaded only when kinds change
+    events.EVENTS.refresh()
+
+
+EVENT_KINDS = Registry('event kind', ('NAME', 'KEYS', 'parse', 'pack', 'apply', 'describe'),
+                       (rotor_effectiveness, cable_release, controller_silence, gust),
+                       changed=_changed)
+register, unregister, registered = (EVENT_KINDS.register, EVENT_KINDS.unregister,
+                                    EVENT_KINDS.registered)
 
 
 def kind_index(name: str) -> int:
@@ -53,37 +60,3 @@ def moves_air(name: str) -> bool:
 def releases_cable(name: str) -> bool:
     """Whether kind `name` lets a cable go (`RELEASES_CABLE`: plots draw it detached)."""
     return getattr(EVENT_KINDS.get(name), 'RELEASES_CABLE', False)
-
-
-def register(kind: ModuleType) -> None:
-    """Add an event kind (a module, or any object, with REQUIRED's names) after the others."""
-    missing = [name for name in REQUIRED if not hasattr(kind, name)]
-    if missing:
-        raise ValueError(f'event kind {kind!r} lacks {", ".join(missing)}')
-    if kind.NAME in EVENT_KINDS:
-        raise ValueError(f'event kind {kind.NAME!r} is registered already')
-    EVENT_KINDS[kind.NAME] = kind
-    _changed()
-
-
-def unregister(name: str) -> None:
-    """Remove kind `name` (one `register` added)."""
-    if any(kind.NAME == name for kind in SHIPPED):
-        raise ValueError(f'event kind {name!r} ships with multilift_sim')
-    del EVENT_KINDS[name]
-    _changed()
-
-
-@contextlib.contextmanager
-def registered(kind: ModuleType) -> Iterator[ModuleType]:
-    """`kind` registered for the block (a test's toy kind)."""
-    register(kind)
-    try:
-        yield kind
-    finally:
-        unregister(kind.NAME)
-
-
-def _changed() -> None:
-    from multilift_sim.events import compiled  # numba's side, loaded only when kinds change
-    compiled.refresh()

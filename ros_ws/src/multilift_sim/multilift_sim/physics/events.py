@@ -4,17 +4,19 @@ them (a released cable no longer taut) and the period from the tick on feels the
 function, which the engine's tick and FormationSimulator both call. Rows: `physics.layout`
 EVENT_*; what each kind does: its module of `multilift_sim.events` (the registry
 EVENT_KINDS), reached through `apply_event`, the dispatcher generated from the registry
-(`multilift_sim.events.compiled`).
+(`EVENTS`, `multilift_sim.part_dispatch`).
 """
 import math
 
-from multilift_sim.events.compiled import dispatcher
+from multilift_sim import events as registry
+from multilift_sim import part_dispatch
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import EVENT_KIND, EVENT_TICK
 
-# the registry's compiled dispatcher: apply_event(kind, row, tick, effectiveness, taut,
-# released, silent_until); rebound when the registry changes (events.compiled.refresh)
-apply_event = dispatcher()
+EVENTS = part_dispatch.declare(
+    'events', 'apply_event(kind, row, tick, effectiveness, taut, released, silent_until)',
+    step='apply', caller=f'{__name__}.apply_events', parts=lambda: registry.EVENT_KINDS)
+apply_event = EVENTS.compiled()  # rebound when the registry changes (EVENTS.refresh)
 
 
 @jit

@@ -63,25 +63,14 @@ def dense_solve(a, b):
 
 @jit
 def times(a, v):
-    """a v for a (r, c), v (c,), in loops (no BLAS: loading it would import scipy)."""
+    """a v for a (r, c), v (c,), in loops (no BLAS: loading it would import scipy); a^T v as
+    times(a.T, v)."""
     out = np.zeros(a.shape[0])
     for i in range(a.shape[0]):
         total = 0.0
         for j in range(a.shape[1]):
             total += a[i, j] * v[j]
         out[i] = total
-    return out
-
-
-@jit
-def transposed_times(a, v):
-    """a^T v for a (r, c), v (r,)."""
-    out = np.zeros(a.shape[1])
-    for j in range(a.shape[1]):
-        total = 0.0
-        for i in range(a.shape[0]):
-            total += a[i, j] * v[i]
-        out[j] = total
     return out
 
 
@@ -115,34 +104,29 @@ def complete_q(a):
         for i in range(j, m):
             v[i] = r[i, j]
         v[j] -= alpha
-        length = 0.0
-        for i in range(j, m):
-            length += v[i] * v[i]
-        if length == 0.0:
-            continue
-        for c in range(j, k):  # r <- (I - 2 v v^T / |v|^2) r
-            dot = 0.0
-            for i in range(j, m):
-                dot += v[i] * r[i, c]
-            scale = 2.0 * dot / length
-            for i in range(j, m):
-                r[i, c] -= scale * v[i]
+        reflect(v, j, r, j, k)  # r <- H_j r
     q = np.eye(m)
     for j in range(k - 1, -1, -1):  # q <- H_j q, the last reflection first
-        v = vectors[j]
-        length = 0.0
-        for i in range(j, m):
-            length += v[i] * v[i]
-        if length == 0.0:
-            continue
-        for c in range(m):
-            dot = 0.0
-            for i in range(j, m):
-                dot += v[i] * q[i, c]
-            scale = 2.0 * dot / length
-            for i in range(j, m):
-                q[i, c] -= scale * v[i]
+        reflect(vectors[j], j, q, 0, m)
     return q
+
+
+@jit
+def reflect(v, j, a, first, last):
+    """a[j:, first:last] <- (I - 2 v v^T / |v|^2) a[j:, first:last], the Householder
+    reflection by v (its entries from j on); nothing for v = 0."""
+    length = 0.0
+    for i in range(j, v.shape[0]):
+        length += v[i] * v[i]
+    if length == 0.0:
+        return
+    for c in range(first, last):
+        dot = 0.0
+        for i in range(j, v.shape[0]):
+            dot += v[i] * a[i, c]
+        scale = 2.0 * dot / length
+        for i in range(j, v.shape[0]):
+            a[i, c] -= scale * v[i]
 
 
 @jit
@@ -257,8 +241,7 @@ def project(x, uavs, masses, tolerance, max_steps):
             break
         translational_jacobian(x, n, jacobian)
         weighted = jacobian / masses  # G M^-1
-        step = transposed_times(weighted, dense_solve(times_transposed(weighted, jacobian),
-                                                      residual))
+        step = times(weighted.T, dense_solve(times_transposed(weighted, jacobian), residual))
         _move_translations(x, n, 0, step)
     translational_jacobian(x, n, jacobian)
     weighted = jacobian / masses
@@ -269,8 +252,8 @@ def project(x, uavs, masses, tolerance, max_steps):
             velocities[3 * i + axis] = x[nq + r + axis]
     for axis in range(3):
         velocities[3 * n + axis] = x[nq + p + axis]
-    step = transposed_times(weighted, dense_solve(times_transposed(weighted, jacobian),
-                                                  times(jacobian, velocities)))
+    step = times(weighted.T, dense_solve(times_transposed(weighted, jacobian),
+                                         times(jacobian, velocities)))
     _move_translations(x, n, nq, step)
 
 

@@ -9,7 +9,7 @@ The package: `config` (the dataclasses), `reading` (a mapping read with checks),
 cannot fly), `files` (names, paths, load/loads). Its names are
 imported from here: `from multilift_sim import scenario as scenario_io; scenario_io.load(...)`.
 """
-from multilift_sim.scenario.config import (CABLE_MODELS,  # noqa: F401
+from multilift_sim.scenario.config import (  # noqa: F401
                                            FORMATION_GEOMETRIES, INPUT_SHAPERS,
                                            ControlConfig, EventConfig,
                                            FormationConfig, MissionConfig, MissionSegment,

@@ -19,8 +19,6 @@ class ScenarioError(ValueError):
     """A scenario that cannot be run; the message says where and why."""
 
 
-CABLE_MODELS = ('rigid', 'slack', 'elastic')  # the seed's two-way rod; pulls only
-#                 (multilift_sim.slack); a rope that stretches (physics.elastic_cables)
 # `control.payload_feedback.input_shaping` (issue 20, not in the seed): each velocity step of the
 # mission split into impulses (time in periods T of the payload's pendulum, share of the step);
 # zero residual swing of an undamped pendulum of period T: zv (Singer & Seering 1990), zvd
@@ -79,8 +77,8 @@ class PayloadConfig:
     alpha: float                     # release angle alpha of seed Eq. 2.33 [rad] (n = 1)
     beta: float                      # release angle beta of seed Eq. 2.33 [rad] (n = 1)
     swing: float                     # release angle out of the UAVs-payload plane [rad] (n = 2)
-    type: str = 'point'              # one of payload_types.PAYLOAD_TYPES
-    # rigid_body: its shape (payload_types.SHAPES) and size [m], principal inertia [kg m^2]
+    type: str = 'point'              # one of payloads.PAYLOAD_TYPES
+    # rigid_body: its shape (payloads.rigid_body.SHAPES) and size [m], principal inertia [kg m^2]
     # and each cable's attach point [m], payload frame (UAV i's cable: entry i)
     shape: str = ''
     size: tuple[float, ...] = ()
@@ -192,7 +190,8 @@ class Scenario:
     mission: MissionConfig
     formation: FormationConfig | None = None
     warnings: tuple[str, ...] = field(default=())
-    cable_model: str = 'rigid'       # one of CABLE_MODELS
+    cable_model: str = 'rigid'       # one of cables.CABLE_MODELS
+    cable: Any = None                # what its `parse_cable` read of `cable:` (None: nothing)
     events: tuple[EventConfig, ...] = ()  # in time order
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # steady wind [m/s], world
     # the wind models `wind:` names: (name, its config) (multilift_sim.wind.WIND_MODELS)
@@ -229,9 +228,9 @@ class Scenario:
             uav_attach_points=(tuple(u.attach_point for u in self.uavs)
                                if any(any(u.attach_point) for u in self.uavs) else None),
             cable_stiffness=(tuple(u.cable_stiffness for u in self.uavs)
-                             if self.cable_model == 'elastic' else None),
+                             if any(u.cable_stiffness for u in self.uavs) else None),
             cable_damping=(tuple(u.cable_damping for u in self.uavs)
-                           if self.cable_model == 'elastic' else None),
+                           if any(u.cable_stiffness for u in self.uavs) else None),
             substeps=sim.substeps,
         )
 

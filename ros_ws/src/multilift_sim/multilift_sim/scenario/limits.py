@@ -2,8 +2,9 @@
 (after `parse` has read every key): each a one-line `ScenarioError` naming the file, the key,
 the value and the rule.
 
-- A rigid payload's attach points lie on or inside its shape (`payload_types.distance_outside`,
-  within `payload_types.attach_margin`: 1 mm or 1 % of its largest dimension).
+- A rigid payload's attach points lie on or inside its shape
+  (`payloads.rigid_body.distance_outside`, within `attach_margin`: 1 mm or 1 % of its largest
+  dimension).
 - A mission segment's speed is at most MAX_MISSION_SPEED [m/s]: a generous cap (a fast
   multirotor's top speed; the seed flies 0.5 m/s), not a derived limit; a cable-carried payload
   flies well below it.
@@ -23,7 +24,7 @@ import math
 
 import numpy as np
 
-from multilift_sim.payload_types import attach_margin, distance_outside, shape_extent
+from multilift_sim.payloads.rigid_body import attach_margin, distance_outside, shape_extent
 from multilift_sim.scenario.config import Scenario, ScenarioError
 
 MAX_MISSION_SPEED = 20.0  # [m/s] a mission segment's speed, at most

@@ -12,19 +12,18 @@ from typing import Any
 from multilift_sim.wind import WIND_MODELS
 from multilift_sim.wind.gusts import Gust
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
-from multilift_sim.formulations import FORMULATIONS, SLACK_FORMULATIONS
-from multilift_sim.payload_types import (PAYLOAD_TYPES, SHAPE_SIZES, SHAPES, is_rigid_body_inertia,
-                                         solid_inertia)
+from multilift_sim.cables import CABLE_MODELS
+from multilift_sim.formulations import FORMULATIONS, unsupported
+from multilift_sim.payloads import PAYLOAD_TYPES
 from multilift_sim.events import EVENT_KINDS
 from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
-from multilift_sim.scenario.config import (CABLE_MODELS, FORMATION_GEOMETRIES,
+from multilift_sim.scenario.config import (FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
                                            MissionConfig, MissionSegment, PayloadConfig,
                                            Scenario, ScenarioError, SensorConfig,
                                            SimulationConfig, UavConfig,
                                            flies_a_period, one_period_rule)
-from multilift_sim.scenario.cables import base_rope, check_rope_stepping, uav_rope
 from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_controllers,
                                                 leader_controllers)
 from multilift_sim.scenario.limits import check_limits
@@ -41,11 +40,12 @@ def scenario_of(data: Any, where: str) -> Scenario:
     name = top.text('name')
     description = top.text('description', '')
     top.text('frame', 'world', choices=('world',))
-    cable_model = top.text('cable_model', 'rigid', choices=CABLE_MODELS)
+    cable_model = top.text('cable_model', 'rigid', choices=tuple(CABLE_MODELS))
+    cables = CABLE_MODELS[cable_model]
     # a slack cable may start with the payload above its UAV (it falls and snaps taut)
-    release_limit = 180.0 if cable_model == 'slack' else 90.0
+    release_limit = cables.RELEASE_LIMIT_DEG
     release_rule = f'must be within (-{release_limit:g}, {release_limit:g}) degrees' + (
-        '' if cable_model == 'slack' else ' (beyond 90 needs cable_model: slack)')
+        '' if release_limit > 90 else ' (beyond 90 needs cable_model: slack)')
 
     s = top.section('simulation')
     duration = s.positive('duration')
@@ -95,7 +95,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
         raise ScenarioError(f'{where}: uavs: {len(uav_list)} entries but formation.n is '
                             f'{n_formation}')
     default_cable = top.positive('cable_length') if top.has('cable_length') else ...
-    rope = base_rope(top, cable_model)  # elastic cables' keys (scenario.cables), else None
+    rope = cables.parse_cable(top)  # its `cable:` keys (an elastic rope's), else None
     uavs = []
     for i, entry in enumerate(uav_list):
         u = Section(entry, f'uavs[{i}]', where)
@@ -108,7 +108,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
             raise u.fail('position', u.data['position'],
                          'is not allowed: follower positions come from the formation geometry')
         length = u.positive('cable_length', default_cable)
-        stiffness, damping = uav_rope(u, length, rope)
+        stiffness, damping = cables.parse_uav_cable(u, length, rope)
         uavs.append(UavConfig(vehicle=vehicle, cable_length=length,
                               position=u.vector('position', [0.0, 0.0, 0.0]),
                               yaw=u.number('yaw', 0.0),
@@ -117,7 +117,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
         u.done()
 
     p = top.section('payload')
-    payload_type = p.text('type', 'point', choices=PAYLOAD_TYPES)
+    payload_type = PAYLOAD_TYPES[p.text('type', 'point', choices=tuple(PAYLOAD_TYPES))]
     payload = PayloadConfig(mass=p.positive('mass'),
                             drag_coefficient=p.non_negative('drag_coefficient', 0.0),
                             alpha=math.radians(p.number('alpha_deg', 0.0,
@@ -128,8 +128,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
                             swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
                                                         'must be within (-90, 90) degrees')))
     swing = math.degrees(payload.swing)
-    if payload_type == 'rigid_body':
-        payload = _rigid_body(p, payload, len(uavs))
+    payload = payload_type.parse(p, payload, len(uavs))
     p.done()
     if len(uavs) > 1 and (payload.alpha or payload.beta):
         raise p.fail('alpha_deg', math.degrees(payload.alpha),
@@ -211,38 +210,34 @@ def scenario_of(data: Any, where: str) -> Scenario:
                         mission=MissionConfig(start=start, segments=tuple(segments),
                                               reference_filter_time=reference_filter_time),
                         formation=formation, warnings=tuple(warnings),
-                        cable_model=cable_model, events=events, wind=tuple(wind),
+                        cable_model=cable_model, cable=rope, events=events, wind=tuple(wind),
                         wind_models=tuple(wind_models), sensors=sensors, parts=parts)
     _check_feasible(scenario)
     check_limits(scenario)
-    # what only the engine's DAE (physics/) models: refused with another formulation
+    # what the scenario uses beyond the seed's formation, each modelled by some formulations
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
-    windy = any(wind) or wind_models or any(u.vehicle.drag_coefficient
-                                                       for u in scenario.uavs)
-    rigid = payload.type == 'rigid_body'
-    off_centre = [i + 1 for i, u in enumerate(scenario.uavs) if any(u.attach_point)]
-    for used, what in ((windy, 'wind and vehicle.drag_coefficient'), (events, 'events'),
-                       (lagging, f'vehicle.motor_time_constant / motor_rate_limit '
-                                 f'(uav{lagging[0] if lagging else 0})'),
-                       (rigid, 'payload.type: rigid_body'),
-                       (off_centre,
-                        f'uavs[{off_centre[0] - 1 if off_centre else 0}].attach_point')):
-        if used and sim.integrator != 'baumgarte':
-            raise ScenarioError(f'{where}: {what} need simulation.integrator: baumgarte, got '
-                                f'{sim.integrator!r}')
-    if rigid and len(uavs) < 2:
-        raise ScenarioError(f'{where}: payload.type: rigid_body needs n >= 2 UAVs')
-    if cable_model == 'elastic':
-        if rigid or off_centre or sim.integrator != 'baumgarte':
-            raise ScenarioError(f'{where}: cable_model: elastic is for a point payload on cables '
-                                'from the UAVs\' centres, simulation.integrator: baumgarte')
-        check_rope_stepping(where, [u.cable_stiffness for u in uavs],
-                            [u.cable_damping for u in uavs], [u.vehicle.mass for u in uavs],
-                            payload.mass, sim.physics_rate, sim.substeps)
-    if cable_model == 'slack' and sim.integrator not in SLACK_FORMULATIONS:
-        raise ScenarioError(f'{where}: cable_model: slack needs simulation.integrator: '
-                            f'baumgarte, got {sim.integrator!r}')
+    off_centre = [i for i, u in enumerate(scenario.uavs) if any(u.attach_point)]
+    used = {feature: what for feature, what, uses in (
+        ('wind', 'wind and vehicle.drag_coefficient',
+         any(wind) or wind_models or any(u.vehicle.drag_coefficient for u in scenario.uavs)),
+        ('events', 'events', events),
+        ('lagging_rotors', f'vehicle.motor_time_constant / motor_rate_limit '
+                           f'(uav{lagging[0] if lagging else 0})', lagging),
+        ('attach_points', f'uavs[{off_centre[0] if off_centre else 0}].attach_point',
+         off_centre)) if uses}
+    used.update({feature: f'payload.type: {payload_type.NAME}'
+                 for feature in sorted(payload_type.NEEDS)})
+    used.update({feature: f'cable_model: {cable_model}' for feature in sorted(cables.NEEDS)})
+    refused = unsupported(sim.integrator, used)
+    if refused:
+        raise ScenarioError(f'{where}: {refused}')
+    if len(uavs) < payload_type.MIN_UAVS:
+        raise ScenarioError(f'{where}: payload.type: {payload_type.NAME} needs n >= '
+                            f'{payload_type.MIN_UAVS} UAVs')
+    refused = cables.check(scenario)
+    if refused:
+        raise ScenarioError(f'{where}: {refused}')
     return scenario
 
 
@@ -287,30 +282,6 @@ def _payload_feedback(c: Section, mode: str) -> dict[str, float]:
                             f'{mode!r}')
     feedback.done()
     return {**gains, 'input_shaping': shaping}
-
-
-def _rigid_body(p: Section, payload: PayloadConfig, n: int) -> PayloadConfig:
-    """`payload.type: rigid_body` (payload_types): its shape and size, inertia (default the
-    uniform solid's; validated as a rigid body's) and one attach point per cable."""
-    shape = p.text('shape', choices=tuple(SHAPES))
-    count = SHAPE_SIZES[shape]
-    size = p.vector('size', length=count, check=lambda v: v > 0, rule='must be > 0')
-    inertia = solid_inertia(shape, payload.mass, size)
-    if p.has('inertia'):
-        inertia = p.vector('inertia', check=lambda v: v > 0, rule='must be > 0')
-    if not is_rigid_body_inertia(inertia):
-        raise p.fail('inertia', list(inertia), 'is no rigid body\'s: each principal moment must '
-                     'be at most the sum of the other two')
-    raw = p.sequence('attach_points')
-    if len(raw) != n:
-        raise p.fail('attach_points', raw, f'must give one [x, y, z] per cable ({n})')
-    holder = Section({str(k): v for k, v in enumerate(raw)}, p.key('attach_points'), p.where)
-    points = tuple(holder.vector(str(k)) for k in range(n))
-    holder.done()
-    if payload.swing:
-        raise p.fail('swing_deg', math.degrees(payload.swing), 'is for a point payload')
-    return dataclasses.replace(payload, type='rigid_body', shape=shape, size=size,
-                               inertia=inertia, attach_points=points)
 
 
 def _sensors(d: Section, sim: SimulationConfig) -> SensorConfig:

@@ -1,7 +1,7 @@
 """Sensor models as registered parts (issue 31): one module per model, `SENSOR_MODELS` the
 registry (name -> module) that the scenario's validation (`sensors.model`, each model's keys),
 the run's arrays (`sensors.arrays`), the physics' tick (`physics.tick.measure`, through
-`sensing.sensed_states` and the dispatcher `compiled` generates), the units table and the
+`sensing.sensed_states` and the dispatcher generated from it), the units table and the
 summary read; nothing else names a model. docs/extending.md, "A sensor model", adds one.
 
 What a sensor model does: from the true measured state of a UAV (seed Eq. 2.7: position and
@@ -35,26 +35,17 @@ controllers received, and the summary's `seeds` the section's `seed` (`topics`,
 
 `register` adds one (a test's toy model, at test time: `registered`; a file a scenario names
 under `parts:`, in every process that reads it: `multilift_sim.parts`); the compiled dispatcher
-follows (`compiled.refresh`).
+follows (`sensing.SENSORS`).
 """
 from __future__ import annotations
 
-import contextlib
 from types import ModuleType
-from typing import Iterator
 
+from multilift_sim.registry import Registry
 from multilift_sim.sensors import measured_state
 
-SHIPPED: tuple[ModuleType, ...] = (measured_state,)
-SENSOR_MODELS: dict[str, ModuleType] = {model.NAME: model for model in SHIPPED}
 DEFAULT_MODEL = measured_state.NAME  # `sensors:` without `model:`
-REQUIRED = ('NAME', 'UNITS', 'parse', 'constants', 'memory', 'draws', 'measure')
 COMMON_KEYS = {'model': '', 'rate': 'Hz', 'seed': ''}  # every model's, with their units
-
-
-def model_index(name: str) -> int:
-    """The registry's index of model `name`: what the compiled dispatcher selects by."""
-    return list(SENSOR_MODELS).index(name)
 
 
 def key_units() -> dict[str, str]:
@@ -66,41 +57,28 @@ def key_units() -> dict[str, str]:
     return units
 
 
-def register(model: ModuleType) -> None:
-    """Add a sensor model (a module, or any object, with REQUIRED's names) after the others."""
-    missing = [name for name in REQUIRED if not hasattr(model, name)]
-    if missing:
-        raise ValueError(f'sensor model {model!r} lacks {", ".join(missing)}')
-    if model.NAME in SENSOR_MODELS:
-        raise ValueError(f'sensor model {model.NAME!r} is registered already')
+def _check(model: ModuleType) -> None:
+    """A new model's keys are its own or another's in the same units."""
     units = key_units()
     clash = sorted(key for key, unit in model.UNITS.items()
                    if key in COMMON_KEYS or units.get(key, unit) != unit)
     if clash:
         raise ValueError(f'sensor model {model.NAME!r}: keys {clash} are common or another '
                          'model\'s in other units')
-    SENSOR_MODELS[model.NAME] = model
-    _changed()
-
-
-def unregister(name: str) -> None:
-    """Remove model `name` (one `register` added)."""
-    if any(model.NAME == name for model in SHIPPED):
-        raise ValueError(f'sensor model {name!r} ships with multilift_sim')
-    del SENSOR_MODELS[name]
-    _changed()
-
-
-@contextlib.contextmanager
-def registered(model: ModuleType) -> Iterator[ModuleType]:
-    """`model` registered for the block (a test's toy model)."""
-    register(model)
-    try:
-        yield model
-    finally:
-        unregister(model.NAME)
 
 
 def _changed() -> None:
-    from multilift_sim.sensors import compiled  # numba's side, loaded only when models change
-    compiled.refresh()
+    from multilift_sim.sensors import sensing  # numba's side, loaded only when models change
+    sensing.SENSORS.refresh()
+
+
+SENSOR_MODELS = Registry('sensor model',
+                         ('NAME', 'UNITS', 'parse', 'constants', 'memory', 'draws', 'measure'),
+                         (measured_state,), changed=_changed, check=_check)
+register, unregister, registered = (SENSOR_MODELS.register, SENSOR_MODELS.unregister,
+                                    SENSOR_MODELS.registered)
+
+
+def model_index(name: str) -> int:
+    """The registry's index of model `name`: what the compiled dispatcher selects by."""
+    return list(SENSOR_MODELS).index(name)

@@ -3,14 +3,16 @@ models' outputs, not the state (docs/sensors.md). One compiled function, which
 `physics.tick.measure` calls for the engine's tick and `FormationSimulator.snapshot` alike, so
 the ROS nodes and the headless engine receive the same numbers to the bit. Each model is
 reached through `measure_sensor`, the dispatcher generated from the registry
-(`multilift_sim.sensors.compiled`)."""
+(`SENSORS`, `multilift_sim.part_dispatch`)."""
+from multilift_sim import part_dispatch
+from multilift_sim import sensors as registry
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import MEASURED_COLUMNS
-from multilift_sim.sensors.compiled import dispatcher
 
-# the registry's compiled dispatcher: measure_sensor(model, constants, draws, memory, tick,
-# truth, received); rebound when the registry changes (sensors.compiled.refresh)
-measure_sensor = dispatcher()
+SENSORS = part_dispatch.declare(
+    'sensors', 'measure_sensor(model, constants, draws, memory, tick, truth, received)',
+    step='measure', caller=f'{__name__}.sensed_states', parts=lambda: registry.SENSOR_MODELS)
+measure_sensor = SENSORS.compiled()  # rebound when the registry changes (SENSORS.refresh)
 
 
 @jit

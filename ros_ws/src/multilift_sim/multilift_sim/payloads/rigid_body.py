@@ -1,16 +1,17 @@
-"""The payload types a scenario can carry (`payload.type`, issue 20): the one registry, which
-scenario validation, the docs and the markers read. World frame (z up), SI units.
-
-- `point`: the seed's point mass on cables from the UAVs' centres of mass (the default).
-- `rigid_body`: a body with mass, principal inertia J_p and one attach point b_i per cable in
-  its own frame (physics.rigid_payload). Its `shape` (SHAPES) sizes the drawing and, unless
-  `inertia` is given, gives J_p as the uniform solid's.
+"""`payload.type: rigid_body` (issue 20): a body with mass, principal inertia J_p and one
+attach point b_i per cable in its own frame (physics.rigid_payload; docs/rigid_payload.md). Its
+`shape` (SHAPES) sizes the drawing and, unless `inertia` is given, gives J_p as the uniform
+solid's. World frame (z up), SI units.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+from typing import Any
 
-PAYLOAD_TYPES = ('point', 'rigid_body')
+NAME = 'rigid_body'
+NEEDS = frozenset({'rigid_body'})
+MIN_UAVS = 2  # one cable cannot hold a body's attitude
 
 # a rigid body's shapes: name -> what `size` lists [m]
 SHAPES = {'box': 'its edges along the payload frame x, y, z',
@@ -73,3 +74,27 @@ def distance_outside(shape: str, size: tuple[float, ...], point: tuple[float, ..
         length, radius = size
         return math.hypot(max(abs(x) - length / 2.0, 0.0), max(math.hypot(y, z) - radius, 0.0))
     raise ValueError(f'unknown payload shape {shape!r} (known: {", ".join(SHAPES)})')
+
+
+def parse(p: Any, payload: Any, n: int) -> Any:
+    """The body's keys of `payload:` (`p` a reading.Section) over `payload` (a
+    scenario.PayloadConfig) for n cables: its shape and size, inertia (default the uniform
+    solid's; validated as a rigid body's) and one attach point per cable."""
+    shape = p.text('shape', choices=tuple(SHAPES))
+    size = p.vector('size', length=SHAPE_SIZES[shape], check=lambda v: v > 0, rule='must be > 0')
+    inertia = solid_inertia(shape, payload.mass, size)
+    if p.has('inertia'):
+        inertia = p.vector('inertia', check=lambda v: v > 0, rule='must be > 0')
+    if not is_rigid_body_inertia(inertia):
+        raise p.fail('inertia', list(inertia), 'is no rigid body\'s: each principal moment must '
+                     'be at most the sum of the other two')
+    raw = p.sequence('attach_points')
+    if len(raw) != n:
+        raise p.fail('attach_points', raw, f'must give one [x, y, z] per cable ({n})')
+    holder = type(p)({str(k): v for k, v in enumerate(raw)}, p.key('attach_points'), p.where)
+    points = tuple(holder.vector(str(k)) for k in range(n))
+    holder.done()
+    if payload.swing:
+        raise p.fail('swing_deg', math.degrees(payload.swing), 'is for a point payload')
+    return dataclasses.replace(payload, type=NAME, shape=shape, size=size, inertia=inertia,
+                               attach_points=points)

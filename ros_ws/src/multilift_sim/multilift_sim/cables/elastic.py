@@ -10,8 +10,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from multilift_sim.scenario.config import ScenarioError
-from multilift_sim.scenario.reading import Section
+NAME = 'elastic'
+NEEDS = frozenset({'elastic'})
+RELEASE_LIMIT_DEG = 90.0
+KEEPS_LENGTH = False  # a rope stretches: no constraint g_i = 0, no check of it
+SLACKENS = False      # (a rope shorter than its rest length pulls nothing: its tension law)
 
 ROPE_KEYS = ('stiffness', 'axial_stiffness', 'damping')
 # the largest omega h [-] an elastic formation is stepped at (omega its fastest mode's bound,
@@ -20,34 +23,35 @@ ROPE_KEYS = ('stiffness', 'axial_stiffness', 'damping')
 ELASTIC_OMEGA_H = 0.5
 
 
-def base_rope(top: Section, cable_model: str) -> dict[str, Any] | None:
-    """The `cable:` section's keys (None unless the cables are elastic; ScenarioError for a
-    `cable:` section with other cable models)."""
-    if cable_model != 'elastic':
-        if top.has('cable'):
-            raise top.fail('cable', top.data['cable'], 'needs cable_model: elastic')
-        return None
+def parse_cable(top: Any) -> dict[str, Any]:
+    """The `cable:` section's keys (`top` the scenario's reading.Section)."""
     return _rope_keys(top.section('cable', {}), None)
 
 
-def uav_rope(u: Section, length: float, base: dict[str, Any] | None) -> tuple[float, float]:
-    """UAV i's cable's (k [N/m], c [N s/m]) from its `cable:` over `base`; (0, 0) for a
-    cable that is not elastic (base None)."""
-    if base is None:
-        if u.has('cable'):
-            raise u.fail('cable', u.data['cable'], 'needs cable_model: elastic')
-        return 0.0, 0.0
+def parse_uav_cable(u: Any, length: float, base: dict[str, Any]) -> tuple[float, float]:
+    """UAV i's cable's (k [N/m], c [N s/m]) from its `cable:` over `base`."""
     keys = _rope_keys(u.section('cable', {}), base)
     if keys['stiffness'] is None and keys['axial_stiffness'] is None:
-        raise ScenarioError(f'{u.where}: cable.stiffness: missing key (cable_model: elastic '
-                            'needs stiffness [N/m] or axial_stiffness [N], in cable: or '
-                            f'{u.key("cable")})')
+        raise u.fail('cable', u.data.get('cable', {}), 'needs stiffness [N/m] or '
+                     'axial_stiffness [N] (cable_model: elastic), here or in cable:')
     stiffness = keys['stiffness'] if keys['stiffness'] is not None else \
         keys['axial_stiffness'] / length
     return stiffness, keys['damping']
 
 
-def _rope_keys(sec: Section, base: dict[str, Any] | None) -> dict[str, Any]:
+def check(scenario: Any) -> str | None:
+    """A point payload on cables from the UAVs' centres, the ropes stepped at omega h <=
+    ELASTIC_OMEGA_H (`rope_stepping`)."""
+    if scenario.payload.type != 'point' or any(any(u.attach_point) for u in scenario.uavs):
+        return ('cable_model: elastic is for a point payload on cables from the UAVs\' '
+                'centres')
+    uavs, sim = scenario.uavs, scenario.simulation
+    return rope_stepping([u.cable_stiffness for u in uavs], [u.cable_damping for u in uavs],
+                         [u.vehicle.mass for u in uavs], scenario.payload.mass,
+                         sim.physics_rate, sim.substeps)
+
+
+def _rope_keys(sec: Any, base: dict[str, Any] | None) -> dict[str, Any]:
     if sec.has('stiffness') and sec.has('axial_stiffness'):
         raise sec.fail('axial_stiffness', sec.data['axial_stiffness'],
                        'goes without stiffness: give one of them')
@@ -72,16 +76,16 @@ def rope_rate(stiffness, damping, masses, payload_mass: float) -> float:
     return math.sqrt(omega_sq) + decay
 
 
-def check_rope_stepping(where: str, stiffness, damping, masses, payload_mass: float,
-                        physics_rate: float, substeps: int) -> None:
-    """ScenarioError (one line: the sub-steps or rate needed) unless the ropes are stepped at
-    omega h <= ELASTIC_OMEGA_H."""
+def rope_stepping(stiffness, damping, masses, payload_mass: float, physics_rate: float,
+                  substeps: int) -> str | None:
+    """One line naming the sub-steps or rate needed unless the ropes are stepped at
+    omega h <= ELASTIC_OMEGA_H (None then)."""
     rate = rope_rate(stiffness, damping, masses, payload_mass)
     omega_h = rate / (physics_rate * substeps)
-    if omega_h > ELASTIC_OMEGA_H:
-        needed = math.ceil(rate / (physics_rate * ELASTIC_OMEGA_H))
-        raise ScenarioError(
-            f'{where}: simulation.substeps: {substeps} steps the elastic cables at omega h = '
+    if omega_h <= ELASTIC_OMEGA_H:
+        return None
+    needed = math.ceil(rate / (physics_rate * ELASTIC_OMEGA_H))
+    return (f'simulation.substeps: {substeps} steps the elastic cables at omega h = '
             f'{omega_h:.2f} (their fastest mode is bounded by {rate:.0f} rad/s), beyond '
             f'{ELASTIC_OMEGA_H}: set simulation.substeps >= {needed} (or physics_rate >= '
             f'{rate / ELASTIC_OMEGA_H / substeps:.0f} Hz)')

@@ -108,7 +108,9 @@ REORGANIZE_MAX_RATE = FOLLOWER_SIZE + 3       # largest speed of a follower's of
 REORGANIZE_FLOOR = FOLLOWER_SIZE + 4          # thrust margin floor [-]
 REORGANIZE_GAIN = FOLLOWER_SIZE + 5           # offset rate per unit of cost gradient [m^2/s]
 REORGANIZE_FILTER_TIME = FOLLOWER_SIZE + 6    # the apparent gravity's low-pass time [s]
-REORGANIZE_UAVS = FOLLOWER_SIZE + 7           # then a row of REORGANIZE_UAV_SIZE per UAV:
+REORGANIZE_RADIUS = FOLLOWER_SIZE + 7         # cable_forces: the UAVs' horizontal distance
+#                                               from the payload at the start [m]
+REORGANIZE_UAVS = FOLLOWER_SIZE + 8           # then a row of REORGANIZE_UAV_SIZE per UAV:
 REORGANIZE_UAV_MASS = 0                       # its vehicle's mass m_i [kg]
 REORGANIZE_UAV_LARGEST = 1                    # u_T,max,i, every rotor at its limit [N]
 REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]

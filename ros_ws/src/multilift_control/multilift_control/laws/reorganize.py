@@ -23,7 +23,8 @@ from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_LAST_T, RO
                                            REORGANIZE_FILTER_TIME, REORGANIZE_FLOOR,
                                            REORGANIZE_GAIN, REORGANIZE_MAX_RATE,
                                            REORGANIZE_MAX_SPREAD, REORGANIZE_MIN_SPACING,
-                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_SHIFT,
+                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_RADIUS,
+                                           REORGANIZE_SHIFT,
                                            REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_LENGTH,
                                            REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
                                            REORGANIZE_UAVS)
@@ -36,6 +37,8 @@ STEP = 1e-3          # the cost's gradient by central differences of this step [
 # the least tension a cable keeps, as a share of m_p |g e_z + a| / n [-]: an unloaded cable
 # is one gust from slack (which the rigid-cable formulations cannot fly)
 LEAST_TENSION_SHARE = 0.25
+SHARE_MARGIN = 0.02  # cable_forces: every share at most 1/2 less this [-]
+REORGANIZE_COUNT = 3  # cable_forces allocates three cables in closed form
 
 
 @jit
@@ -204,19 +207,13 @@ def within_limits(places, min_spacing, max_spread):
 
 
 @jit
-def reorganize(constants, memory, t, masses, rows, targets, vectors):
-    """One tick's step at t [s] of the shift of the rows' targets in memory (REORGANIZE_SHIFT),
-    returned as the targets the follower keeps (targets + shift, (m,) [m]): the apparent
-    gravity g e_z + a low-passed (a = sum_i lift_i / sum_i m_i - g e_z, vectors (n, 3) the
-    lifts [N], masses the hover masses [kg]), the cost's gradient over the followers'
-    horizontal places, each follower's rate -REORGANIZE_GAIN grad clipped to
-    REORGANIZE_MAX_RATE, the step taken when its places keep the limits and the payload
-    hangs. Call before `follower_update`, which advances FOLLOWER_LAST_T."""
+def filtered_gravity(constants, memory, dt, masses, vectors):
+    """The formation's apparent gravity g e_z + a (3,) [m/s^2], a low-passed in memory
+    (REORGANIZE_ACCELERATION, time constant REORGANIZE_FILTER_TIME) from
+    a = sum_i lift_i / sum_i m_i - g e_z (vectors (n, 3) the lifts [N], masses the hover masses
+    [kg]) over dt [s]."""
     n = vectors.shape[0]
-    m = rows.shape[0]
     gravity = constants[FOLLOWER_GRAVITY]
-    last = memory[FOLLOWER_LAST_T]
-    dt = 0.0 if math.isnan(last) else max(t - last, 0.0)
     total = 0.0
     for j in range(n):
         total += masses[j]
@@ -229,35 +226,136 @@ def reorganize(constants, memory, t, masses, rows, targets, vectors):
         memory[REORGANIZE_ACCELERATION + d] += blend * (a - memory[REORGANIZE_ACCELERATION + d])
     effective = memory[REORGANIZE_ACCELERATION:REORGANIZE_ACCELERATION + 3].copy()
     effective[2] += gravity
-    shift = memory[REORGANIZE_SHIFT:REORGANIZE_SHIFT + m]
-    places = target_places(rows, targets, shift, n)
-    floor = constants[REORGANIZE_FLOOR]
-    if dt > 0.0:
-        moved = places.copy()
-        for j in range(1, n):
-            rate = np.zeros(2)
-            for d in range(2):
-                probe = places.copy()
-                probe[j, d] += STEP
-                ahead = margin_cost(static_margins(constants, probe, effective), floor)
-                probe[j, d] -= 2.0 * STEP
-                behind = margin_cost(static_margins(constants, probe, effective), floor)
-                rate[d] = -constants[REORGANIZE_GAIN] * (ahead - behind) / (2.0 * STEP)
-            speed = math.sqrt(rate[0] ** 2 + rate[1] ** 2)
-            limit = constants[REORGANIZE_MAX_RATE]
-            scale = limit / speed if speed > limit else 1.0
-            if not math.isfinite(speed):
-                scale = 0.0
-            for d in range(2):
-                moved[j, d] += scale * rate[d] * dt
-        if within_limits(moved, constants[REORGANIZE_MIN_SPACING],
-                         constants[REORGANIZE_MAX_SPREAD]) \
-                and math.isfinite(margin_cost(static_margins(constants, moved, effective),
-                                              floor)):
-            for k in range(m):
-                if rows[k, ROW_FIRST] == 0 and 0 <= rows[k, ROW_AXIS] < 2:
-                    shift[k] = -moved[rows[k, ROW_SECOND], rows[k, ROW_AXIS]] - targets[k]
+    return effective
+
+
+@jit
+def _elapsed(memory, t):
+    last = memory[FOLLOWER_LAST_T]
+    return 0.0 if math.isnan(last) else max(t - last, 0.0)
+
+
+@jit
+def _kept(rows, targets, shift, constants, effective, places, moved):
+    """Take `moved` (the shift of its x, y rows) when it keeps the limits and the statics;
+    returns targets + shift (m,)."""
+    m = rows.shape[0]
+    if within_limits(moved, constants[REORGANIZE_MIN_SPACING],
+                     constants[REORGANIZE_MAX_SPREAD]) \
+            and math.isfinite(margin_cost(static_margins(constants, moved, effective), 0.0)):
+        for k in range(m):
+            if rows[k, ROW_FIRST] == 0 and 0 <= rows[k, ROW_AXIS] < 2:
+                shift[k] = -moved[rows[k, ROW_SECOND], rows[k, ROW_AXIS]] - targets[k]
     kept = np.empty(m)
     for k in range(m):
         kept[k] = targets[k] + shift[k]
     return kept
+
+
+@jit
+def reorganize(constants, memory, t, masses, rows, targets, vectors):
+    """One tick's step at t [s] of the shift of the rows' targets in memory (REORGANIZE_SHIFT),
+    returned as the targets the follower keeps (targets + shift, (m,) [m]): the apparent
+    gravity (`filtered_gravity`), the cost's gradient over the followers' horizontal places,
+    each follower's rate -REORGANIZE_GAIN grad clipped to REORGANIZE_MAX_RATE, the step taken
+    when its places keep the limits and the payload hangs. Call before `follower_update`,
+    which advances FOLLOWER_LAST_T."""
+    n = vectors.shape[0]
+    m = rows.shape[0]
+    dt = _elapsed(memory, t)
+    effective = filtered_gravity(constants, memory, dt, masses, vectors)
+    shift = memory[REORGANIZE_SHIFT:REORGANIZE_SHIFT + m]
+    places = target_places(rows, targets, shift, n)
+    floor = constants[REORGANIZE_FLOOR]
+    moved = places.copy()
+    for j in range(1, n):
+        rate = np.zeros(2)
+        for d in range(2):
+            probe = places.copy()
+            probe[j, d] += STEP
+            ahead = margin_cost(static_margins(constants, probe, effective), floor)
+            probe[j, d] -= 2.0 * STEP
+            behind = margin_cost(static_margins(constants, probe, effective), floor)
+            rate[d] = -constants[REORGANIZE_GAIN] * (ahead - behind) / (2.0 * STEP)
+        speed = math.sqrt(rate[0] ** 2 + rate[1] ** 2)
+        limit = constants[REORGANIZE_MAX_RATE]
+        scale = limit / speed if speed > limit else 1.0
+        if not math.isfinite(speed):
+            scale = 0.0
+        for d in range(2):
+            moved[j, d] += scale * rate[d] * dt
+    if dt == 0.0:
+        moved = places
+    return _kept(rows, targets, shift, constants, effective, places, moved)
+
+
+@jit
+def load_shares(constants, effective):
+    """Each cable's share s_i (n,) of the payload's apparent weight that gives every UAV the
+    same thrust utilisation (m_i |g_eff| + s_i m_p |g_eff|) / u_T,max,i (the least effort under
+    the thrust limits: the largest utilisation least), the cable's vertical pull counted as
+    its tension, clipped to [LEAST_TENSION_SHARE / n, 1/2 - SHARE_MARGIN] (a triangle of forces
+    exists only with every share below 1/2) and renormalised."""
+    n = REORGANIZE_COUNT
+    weight = math.sqrt(effective[0] ** 2 + effective[1] ** 2 + effective[2] ** 2)
+    load = constants[REORGANIZE_PAYLOAD_MASS] * weight
+    largest = np.empty(n)
+    own = np.empty(n)
+    for j in range(n):
+        row = REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j
+        largest[j] = constants[row + REORGANIZE_UAV_LARGEST]
+        own[j] = constants[row + REORGANIZE_UAV_MASS] * weight
+    utilisation = (load + own.sum()) / largest.sum()
+    shares = (utilisation * largest - own) / load
+    low, high = LEAST_TENSION_SHARE / n, 0.5 - SHARE_MARGIN
+    for _ in range(4):
+        for j in range(n):
+            shares[j] = min(max(shares[j], low), high)
+        shares /= shares.sum()
+    return shares
+
+
+@jit
+def allocated_places(constants, effective):
+    """The three UAVs' places relative to the leader (3, 3) [m] where their cables carry
+    `load_shares`: level UAVs on equal cables at REORGANIZE_RADIUS from the point below which
+    the payload hangs, in directions u_i with sum s_i u_i = 0 (the horizontal balance), the
+    leader ahead (+x) and UAV 2 on its left (+y) as in the V: the triangle of forces of sides
+    s_1, s_2, s_3, the angle between u_1 and u_2 by the law of cosines."""
+    s = load_shares(constants, effective)
+    cosine = (s[2] ** 2 - s[0] ** 2 - s[1] ** 2) / (2.0 * s[0] * s[1])
+    cosine = min(max(cosine, -1.0), 1.0)
+    sine = math.sqrt(1.0 - cosine * cosine)
+    units = np.zeros((3, 3))
+    units[0, 0] = 1.0
+    units[1, 0], units[1, 1] = cosine, sine
+    for d in range(2):
+        units[2, d] = -(s[0] * units[0, d] + s[1] * units[1, d]) / s[2]
+    places = np.zeros((3, 3))
+    radius = constants[REORGANIZE_RADIUS]
+    for j in range(3):
+        for d in range(2):
+            places[j, d] = radius * (units[j, d] - units[0, d])
+    return places
+
+
+@jit
+def allocate(constants, memory, t, masses, rows, targets, vectors):
+    """`reorganize`'s tick for `formation.reorganize: cable_forces` (three UAVs, a point
+    payload): the followers' places move towards `allocated_places` at the apparent gravity,
+    each at most REORGANIZE_MAX_RATE, within the limits; returns targets + shift (m,) [m]."""
+    n = vectors.shape[0]
+    m = rows.shape[0]
+    dt = _elapsed(memory, t)
+    effective = filtered_gravity(constants, memory, dt, masses, vectors)
+    shift = memory[REORGANIZE_SHIFT:REORGANIZE_SHIFT + m]
+    places = target_places(rows, targets, shift, n)
+    wanted = allocated_places(constants, effective)
+    moved = places.copy()
+    for j in range(1, n):
+        gap = math.sqrt((wanted[j, 0] - places[j, 0]) ** 2 + (wanted[j, 1] - places[j, 1]) ** 2)
+        step = constants[REORGANIZE_MAX_RATE] * dt
+        scale = 1.0 if gap <= step else step / gap
+        for d in range(2):
+            moved[j, d] += scale * (wanted[j, d] - places[j, d])
+    return _kept(rows, targets, shift, constants, effective, places, moved)

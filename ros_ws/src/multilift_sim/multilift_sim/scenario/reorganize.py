@@ -1,9 +1,11 @@
 """The keys of a formation that reorganises to share its payload (issue 35 item 2; the law:
 multilift_control's follower `thrust_margin`, `laws.reorganize`), read and checked once:
 
-- `formation.reorganize`: `none` (the seed's fixed geometry, the default) or `thrust_margin`
+- `formation.reorganize`: `none` (the seed's fixed geometry, the default), `thrust_margin`
   (the followers' horizontal offsets move online so that the UAVs' thrust margins stay even,
-  or above the floor); needs a linear or V formation of two UAVs or more;
+  or above the floor) or `cable_forces` (they move where the cables carry the shares that give
+  every UAV the same share of its largest thrust: three UAVs); needs a linear or V formation
+  of two UAVs or more;
 - `formation.min_spacing` [m] (default 1.0): the least horizontal distance between two UAVs;
   a point payload's cables meet at the payload, so their spacing grows with the UAVs';
 - `formation.max_spread` [m] (default: none): the largest horizontal distance between two UAVs;
@@ -20,8 +22,7 @@ from typing import Any
 from multilift_sim.scenario.config import ScenarioError
 from multilift_sim.scenario.reading import Section
 
-REORGANIZE = ('none', 'thrust_margin')
-REORGANIZING_FOLLOWER = 'thrust_margin'  # control.follower of `reorganize: thrust_margin`
+REORGANIZE = ('none', 'thrust_margin', 'cable_forces')  # each a follower of that name
 
 
 def parse(f: Section, n: int, geometry: str) -> dict[str, Any]:
@@ -29,6 +30,8 @@ def parse(f: Section, n: int, geometry: str) -> dict[str, Any]:
     kind = f.text('reorganize', 'none', choices=REORGANIZE)
     if kind != 'none' and n < 2:
         raise f.fail('reorganize', kind, 'needs a formation of two UAVs or more (n = 1)')
+    if kind == 'cable_forces' and n != 3:
+        raise f.fail('reorganize', kind, f'allocates three cables in closed form, not {n}')
     if kind != 'none' and geometry not in ('v', 'linear'):
         raise f.fail('reorganize', kind, f'moves linear or V offsets, not a {geometry!r} '
                                          'formation')
@@ -46,16 +49,15 @@ def parse(f: Section, n: int, geometry: str) -> dict[str, Any]:
 
 
 def control_of(c: Section, formation, control):
-    """The control section's config with the reorganising follower when the formation
-    reorganises (`control.follower` must then be left out or be that follower)."""
-    reorganizes = formation is not None and formation.reorganize != 'none'
-    if reorganizes == (control.follower == REORGANIZING_FOLLOWER):
+    """The control section's config with the follower of `formation.reorganize` when the
+    formation reorganises (`control.follower` must then be left out or be that follower)."""
+    kind = 'none' if formation is None else formation.reorganize
+    if control.follower == kind or (kind == 'none' and control.follower not in REORGANIZE):
         return control
-    if reorganizes and not c.has('follower'):
-        return dataclasses.replace(control, follower=REORGANIZING_FOLLOWER)
+    if kind != 'none' and not c.has('follower'):
+        return dataclasses.replace(control, follower=kind)
     raise c.fail('follower', control.follower,
-                 f'must be {REORGANIZING_FOLLOWER!r} exactly when formation.reorganize is '
-                 f'thrust_margin')
+                 f'must be the follower of formation.reorganize ({kind!r}) or left out')
 
 
 def check_start(source: str, formation, uavs) -> None:

@@ -19,12 +19,14 @@ from multilift_control.laws.follower import follower_update, formation_terms
 from multilift_control.laws.layout import (REORGANIZE_FILTER_TIME, REORGANIZE_FLOOR,
                                            REORGANIZE_GAIN, REORGANIZE_MAX_RATE,
                                            REORGANIZE_MAX_SPREAD, REORGANIZE_MIN_SPACING,
-                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_SHIFT,
+                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_RADIUS,
+                                           REORGANIZE_SHIFT,
                                            REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_LENGTH,
                                            REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
                                            REORGANIZE_UAVS)
 from multilift_control.laws.reorganize import reorganize
 from multilift_sim.scenario import Scenario
+from multilift_sim.start import formation_start
 
 NAME = 'thrust_margin'
 KEYS = ()  # its keys are the formation section's (formation.reorganize and its limits)
@@ -47,6 +49,8 @@ def arrays(scenario: Scenario, index: int
     own[REORGANIZE_FLOOR] = f.thrust_margin_floor
     own[REORGANIZE_GAIN] = GAIN
     own[REORGANIZE_FILTER_TIME] = FILTER_TIME
+    uavs, payload = formation_start(scenario)  # where the formation hangs at the start
+    own[REORGANIZE_RADIUS] = float(np.mean(np.hypot(*(uavs[:, :2] - payload[:2]).T)))
     for j, uav in enumerate(scenario.uavs):
         row = REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j
         own[row + REORGANIZE_UAV_MASS] = uav.vehicle.mass

@@ -1,5 +1,5 @@
-"""The reorganising V (`formation.reorganize: thrust_margin`, v3_mixed) flies through ROS as
-headless: each follower node steps its own copy of the formation's moving offsets from the
+"""The reorganising V (`formation.reorganize: thrust_margin` and `cable_forces`, v3_mixed)
+flies through ROS as headless: each follower node steps its own copy of the formation's moving offsets from the
 states and lifts it is sent, and the followers agree with the engine's one tick to 1e-9 m."""
 from __future__ import annotations
 
@@ -7,14 +7,17 @@ import os
 import subprocess
 
 import numpy as np
+import pytest
 import yaml
 
 from conftest import ROOT, SCENARIOS, next_domain
 from multilift_tools.bagdata import load_run
 
 
-def test_a_reorganising_v_flies_alike_through_ros_and_headless(tmp_path):
+@pytest.mark.parametrize('reorganize', ['thrust_margin', 'cable_forces'])
+def test_a_reorganising_v_flies_alike_through_ros_and_headless(tmp_path, reorganize):
     data = yaml.safe_load((SCENARIOS / 'v3_mixed.yaml').read_text())
+    data['formation']['reorganize'] = reorganize
     data['simulation']['duration'] = 14.0  # its hover (it reorganises) and the climb's start
     path = tmp_path / 'v3_mixed_short.yaml'
     path.write_text(yaml.safe_dump(data))

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+import yaml
 
 from multilift_control import laws
 from multilift_control.controllers import LeaderController
@@ -127,6 +128,13 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
     shaped = [MissionPath(mission, INPUT_SHAPERS['zvd'], 6.4)  # control.payload_feedback
               for mission in (twin.mission, raw_mission)]
     paths = (leader.path, raw, *shaped)
+    waypoints = MissionPath(scenario_io.loads(yaml.safe_dump(dict(
+        yaml.safe_load((scenario_io.scenario_dir() / 'single_lift.yaml').read_text()),
+        mission={'type': 'waypoints', 'waypoints': [
+            {'time': 0.0, 'position': [0.0, 0.0, 0.0]},
+            {'time': 4.0, 'position': [1.0, 0.5, 0.5], 'yaw': 0.3},
+            {'time': 9.0, 'position': [2.0, -1.0, 0.5]},
+            {'time': 12.0, 'position': [0.0, 0.0, 1.0], 'yaw': -0.4}]}))).mission)
     followers = _followers()
     memories = {id(f): f.memory.copy() for f, _ in followers}
     cascade_memory = leader.cascade.memory.copy()
@@ -141,6 +149,11 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
             check(reference.raw_reference, path.mission, path.segments, moment,
                   np.empty(REFERENCE_SIZE))
             check(reference.mission_reference, path.mission, path.segments, path.steps, moment)
+        moment = float(rng.uniform(-2.0, 14.0))  # a waypoints mission (a polynomial's pieces)
+        check(reference.polynomial_reference, waypoints.mission, waypoints.segments, moment,
+              np.empty(REFERENCE_SIZE))
+        check(reference.mission_reference, waypoints.mission, waypoints.segments,
+              waypoints.steps, moment)
         state = _states(rng, np.zeros((1, 3)), spread)[0]
         ref = (40.0 if far else 0.01) * rng.normal(size=REFERENCE_SIZE)
         ref[0] += 200.0 if far else 0.0  # an error that lasts: the integral clamps

@@ -202,6 +202,15 @@ def test_a_circle_cannot_reorganise(tmp_path):
         scenario_io.load(str(path))
 
 
+def test_cable_forces_allocates_three_cables_only(tmp_path):
+    data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
+    data['formation']['reorganize'] = 'cable_forces'
+    path = tmp_path / 'twin.yaml'
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ScenarioError, match='allocates three cables in closed form, not 2'):
+        scenario_io.load(str(path))
+
+
 def test_a_formation_of_one_cannot_reorganise_and_the_command_says_so(tmp_path, capsys):
     data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
     data['formation'] = {'geometry': 'v', 'distance': 4.0, 'half_angle_deg': 30.0,

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Sequence
 
+from multilift_control.laws.layout import REFERENCE_ACCELERATION, REFERENCE_POSITION
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.wire import cdr
 from multilift_sim.wire.msgvalues import uav_frame
@@ -57,7 +58,9 @@ class AnswerMessages:
         messages = self.command_of(index, t_ns, speeds, saturated)
         messages.append((setpoint_topic, setpoint_packer.pack(t_ns, *setpoint, thrust)))
         if reference is not None:
-            messages.append((ref_topic, self._reference.pack(t_ns, *reference)))
+            # the message's 9 numbers: the heading is the setpoint's yaw
+            messages.append((ref_topic, self._reference.pack(
+                t_ns, *reference[REFERENCE_POSITION:REFERENCE_ACCELERATION + 3])))
         if errors is not None:
             rows = len(errors)
             packer = self._errors.get(rows)

@@ -132,12 +132,13 @@ def fly(scenario: Scenario, progress: Callable[[float, float], None] | None = No
     return run
 
 
-def fly_batch(scenarios: list[Scenario]) -> list[FlownRun]:
-    """Fly scenarios of one shape (`engine.arrays.shape_groups`) to their t_max together, one
-    engine batch, each to the numbers it gets alone (tests/unit/test_engine.py); a run Algorithm
-    1 stops has `error` set. Each run's wall time is its share of the batch's."""
+def fly_batch(scenarios: list[Scenario], fields: list | None = None) -> list[FlownRun]:
+    """Fly scenarios of one shape (`engine.arrays.shape_groups`, which gives their `fields`)
+    to their t_max together, one engine batch, each to the numbers it gets alone
+    (tests/unit/test_engine.py); a run Algorithm 1 stops has `error` set. Each run's wall time
+    is its share of the batch's."""
     start = time.monotonic()
-    engine = Engine(scenarios)
+    engine = Engine(scenarios, fields=fields)
     engine.step(int(engine.arrays.tick_count.max()))
     share = (time.monotonic() - start) / len(scenarios)
     return [FlownRun(s, engine, b, share) for b, s in enumerate(scenarios)]

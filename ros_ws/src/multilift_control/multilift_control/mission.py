@@ -1,19 +1,25 @@
-"""The leader's mission path (seed §4.2): piecewise-constant velocity segments, world frame."""
+"""The leader's mission path: the arrays of the compiled reference (`laws.reference`) built from
+the scenario's mission source (multilift_sim.missions: the seed's velocity segments, §4.2, or a
+piecewise polynomial), world frame."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from multilift_control import laws
-from multilift_control.laws.layout import (MISSION_FINAL, MISSION_OMEGA, MISSION_SHAPED,
-                                           MISSION_SIZE,
-                                           MISSION_START, REFERENCE_ACCELERATION,
-                                           REFERENCE_POSITION, REFERENCE_VELOCITY,
+from multilift_control.laws.layout import (FORM_POLYNOMIAL, FORM_VELOCITY_SEGMENTS,
+                                           MISSION_FINAL, MISSION_FORM, MISSION_OMEGA,
+                                           MISSION_SHAPED, MISSION_SIZE, MISSION_START,
+                                           PIECE_AXES, PIECE_COEFFICIENTS, PIECE_END_TIME,
+                                           PIECE_ORDER, PIECE_SIZE, PIECE_START_TIME,
+                                           REFERENCE_ACCELERATION, REFERENCE_POSITION,
+                                           REFERENCE_VELOCITY, REFERENCE_YAW,
                                            SEGMENT_END_TIME, SEGMENT_ORIGIN, SEGMENT_SIZE,
                                            SEGMENT_START_TIME, SEGMENT_VELOCITY, STEP_DV,
                                            STEP_SIZE, STEP_TIME)
 from multilift_control.laws.reference import mission_reference
+from multilift_sim.missions import FORMS, source_of
 from multilift_sim.scenario import MissionConfig
 
 
@@ -23,13 +29,15 @@ class Reference:
     position: np.ndarray      # [m]
     velocity: np.ndarray      # [m/s]
     acceleration: np.ndarray  # [m/s^2]
+    yaw: float = 0.0          # heading [rad]
 
     @classmethod
     def of(cls, row: np.ndarray) -> Reference:
         """The reference in a law's REFERENCE_* slots."""
         return cls(row[REFERENCE_POSITION:REFERENCE_POSITION + 3],
                    row[REFERENCE_VELOCITY:REFERENCE_VELOCITY + 3],
-                   row[REFERENCE_ACCELERATION:REFERENCE_ACCELERATION + 3])
+                   row[REFERENCE_ACCELERATION:REFERENCE_ACCELERATION + 3],
+                   float(row[REFERENCE_YAW]))
 
 
 class MissionPath:
@@ -53,10 +61,49 @@ class MissionPath:
     acceleration is left at rest after the last impulse, whatever the filter after it.
 
     `mission`, `segments`, `steps`: the law's arrays (MISSION_*, SEGMENT_*, STEP_* slots).
+
+    A source of the `polynomial` form (`mission.type` waypoints, file): `segments` holds its
+    pieces (PIECE_* slots), `steps` is empty, MISSION_FORM is FORM_POLYNOMIAL; no filter, no
+    shaper (validation refuses them).
+
+    With `offset` (3,) [m], world, every position of the path is moved by it (the velocities
+    and accelerations are the path's): `mission.tracks: payload`, whose path is the payload's,
+    flown by the leader at its offset from the payload at the formation's hanging rest
+    (`controllers.tracked_offset`).
     """
 
     def __init__(self, mission: MissionConfig,
-                 shaper: tuple[tuple[float, float], ...] = ((0.0, 1.0),), period: float = 0.0):
+                 shaper: tuple[tuple[float, float], ...] = ((0.0, 1.0),), period: float = 0.0,
+                 offset: np.ndarray | None = None):
+        if offset is not None:
+            mission = shifted(mission, np.asarray(offset, dtype=float))
+        form = FORMS.index(source_of(mission).FORM)
+        if form == FORM_POLYNOMIAL:
+            self._polynomial(mission)
+        else:
+            self._segments(mission, shaper, period)
+        self.mission[MISSION_FORM] = float(form)
+        for array in (self.mission, self.segments, self.steps):
+            array.flags.writeable = False
+        self._law = laws.runnable(mission_reference)
+
+    def _polynomial(self, mission: MissionConfig) -> None:
+        coefficients = np.asarray(mission.coefficients, dtype=float).reshape(
+            len(mission.coefficients), PIECE_AXES, -1)
+        knots = np.asarray(mission.knots, dtype=float)
+        self.mission = np.zeros(MISSION_SIZE)
+        self.mission[MISSION_START:MISSION_START + 3] = mission.points[0]
+        self.mission[MISSION_FINAL:MISSION_FINAL + 3] = mission.points[-1]
+        self.segments = np.zeros((len(coefficients), PIECE_SIZE))
+        self.segments[:, PIECE_START_TIME] = knots[:-1]
+        self.segments[:, PIECE_END_TIME] = knots[1:]
+        for axis in range(PIECE_AXES):
+            first = PIECE_COEFFICIENTS + axis * PIECE_ORDER
+            self.segments[:, first:first + coefficients.shape[2]] = coefficients[:, axis]
+        self.steps = np.zeros((0, STEP_SIZE))
+
+    def _segments(self, mission: MissionConfig, shaper: tuple[tuple[float, float], ...],
+                  period: float) -> None:
         tau = float(mission.reference_filter_time)
         start = np.asarray(mission.start, dtype=float)
         ends = np.array([s.end_time for s in mission.segments], dtype=float)
@@ -72,6 +119,7 @@ class MissionPath:
                                                          if len(steps) else start)
         self.mission[MISSION_OMEGA] = 1.0 / tau if tau > 0.0 else 0.0
         self.mission[MISSION_SHAPED] = 1.0 if len(shaper) > 1 else 0.0
+        self.mission[MISSION_FORM] = float(FORM_VELOCITY_SEGMENTS)
         self.segments = np.empty((len(ends), SEGMENT_SIZE))
         self.segments[:, SEGMENT_START_TIME] = starts
         self.segments[:, SEGMENT_END_TIME] = ends
@@ -93,10 +141,21 @@ class MissionPath:
                 shaped.append(part)
             shaped = np.vstack(shaped)
             self.steps = shaped[np.argsort(shaped[:, STEP_TIME], kind='stable')]
-        for array in (self.mission, self.segments, self.steps):
-            array.flags.writeable = False
-        self._law = laws.runnable(mission_reference)
 
     def __call__(self, t: float) -> Reference:
         """The reference at simulated time t [s]."""
         return Reference.of(self._law(self.mission, self.segments, self.steps, float(t)))
+
+
+def shifted(mission: MissionConfig, offset: np.ndarray) -> MissionConfig:
+    """`mission` with every position moved by `offset` (3,) [m], world: its start and, for a
+    polynomial, each piece's constant term and its points."""
+    coefficients = np.array(mission.coefficients, dtype=float).reshape(
+        len(mission.coefficients), PIECE_AXES, -1)
+    if len(coefficients):
+        coefficients[:, :3, 0] += offset
+    return replace(
+        mission, start=tuple(float(v) for v in np.add(mission.start, offset)),
+        coefficients=tuple(tuple(tuple(float(c) for c in axis) for axis in piece)
+                           for piece in coefficients),
+        points=tuple(tuple(float(v) for v in np.add(p, offset)) for p in mission.points))

@@ -21,11 +21,13 @@ from typing import Any
 import numpy as np
 import yaml
 
-from multilift_control.laws.layout import (MISSION_FINAL, MISSION_START, REFERENCE_POSITION,
-                                           REFERENCE_VELOCITY, SEGMENT_ORIGIN)
+from multilift_control.laws.layout import (FORM_POLYNOMIAL, MISSION_FINAL, MISSION_FORM,
+                                           MISSION_START, PIECE_COEFFICIENTS, PIECE_ORDER,
+                                           REFERENCE_POSITION, REFERENCE_VELOCITY,
+                                           SEGMENT_ORIGIN)
 from multilift_sim import scenario as scenario_io
 from multilift_sim.registry import one_of
-from multilift_sim.scenario import MissionSegment, Scenario
+from multilift_sim.scenario import MissionConfig, MissionSegment, Scenario
 from multilift_tools.campaign import edited, format_value, load_base, parse_key
 
 
@@ -82,7 +84,17 @@ def task_scenario(scenario: Scenario, task_name: str, start: str = 'rest') -> Sc
     if task_name != 'hover' or scenario.control.mode != 'cascade':
         return scenario
     hold = MissionSegment(velocity=(0.0, 0.0, 0.0), end_time=scenario.simulation.duration)
-    return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))
+    if _seed_mission(scenario):
+        return replace(scenario, mission=replace(scenario.mission, segments=(hold,)))
+    # another source (waypoints, a file, the payload tracked): a segments mission from the
+    # leader's start
+    return replace(scenario, mission=MissionConfig(start=scenario.uavs[0].position,
+                                                   segments=(hold,)))
+
+
+def _seed_mission(scenario: Scenario) -> bool:
+    """Whether the scenario's mission is the default source's (segments) for the leader."""
+    return scenario.mission.type == 'segments' and scenario.mission.tracks == 'leader'
 
 
 def task_scenario_yaml(source: str, task_name: str, start: str = 'rest',
@@ -98,8 +110,10 @@ def task_scenario_yaml(source: str, task_name: str, start: str = 'rest',
         data['payload'] = {k: v for k, v in data['payload'].items()
                            if k not in ('swing_deg', 'alpha_deg', 'beta_deg')}
     if task_name == 'hover' and scenario.control.mode == 'cascade':
-        data['mission'] = dict(data['mission'], segments=[
-            {'velocity': [0.0, 0.0, 0.0], 'until': scenario.simulation.duration}])
+        hold = [{'velocity': [0.0, 0.0, 0.0], 'until': scenario.simulation.duration}]
+        data['mission'] = (dict(data['mission'], segments=hold)
+                           if _seed_mission(scenario_of(source))
+                           else {'start': list(scenario.mission.start), 'segments': hold})
     header = f'# {path} as the learning task {task_name!r} flies it (multilift_learning.tasks)\n'
     return header + yaml.safe_dump(data, sort_keys=False)
 
@@ -123,8 +137,8 @@ class Targets:
 
     def reset(self, which: np.ndarray, rngs: list[np.random.Generator]) -> None:
         """New targets for the formations in `which` (B,) bool, each from its own generator;
-        for hover the leader's mission (its positions: start, end, each segment's origin)
-        moves with the target."""
+        for hover the leader's mission (its positions: start, end, each segment's origin or
+        each polynomial piece's constant term) moves with the target."""
         a = self.arrays
         for b in np.flatnonzero(which):
             offset = np.zeros(3)
@@ -137,7 +151,11 @@ class Targets:
             if self.task.name == 'hover':
                 a.mission[b, MISSION_START:MISSION_START + 3] += shift
                 a.mission[b, MISSION_FINAL:MISSION_FINAL + 3] += shift
-                a.segments[b, :, SEGMENT_ORIGIN:SEGMENT_ORIGIN + 3] += shift
+                if a.mission[b, MISSION_FORM] == FORM_POLYNOMIAL:  # each piece's constant
+                    for axis in range(3):
+                        a.segments[b, :, PIECE_COEFFICIENTS + axis * PIECE_ORDER] += shift[axis]
+                else:
+                    a.segments[b, :, SEGMENT_ORIGIN:SEGMENT_ORIGIN + 3] += shift
 
     def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(position, velocity) of each formation's target at its time t (B,) [s]."""

@@ -58,7 +58,7 @@ from multilift_control.mission import MissionPath, Reference
 from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
 from multilift_sim.scenario import INPUT_SHAPERS, Scenario
 from multilift_sim.scenario.controllers import FOLLOWER_CONTROLLERS, LEADER_CONTROLLERS
-from multilift_sim.start import formation_start
+from multilift_sim.start import formation_start, start_lengths
 
 LEADER_REQUIRED = ('NAME', 'KEYS', 'TRACKS_MISSION', 'arrays', 'answer')
 FOLLOWER_REQUIRED = ('NAME', 'KEYS', 'arrays', 'shared', 'answer')
@@ -161,7 +161,7 @@ class LeaderController:
         self.law = law_index(LEADER_CONTROLLERS, self.part.NAME)
         self.cascade = vehicle_cascade(scenario, index)
         self.path = MissionPath(scenario.mission, INPUT_SHAPERS[scenario.control.input_shaping],
-                                swing_period(scenario))
+                                swing_period(scenario), tracked_offset(scenario))
         self.constants, self.memory = (np.asarray(a, dtype=float)
                                        for a in self.part.arrays(scenario, index))
         control = scenario.control
@@ -233,6 +233,18 @@ def swing_rest(scenario: Scenario) -> tuple[float, float]:
     uavs, payload = formation_start(scenario)
     offset = payload - uavs.mean(axis=0)
     return float(offset[0]), float(offset[1])
+
+
+def tracked_offset(scenario: Scenario) -> np.ndarray | None:
+    """`mission.tracks: payload`: the leader's position less the payload's at the formation's
+    hanging rest (`simulation.formation_start`: the payload at rest under its cables), world [m],
+    which moves the payload's path to the leader's; None (the path as written) for `leader`."""
+    if scenario.mission.tracks != 'payload':
+        return None
+    if scenario.n_uavs == 1:  # the payload straight below its cable's length
+        return np.array([0.0, 0.0, start_lengths(scenario)[0]])
+    uavs, payload = formation_start(scenario)
+    return uavs[0] - payload
 
 
 def swing_period(scenario: Scenario) -> float:

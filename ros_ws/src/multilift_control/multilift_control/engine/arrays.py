@@ -115,7 +115,7 @@ def _padded(rows: np.ndarray, rotors: int) -> np.ndarray:
     return out
 
 
-def _formation_fields(scenario: Scenario) -> tuple[dict, dict]:
+def formation_fields(scenario: Scenario) -> tuple[dict, dict]:
     """One formation's (FormationArrays fields, FormationMemory fields), without the batch
     axis: the physics' (`multilift_sim.tick_arrays.physics_fields`), then the controllers'
     (their parts' arrays, `multilift_control.controllers`)."""
@@ -174,24 +174,40 @@ def _shape_key(fields: tuple[dict, dict]) -> tuple:
             tuple(np.shape(v) for v in memory.values()))
 
 
-def shape_groups(scenarios: Sequence[Scenario]) -> list[list[int]]:
+Fields = tuple[dict, dict]  # formation_fields' (arrays, memory) of one formation
+
+
+def shape_groups(scenarios: Sequence[Scenario]) -> list[tuple[list[int], list[Fields] | None]]:
     """The scenarios' indices grouped into batches the engine can fly together (the same
-    shapes of every array, control and physics rates), in order of first appearance."""
-    groups: dict[tuple, list[int]] = {}
+    shapes of every array, control and physics rates), in order of first appearance, each
+    with its formations' fields (for `batch_arrays`, built once; None for a scenario whose
+    fields raise: a batch of its own, whose flight says what failed)."""
+    groups: dict[tuple, tuple[list[int], list[Fields] | None]] = {}
     for index, scenario in enumerate(scenarios):
         try:
-            key = _shape_key(_formation_fields(scenario))
+            fields = formation_fields(scenario)
+            key = _shape_key(fields)
         except Exception:  # noqa: BLE001 - a batch of its own, whose flight says what failed
-            key = ('alone', index)
-        groups.setdefault(key, []).append(index)
+            groups[('alone', index)] = ([index], None)
+            continue
+        groups.setdefault(key, ([], []))[0].append(index)
+        groups[key][1].append(fields)
     return list(groups.values())
 
 
-def batch_arrays(scenarios: Sequence[Scenario]) -> tuple[FormationArrays, FormationMemory]:
-    """The arrays of `scenarios` (B >= 1 of the same shape): (constants, initial memory)."""
+def batch_arrays(scenarios: Sequence[Scenario], fields: Sequence[Fields] | None = None
+                 ) -> tuple[FormationArrays, FormationMemory]:
+    """The arrays of `scenarios` (B >= 1 of the same shape): (constants, initial memory);
+    `fields` their formation_fields if built already (a scenario given B times is built
+    once: the stacking copies)."""
     if not scenarios:
         raise ValueError('a batch needs at least one scenario')
-    fields = [_formation_fields(s) for s in scenarios]
+    if fields is None:
+        built: dict[int, Fields] = {}
+        for s in scenarios:
+            if id(s) not in built:
+                built[id(s)] = formation_fields(s)
+        fields = [built[id(s)] for s in scenarios]
     arrays = FormationArrays(**{name: stacked(name, [f[0][name] for f in fields])
                                 for name in FormationArrays._fields})
     memory = FormationMemory(**{name: stacked(name, [f[1][name] for f in fields])

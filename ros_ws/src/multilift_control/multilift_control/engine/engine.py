@@ -33,7 +33,8 @@ class Engine:
     scenario's duration; the others go on.
     """
 
-    def __init__(self, scenarios: Scenario | Sequence[Scenario], batch: int | None = None):
+    def __init__(self, scenarios: Scenario | Sequence[Scenario], batch: int | None = None,
+                 fields: Sequence[tuple[dict, dict]] | None = None):
         if isinstance(scenarios, Scenario):
             scenarios = [scenarios] * (1 if batch is None else batch)
         elif batch is not None and batch != len(scenarios):
@@ -43,7 +44,7 @@ class Engine:
             raise ValueError(f'batch must be >= 1, got {batch}')
         self.arrays: FormationArrays
         self.memory: FormationMemory
-        self.arrays, self._initial = batch_arrays(self.scenarios)
+        self.arrays, self._initial = batch_arrays(self.scenarios, fields)
         self.n_uavs = self.arrays.uavs.shape[1]
         self.layout = StateLayout(self.n_uavs)
         (self._run_ticks, self._start, self._measure_all, self._answer_all,

@@ -17,8 +17,8 @@ from multilift_control.laws.layout import (CASCADE_ATT_KD, CASCADE_ATT_KP, CASCA
                                            CASCADE_SQUARE_MIN, CASCADE_SWING_DAMPING,
                                            CASCADE_SWING_STIFFNESS, REFERENCE_ACCELERATION,
                                            REFERENCE_POSITION, REFERENCE_VELOCITY,
-                                           UAV_BODY_RATES, UAV_EULER, UAV_POSITION,
-                                           UAV_VELOCITY)
+                                           REFERENCE_YAW, UAV_BODY_RATES, UAV_EULER,
+                                           UAV_POSITION, UAV_VELOCITY)
 from multilift_control.laws.mixer import rotor_speeds
 from multilift_control.laws.reference import mission_reference
 from multilift_control.laws.swing import swing_feedback
@@ -159,10 +159,11 @@ def cascade_update(constants, mixer, memory, t, state, reference, yaw):
 def leader_update(constants, mixer, memory, mission, segments, steps, t, states,
                   payload_position, payload_velocity):
     """A leader's tick at t [s]: the mission reference (`reference.mission_reference`) tracked
-    by the cascade at heading 0. With CASCADE_SWING_STIFFNESS or _DAMPING not 0 the swing
-    feedback (`swing.swing_feedback`) adds m a_s to the position loop's force (as a_s added to
-    the reference's acceleration) unless that asks a rotor beyond its limits: then the force
-    without it goes (the feedback yields to the mission). states (n, UAV_STATE_SIZE): every
+    by the cascade at the reference's heading (REFERENCE_YAW; the seed's segments: 0). With
+    CASCADE_SWING_STIFFNESS or _DAMPING not 0 the swing feedback (`swing.swing_feedback`) adds
+    m a_s to the position loop's force (as a_s added to the reference's acceleration) unless
+    that asks a rotor beyond its limits: then the force without it goes (the feedback yields
+    to the mission). states (n, UAV_STATE_SIZE): every
     UAV's, the leader's first; payload_position [m], payload_velocity [m/s] (3,), world (read
     only with the feedback on). Returns (speeds, saturated, setpoint, thrust, reference)."""
     reference = mission_reference(mission, segments, steps, t)
@@ -175,9 +176,11 @@ def leader_update(constants, mixer, memory, mission, segments, steps, t, states,
             pushed = force.copy()
             for axis in range(2):
                 pushed[axis] += share * constants[CASCADE_HOVER_MASS] * feedback[axis]
-            speeds, saturated, setpoint, thrust = command(constants, mixer, state, pushed, 0.0)
+            speeds, saturated, setpoint, thrust = command(constants, mixer, state, pushed,
+                                                          reference[REFERENCE_YAW])
             if not saturated.any():
                 return speeds, saturated, setpoint, thrust, reference
             share *= 0.5
-    speeds, saturated, setpoint, thrust = command(constants, mixer, state, force, 0.0)
+    speeds, saturated, setpoint, thrust = command(constants, mixer, state, force,
+                                                  reference[REFERENCE_YAW])
     return speeds, saturated, setpoint, thrust, reference

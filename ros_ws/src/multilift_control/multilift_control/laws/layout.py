@@ -21,13 +21,26 @@ UAV_STATE_SIZE = MEASURED_COLUMNS
 REFERENCE_POSITION = 0      # (3) [m]
 REFERENCE_VELOCITY = 3      # (3) [m/s]
 REFERENCE_ACCELERATION = 6  # (3) [m/s^2]
-REFERENCE_SIZE = 9
+REFERENCE_YAW = 9           # the heading to hold [rad] (0: the seed's)
+REFERENCE_SIZE = 10
 # the mission's constants
 MISSION_START = 0   # (3) position at t = 0 [m]
 MISSION_FINAL = 3   # (3) position after the last segment [m]
 MISSION_OMEGA = 6   # 1 / tau of the reference prefilter [1/s]; 0: the raw path
 MISSION_SHAPED = 7  # 1: the steps are an input shaper's (control.payload_feedback); 0: not
-MISSION_SIZE = 8
+MISSION_FORM = 8    # which compiled reference: FORM_VELOCITY_SEGMENTS or FORM_POLYNOMIAL
+MISSION_SIZE = 9
+# MISSION_FORM's values: the index of a mission source's FORM in multilift_sim.missions.FORMS
+FORM_VELOCITY_SEGMENTS = 0  # `segments` rows (SEGMENT_*) and `steps` (STEP_*)
+FORM_POLYNOMIAL = 1         # `segments` holds pieces (PIECE_*), `steps` is empty
+# a polynomial mission's pieces, a row each (pieces, PIECE_SIZE), in the segments' place
+PIECE_START_TIME = 0    # [s]
+PIECE_END_TIME = 1      # [s]
+PIECE_AXES = 4          # x, y, z [m], yaw [rad]
+PIECE_ORDER = 8         # coefficients an axis: degree 7 at most (multilift_sim.missions)
+PIECE_COEFFICIENTS = 2  # (PIECE_AXES * PIECE_ORDER) axis by axis, the lowest power first, in
+#                         powers of t - PIECE_START_TIME [s]
+PIECE_SIZE = PIECE_COEFFICIENTS + PIECE_AXES * PIECE_ORDER
 # the mission's segments, a row each (segments, SEGMENT_SIZE)
 SEGMENT_START_TIME = 0  # [s]
 SEGMENT_END_TIME = 1    # [s]

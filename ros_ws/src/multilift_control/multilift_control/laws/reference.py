@@ -1,14 +1,17 @@
-"""The leader's mission reference (seed §4.2): piecewise-constant velocity segments, world
-frame, and its prefilter (not in the seed: `MissionPath`'s docstring)."""
+"""The leader's mission reference: the seed's piecewise-constant velocity segments (§4.2), world
+frame, and their prefilter (not in the seed: `MissionPath`'s docstring), or a piecewise
+polynomial (issue 34: `mission.type` waypoints or file, multilift_sim.missions)."""
 import math
 
 import numpy as np
 
 from multilift_control.laws import jit
-from multilift_control.laws.layout import (MISSION_FINAL, MISSION_OMEGA, MISSION_SHAPED,
-                                           MISSION_START,
+from multilift_control.laws.layout import (FORM_POLYNOMIAL, MISSION_FINAL, MISSION_FORM,
+                                           MISSION_OMEGA, MISSION_SHAPED, MISSION_START,
+                                           PIECE_AXES, PIECE_COEFFICIENTS, PIECE_END_TIME,
+                                           PIECE_ORDER, PIECE_START_TIME,
                                            REFERENCE_ACCELERATION, REFERENCE_POSITION,
-                                           REFERENCE_SIZE, REFERENCE_VELOCITY,
+                                           REFERENCE_SIZE, REFERENCE_VELOCITY, REFERENCE_YAW,
                                            SEGMENT_END_TIME, SEGMENT_ORIGIN, SEGMENT_START_TIME,
                                            SEGMENT_VELOCITY, STEP_DV, STEP_TIME)
 
@@ -42,6 +45,47 @@ def raw_reference(mission, segments, t, out):
 
 
 @jit
+def polynomial_reference(mission, pieces, t, out):
+    """A piecewise polynomial's reference at t [s] into `out` (REFERENCE_* slots, world: [m],
+    [m/s], [m/s^2], yaw [rad]): piece k's p(t - t_k) and its first two derivatives by Horner's
+    rule; before the first piece its start, after the last its end, at rest (derivatives 0).
+    pieces (k, PIECE_SIZE); no piece: MISSION_START."""
+    for slot in range(REFERENCE_SIZE):
+        out[slot] = 0.0
+    count = pieces.shape[0]
+    if count == 0:
+        for axis in range(3):
+            out[REFERENCE_POSITION + axis] = mission[MISSION_START + axis]
+        return out
+    k, held = 0, True
+    local = 0.0
+    if t >= pieces[count - 1, PIECE_END_TIME]:
+        k = count - 1
+        local = pieces[k, PIECE_END_TIME] - pieces[k, PIECE_START_TIME]
+    elif t > pieces[0, PIECE_START_TIME]:
+        held = False
+        while pieces[k, PIECE_END_TIME] <= t:  # the piece holding t
+            k += 1
+        local = t - pieces[k, PIECE_START_TIME]
+    for axis in range(PIECE_AXES):
+        first = PIECE_COEFFICIENTS + axis * PIECE_ORDER
+        position, velocity, acceleration = 0.0, 0.0, 0.0
+        for j in range(PIECE_ORDER - 1, -1, -1):
+            c = pieces[k, first + j]
+            acceleration = acceleration * local + 2.0 * velocity
+            velocity = velocity * local + position
+            position = position * local + c
+        if axis == 3:
+            out[REFERENCE_YAW] = position
+        else:
+            out[REFERENCE_POSITION + axis] = position
+            if not held:
+                out[REFERENCE_VELOCITY + axis] = velocity
+                out[REFERENCE_ACCELERATION + axis] = acceleration
+    return out
+
+
+@jit
 def mission_reference(mission, segments, steps, t):
     """The reference at t [s]: (REFERENCE_SIZE,) position [m], velocity [m/s], acceleration
     [m/s^2], world. With MISSION_OMEGA = omega = 1/tau > 0 each horizontal velocity step dv_k
@@ -49,7 +93,10 @@ def mission_reference(mission, segments, steps, t):
     form: v(t) = sum_k dv_k s(t - t_k), s(x) = 1 - (1 + omega x) e^(-omega x); the position is
     its integral, the acceleration omega^2 x e^(-omega x) dv_k. omega = 0: `raw_reference`, or
     with MISSION_SHAPED the shaped steps unfiltered, s(x) = 1 (the acceleration their
-    impulses, 0 between them)."""
+    impulses, 0 between them). MISSION_FORM FORM_POLYNOMIAL: `polynomial_reference` of the
+    pieces in `segments`' place."""
+    if mission[MISSION_FORM] == FORM_POLYNOMIAL:
+        return polynomial_reference(mission, segments, t, np.empty(REFERENCE_SIZE))
     out = raw_reference(mission, segments, t, np.empty(REFERENCE_SIZE))
     omega = mission[MISSION_OMEGA]
     if omega == 0.0 and mission[MISSION_SHAPED] == 0.0:

@@ -18,7 +18,7 @@ from multilift_sim.scenario.config import (  # noqa: F401
 from multilift_sim.scenario.controllers import (FOLLOWER_CONTROLLERS,  # noqa: F401
                                                 LEADER_CONTROLLERS, follower_controllers,
                                                 leader_controllers)
-from multilift_sim.scenario.files import (anchored, load, loads, resolve,  # noqa: F401
-                                          scenario_dir)
+from multilift_sim.scenario.files import (anchored, from_mapping, load, loads,  # noqa: F401
+                                          resolve, scenario_dir)
 from multilift_sim.scenario.vehicle import (INERTIA_SOURCES, SEED_INERTIA,  # noqa: F401
                                             VEHICLE_KEYS)

@@ -142,6 +142,14 @@ class MissionConfig:
     segments: tuple[MissionSegment, ...]
     # tau of the leader's reference prefilter [s] (not in the seed; 0 = the raw corners)
     reference_filter_time: float = 0.0
+    # the source (multilift_sim.missions.MISSION_SOURCES) that read it, and what tracks it
+    type: str = 'segments'
+    tracks: str = 'leader'           # 'leader' or 'payload' (missions.TRACKED)
+    # a `polynomial` source's trajectory (missions.polynomials): times (m + 1,) [s] and
+    # coefficients (m, 4, 8): x, y, z [m], yaw [rad] in powers of t - knots[k]
+    knots: tuple[float, ...] = ()
+    coefficients: tuple[tuple[tuple[float, ...], ...], ...] = ()
+    points: tuple[tuple[float, float, float], ...] = ()  # the points it passes, world [m]
 
 
 @dataclass(frozen=True)

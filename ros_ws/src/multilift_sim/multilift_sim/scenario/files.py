@@ -48,14 +48,23 @@ def load(name_or_path: str) -> Scenario:
 
 
 def anchored(data: Any, folder: Path) -> Any:
-    """A scenario's mapping with its `parts:` files made absolute against `folder` (the
-    file's own), for a copy validated elsewhere (a sweep's runs, `loads`)."""
+    """A scenario's mapping with its `parts:` files and its `mission.file` made absolute against
+    `folder` (the file's own), for a copy validated elsewhere (a sweep's runs, `loads`)."""
     if isinstance(data, dict) and isinstance(data.get('parts'), list):
         data = dict(data, parts=[str((folder / p).resolve()) if isinstance(p, str) else p
                                  for p in data['parts']])
+    mission = data.get('mission') if isinstance(data, dict) else None
+    if isinstance(mission, dict) and isinstance(mission.get('file'), str):  # mission.type file
+        data = dict(data, mission=dict(mission, file=str((folder / mission['file']).resolve())))
     return data
 
 
 def loads(text: str, where: str = '<string>') -> Scenario:
     """Validate a scenario given as YAML text (tests, tools)."""
     return scenario_of(yaml.safe_load(text), where)
+
+
+def from_mapping(data: Any, where: str = '<mapping>') -> Scenario:
+    """Validate a scenario given as the mapping a YAML file loads to (a sweep's edited copy:
+    no round trip through text)."""
+    return scenario_of(data, where)

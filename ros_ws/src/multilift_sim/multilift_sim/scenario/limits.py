@@ -63,7 +63,30 @@ def max_mission_acceleration(scenario: Scenario) -> float:
     return g * min(math.tan(scenario.control.max_tilt), math.sqrt(max(ratio * ratio - 1.0, 0.0)))
 
 
+def _check_polynomial(scenario: Scenario) -> None:
+    """A polynomial mission's speed (sampled 64 times a piece) at most MAX_MISSION_SPEED; no
+    input shaper (it shapes the segments' velocity steps)."""
+    mission = scenario.mission
+    if scenario.control.input_shaping != 'none':
+        raise _fail(scenario, 'mission.type', mission.type,
+                    f'cannot be flown with input_shaping {scenario.control.input_shaping!r} '
+                    f'(it shapes the velocity steps of mission.type segments)')
+    powers = np.arange(1, 8)
+    for k, piece in enumerate(mission.coefficients):
+        duration = mission.knots[k + 1] - mission.knots[k]
+        local = np.linspace(0.0, duration, 64)[:, None]
+        velocity = (np.array(piece)[:3, 1:] * powers) @ (local ** (powers - 1)).T
+        speed = float(np.sqrt((velocity ** 2).sum(axis=0)).max())
+        if speed > MAX_MISSION_SPEED:
+            raise _fail(scenario, 'mission.type', mission.type,
+                        f'asks a speed of {speed:.3g} m/s between {mission.knots[k]:g} and '
+                        f'{mission.knots[k + 1]:g} s, more than {MAX_MISSION_SPEED:g} m/s '
+                        f'(limits.MAX_MISSION_SPEED)')
+
+
 def _check_mission(scenario: Scenario) -> None:
+    if scenario.mission.knots:
+        _check_polynomial(scenario)
     segments = scenario.mission.segments
     for k, segment in enumerate(segments):
         speed = math.sqrt(sum(v * v for v in segment.velocity))

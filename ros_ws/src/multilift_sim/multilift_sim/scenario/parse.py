@@ -20,7 +20,7 @@ from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
 from multilift_sim.scenario.config import (FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
-                                           MissionConfig, MissionSegment, PayloadConfig,
+                                           PayloadConfig,
                                            Scenario, ScenarioError, SensorConfig,
                                            SimulationConfig, UavConfig,
                                            flies_a_period, one_period_rule)
@@ -31,7 +31,7 @@ from multilift_sim.scenario import reorganize
 from multilift_sim.scenario.part_files import scenario_parts
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
-                                            vehicle_params)
+                                            preset_values, vehicle_params)
 
 
 def scenario_of(data: Any, where: str) -> Scenario:
@@ -73,8 +73,11 @@ def scenario_of(data: Any, where: str) -> Scenario:
     sim = dataclasses.replace(sim, substeps=int(sim.substeps))
 
     v = top.section('vehicle')
-    base_vehicle = dataclasses.asdict(vehicle_params(v, None))
-    base_source = inertia_source(v, tuple(base_vehicle['inertia']))
+    preset = preset_values(v)  # vehicle.preset: its values under the keys given
+    base_vehicle = dataclasses.asdict(vehicle_params(v, preset))
+    base_source = inertia_source(v, tuple(base_vehicle['inertia']),
+                                 'given' if preset is None or v.has('inertia')
+                                 else preset['inertia_source'])
     v.done()
     warnings = inertia_warning(where, 'vehicle.inertia', tuple(base_vehicle['inertia']),
                                base_source)
@@ -185,30 +188,13 @@ def scenario_of(data: Any, where: str) -> Scenario:
     gains_att.done()
     c.done()
 
-    m = top.section('mission')
-    start = m.vector('start', list(uavs[0].position))
-    segments = []
-    t_prev = 0.0
-    for i, entry in enumerate(m.sequence('segments', [])):
-        seg = Section(entry, f'mission.segments[{i}]', where)
-        velocity = seg.vector('velocity')
-        if seg.has('duration') == seg.has('until'):
-            raise ScenarioError(f'{where}: {seg.path}: give exactly one of duration, until')
-        if seg.has('duration'):
-            end = t_prev + seg.positive('duration')
-        else:
-            end = seg.number('until', ..., lambda t: t > t_prev, f'must be > {t_prev}')
-        seg.done()
-        segments.append(MissionSegment(velocity=velocity, end_time=end))
-        t_prev = end
-    reference_filter_time = m.non_negative('reference_filter_time', 0.0)
-    m.done()
+    from multilift_sim.missions import read_mission  # its parts import scenario's names
+    mission = read_mission(top, uavs[0].position)
     top.done()
 
     scenario = Scenario(name=name, description=description, source=where, simulation=sim,
                         uavs=tuple(uavs), payload=payload, gusts=tuple(gusts), control=control,
-                        mission=MissionConfig(start=start, segments=tuple(segments),
-                                              reference_filter_time=reference_filter_time),
+                        mission=mission,
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, cable=rope, events=events, wind=tuple(wind),
                         wind_models=tuple(wind_models), sensors=sensors, parts=parts)

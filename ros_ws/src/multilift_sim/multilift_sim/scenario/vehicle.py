@@ -15,6 +15,23 @@ VEHICLE_KEYS = ('mass', 'inertia', 'frame_type', 'arm_length', 'thrust_coefficie
                 'motor_time_constant', 'motor_rate_limit', 'drag_coefficient')
 
 
+def preset_values(sec: Section) -> dict[str, Any] | None:
+    """The `vehicle` section's `preset` (multilift_sim.vehicles.presets.VEHICLE_PRESETS): every
+    vehicle key's value (the optional ones at their defaults) and `inertia_source`, or None
+    without a preset."""
+    from multilift_sim.vehicles.presets import VEHICLE_PRESETS
+    name = sec.text('preset', None) if sec.has('preset') else None
+    if name is None:
+        return None
+    if name not in VEHICLE_PRESETS:
+        raise sec.fail('preset', name, f'must be one of {", ".join(VEHICLE_PRESETS)}')
+    values = {'motor_time_constant': 0.0, 'motor_rate_limit': math.inf,
+              'drag_coefficient': 0.0, 'inertia_source': 'given'}
+    values.update(VEHICLE_PRESETS[name].VALUES)
+    values['inertia'] = list(values['inertia'])
+    return values
+
+
 def vehicle_params(sec: Section, base: dict[str, Any] | None) -> MultirotorParams:
     """A MultirotorParams from `sec`, falling back to `base` (the shared `vehicle` section)."""
     def default(key: str) -> Any:

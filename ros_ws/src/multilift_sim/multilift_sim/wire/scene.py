@@ -74,7 +74,10 @@ def tension_color(tension: float, reference: float) -> tuple[float, float, float
 
 
 def mission_corners(scenario: Scenario) -> list[tuple[float, float, float]]:
-    """The leader reference's corners, world [m]: the start, then the end of every segment."""
+    """The leader reference's corners, world [m]: the start, then the end of every segment; a
+    polynomial mission's points (multilift_sim.missions)."""
+    if scenario.mission.points:
+        return [tuple(p) for p in scenario.mission.points]
     corners = [tuple(float(c) for c in scenario.mission.start)]
     previous_end = 0.0
     for segment in scenario.mission.segments:

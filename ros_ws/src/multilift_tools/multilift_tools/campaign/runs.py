@@ -21,7 +21,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from multilift_sim import scenario as scenario_io
 from multilift_sim.statistics import summary_row
@@ -63,7 +62,7 @@ def _plain(value: Any) -> Any:
 def _scenario(source: str, base: dict, edits: list, duration: float | None):
     """The run's scenario: the base with its edits (checked by the loader) and duration."""
     data = edited(base, [tuple(e) for e in edits])
-    scenario = scenario_io.loads(yaml.safe_dump(data, sort_keys=False), _label(source, edits))
+    scenario = scenario_io.from_mapping(data, _label(source, edits))
     return scenario if duration is None else scenario.with_duration(duration)
 
 
@@ -161,12 +160,12 @@ def run_chunk(source: str, base: dict, runs: list[tuple[list, str | None]],
             continue
         loading[k] = time.perf_counter() - start
         flights.append((k, scenario))
-    for group in shape_groups([scenario for _, scenario in flights]):
+    for group, fields in shape_groups([scenario for _, scenario in flights]):
         members = [flights[i] for i in group]
         warm_up('engine', members[0][1])
         start = time.perf_counter()
         try:
-            flown = fly_batch([scenario for _, scenario in members])
+            flown = fly_batch([scenario for _, scenario in members], fields)
         except Exception:  # noqa: BLE001 - find the run at fault: one by one
             for k, _ in members:
                 results[k] = run_one(source, base, runs[k][0], duration)

@@ -1,6 +1,7 @@
 """The reorganising V (`formation.reorganize: thrust_margin` and `cable_forces`, v3_mixed)
-flies through ROS as headless: each follower node steps its own copy of the formation's moving offsets from the
-states and lifts it is sent, and the followers agree with the engine's one tick to 1e-9 m."""
+flies through ROS as headless: each follower node steps its own copy of the formation's
+moving offsets from the states and lifts it is sent, and the followers agree with the engine's
+one tick to 1e-9 m."""
 from __future__ import annotations
 
 import os

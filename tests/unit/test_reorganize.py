@@ -133,7 +133,8 @@ def test_every_reorganising_law_compiled_equals_its_uncompiled_run():
     check(laws._lowest, np.zeros(3), -math.inf, places[0] - [0, 0, 10.0],
           np.array([0.0, 0.0, -1.0]), places, np.full(3, 10.26))
     check(laws.filtered_gravity, constants, memory, 0.01, masses, masses[:, None] * [0, 0, G])
-    check(laws._elapsed, memory, 0.5)
+    check(laws._begin, constants, memory, 0.5, masses, constraints.rows, constraints.targets,
+          masses[:, None] * [0, 0, G])
     check(laws._kept, constraints.rows, constraints.targets, np.zeros(6), constants, effective,
           places, places + 0.01)
     check(laws.load_shares, constants, effective)

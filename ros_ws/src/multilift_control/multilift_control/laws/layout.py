@@ -123,11 +123,14 @@ REORGANIZE_GAIN = FOLLOWER_SIZE + 5           # offset rate per unit of cost gra
 REORGANIZE_FILTER_TIME = FOLLOWER_SIZE + 6    # the apparent gravity's low-pass time [s]
 REORGANIZE_RADIUS = FOLLOWER_SIZE + 7         # cable_forces: the UAVs' horizontal distance
 #                                               from the payload at the start [m]
-REORGANIZE_UAVS = FOLLOWER_SIZE + 8           # then a row of REORGANIZE_UAV_SIZE per UAV:
+REORGANIZE_MODE = FOLLOWER_SIZE + 8           # REORGANIZE_GRADIENT or REORGANIZE_ALLOCATE
+REORGANIZE_UAVS = FOLLOWER_SIZE + 9           # then a row of REORGANIZE_UAV_SIZE per UAV:
 REORGANIZE_UAV_MASS = 0                       # its vehicle's mass m_i [kg]
 REORGANIZE_UAV_LARGEST = 1                    # u_T,max,i, every rotor at its limit [N]
 REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]
 REORGANIZE_UAV_SIZE = 3
+REORGANIZE_GRADIENT = 0.0  # thrust_margin: laws.reorganize.reorganize
+REORGANIZE_ALLOCATE = 1.0  # cable_forces: laws.reorganize.allocate
 # its memory after the FOLLOWER_* slots
 REORGANIZE_ACCELERATION = FOLLOWER_MEMORY_SIZE  # (3) the formation's filtered a [m/s^2]
 REORGANIZE_SHIFT = FOLLOWER_MEMORY_SIZE + 3     # (m) the rows' targets moved by [m]

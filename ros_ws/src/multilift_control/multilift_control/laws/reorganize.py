@@ -230,9 +230,15 @@ def filtered_gravity(constants, memory, dt, masses, vectors):
 
 
 @jit
-def _elapsed(memory, t):
+def _begin(constants, memory, t, masses, rows, targets, vectors):
+    """A step's start at t [s]: (dt since the follower's last tick [s], 0 at the first; the
+    apparent gravity (`filtered_gravity`) [m/s^2]; the shift, a view of memory's
+    REORGANIZE_SHIFT (m,) [m]; the places it asks for (n, 3) [m])."""
     last = memory[FOLLOWER_LAST_T]
-    return 0.0 if math.isnan(last) else max(t - last, 0.0)
+    dt = 0.0 if math.isnan(last) else max(t - last, 0.0)
+    effective = filtered_gravity(constants, memory, dt, masses, vectors)
+    shift = memory[REORGANIZE_SHIFT:REORGANIZE_SHIFT + rows.shape[0]]
+    return dt, effective, shift, target_places(rows, targets, shift, vectors.shape[0])
 
 
 @jit
@@ -261,11 +267,7 @@ def reorganize(constants, memory, t, masses, rows, targets, vectors):
     when its places keep the limits and the payload hangs. Call before `follower_update`,
     which advances FOLLOWER_LAST_T."""
     n = vectors.shape[0]
-    m = rows.shape[0]
-    dt = _elapsed(memory, t)
-    effective = filtered_gravity(constants, memory, dt, masses, vectors)
-    shift = memory[REORGANIZE_SHIFT:REORGANIZE_SHIFT + m]
-    places = target_places(rows, targets, shift, n)
+    dt, effective, shift, places = _begin(constants, memory, t, masses, rows, targets, vectors)
     floor = constants[REORGANIZE_FLOOR]
     moved = places.copy()
     for j in range(1, n):
@@ -345,11 +347,7 @@ def allocate(constants, memory, t, masses, rows, targets, vectors):
     payload): the followers' places move towards `allocated_places` at the apparent gravity,
     each at most REORGANIZE_MAX_RATE, within the limits; returns targets + shift (m,) [m]."""
     n = vectors.shape[0]
-    m = rows.shape[0]
-    dt = _elapsed(memory, t)
-    effective = filtered_gravity(constants, memory, dt, masses, vectors)
-    shift = memory[REORGANIZE_SHIFT:REORGANIZE_SHIFT + m]
-    places = target_places(rows, targets, shift, n)
+    dt, effective, shift, places = _begin(constants, memory, t, masses, rows, targets, vectors)
     wanted = allocated_places(constants, effective)
     moved = places.copy()
     for j in range(1, n):

@@ -4,7 +4,8 @@ offsets move online so that the UAVs' thrust margins stay even, or above
 `formation.thrust_margin_floor` (`laws.reorganize`: the statics of Eq. 2.73 at the formation's
 apparent gravity, a rate-limited gradient step within `formation.min_spacing`, `max_spread`,
 `max_offset_rate`). The scenario's parse picks it when `formation.reorganize` is
-`thrust_margin`; every follower computes the same step (its memory keeps its copy).
+`thrust_margin`; every follower computes the same step (its memory keeps its copy). Its
+`answer` also flies `cable_forces` (REORGANIZE_MODE says which step).
 
 Its constants are the seed follower's FOLLOWER_* then the REORGANIZE_* slots (laws.layout),
 its memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT; its matrices the
@@ -15,16 +16,9 @@ import numpy as np
 
 from multilift_control.controllers.followers import virtual_constraints
 from multilift_control.laws import jit
-from multilift_control.laws.follower import follower_update, formation_terms
-from multilift_control.laws.layout import (REORGANIZE_FILTER_TIME, REORGANIZE_FLOOR,
-                                           REORGANIZE_GAIN, REORGANIZE_MAX_RATE,
-                                           REORGANIZE_MAX_SPREAD, REORGANIZE_MIN_SPACING,
-                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_RADIUS,
-                                           REORGANIZE_SHIFT,
-                                           REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_LENGTH,
-                                           REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
-                                           REORGANIZE_UAVS)
-from multilift_control.laws.reorganize import reorganize
+from multilift_control.laws import layout as slots
+from multilift_control.laws.follower import formation_terms
+from multilift_control.laws.reorganize import allocate, reorganize
 from multilift_sim.scenario import Scenario
 from multilift_sim.start import formation_start
 
@@ -34,32 +28,40 @@ GAIN = 25.0         # offset rate per unit of the cost's gradient [m^2/s]
 FILTER_TIME = 1.0   # the apparent gravity's low-pass time constant [s]
 
 
-def arrays(scenario: Scenario, index: int
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(constants, memory at t = 0, P, Q) of follower `index` (from 1): the seed follower's,
-    extended by the REORGANIZE_* slots."""
+def mode_arrays(scenario: Scenario, index: int, mode: float
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(constants, memory at t = 0, P, Q) of follower `index` (from 1) stepping by `mode`
+    (slots.REORGANIZE_GRADIENT or _ALLOCATE): the seed follower's, extended by the
+    REORGANIZE_* slots."""
     constants, memory, p, q = virtual_constraints.arrays(scenario, index)
     f, n = scenario.formation, scenario.n_uavs
-    extra = np.empty(REORGANIZE_UAVS - len(constants) + REORGANIZE_UAV_SIZE * n)
+    extra = np.empty(slots.REORGANIZE_UAVS - len(constants) + slots.REORGANIZE_UAV_SIZE * n)
     own = np.concatenate([constants, extra])
-    own[REORGANIZE_PAYLOAD_MASS] = scenario.payload.mass
-    own[REORGANIZE_MIN_SPACING] = f.min_spacing
-    own[REORGANIZE_MAX_SPREAD] = f.max_spread
-    own[REORGANIZE_MAX_RATE] = f.max_offset_rate
-    own[REORGANIZE_FLOOR] = f.thrust_margin_floor
-    own[REORGANIZE_GAIN] = GAIN
-    own[REORGANIZE_FILTER_TIME] = FILTER_TIME
+    own[slots.REORGANIZE_PAYLOAD_MASS] = scenario.payload.mass
+    own[slots.REORGANIZE_MIN_SPACING] = f.min_spacing
+    own[slots.REORGANIZE_MAX_SPREAD] = f.max_spread
+    own[slots.REORGANIZE_MAX_RATE] = f.max_offset_rate
+    own[slots.REORGANIZE_FLOOR] = f.thrust_margin_floor
+    own[slots.REORGANIZE_GAIN] = GAIN
+    own[slots.REORGANIZE_FILTER_TIME] = FILTER_TIME
     uavs, payload = formation_start(scenario)  # where the formation hangs at the start
-    own[REORGANIZE_RADIUS] = float(np.mean(np.hypot(*(uavs[:, :2] - payload[:2]).T)))
+    own[slots.REORGANIZE_RADIUS] = float(np.mean(np.hypot(*(uavs[:, :2] - payload[:2]).T)))
+    own[slots.REORGANIZE_MODE] = mode
     for j, uav in enumerate(scenario.uavs):
-        row = REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j
-        own[row + REORGANIZE_UAV_MASS] = uav.vehicle.mass
-        own[row + REORGANIZE_UAV_LARGEST] = uav.vehicle.max_thrust
-        own[row + REORGANIZE_UAV_LENGTH] = uav.cable_length
+        row = slots.REORGANIZE_UAVS + slots.REORGANIZE_UAV_SIZE * j
+        own[row + slots.REORGANIZE_UAV_MASS] = uav.vehicle.mass
+        own[row + slots.REORGANIZE_UAV_LARGEST] = uav.vehicle.max_thrust
+        own[row + slots.REORGANIZE_UAV_LENGTH] = uav.cable_length
     rows = p.shape[1]
-    extended = np.zeros(REORGANIZE_SHIFT + rows)  # the acceleration and the shift start at 0
+    extended = np.zeros(slots.REORGANIZE_SHIFT + rows)  # the acceleration, the shift: 0
     extended[:len(memory)] = memory
     return own, extended, p, q
+
+
+def arrays(scenario: Scenario, index: int
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(constants, memory at t = 0, P, Q) of follower `index` (from 1): the gradient's step."""
+    return mode_arrays(scenario, index, slots.REORGANIZE_GRADIENT)
 
 
 @jit
@@ -71,20 +73,15 @@ def shared(constants, masses, rows, targets, states, vectors):
 @jit
 def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses, rows,
            targets, law_p, law_q, terms, speeds, saturated, setpoint, errors, rates):
-    """Follower `index`'s tick at t [s]: the formation's step (`laws.reorganize.reorganize`),
-    then the seed follower's tick (`follower_update`) to the moved targets; writes as
-    `virtual_constraints.answer` and returns the collective thrust asked [N]."""
-    kept = reorganize(constants, memory, t, masses, rows, targets, vectors)
+    """Follower `index`'s tick at t [s]: the formation's step (`laws.reorganize.reorganize`, or
+    `allocate` in REORGANIZE_ALLOCATE mode), then the seed follower's answer to the moved
+    targets (`virtual_constraints.answer`, which writes speeds, saturated, setpoint, errors and
+    rates); returns the collective thrust asked [N]."""
+    if constants[slots.REORGANIZE_MODE] == slots.REORGANIZE_ALLOCATE:
+        kept = allocate(constants, memory, t, masses, rows, targets, vectors)
+    else:
+        kept = reorganize(constants, memory, t, masses, rows, targets, vectors)
     own_terms = formation_terms(constants, masses, rows, kept, states, vectors)
-    s, sat, attitude, thrust, own_errors, own_rates = follower_update(
-        constants, masses, rows, kept, law_p, law_q, index, memory, t, states, vectors,
-        own_terms, cascade, mixer)
-    for k in range(s.shape[0]):
-        speeds[k] = s[k]
-        saturated[k] = sat[k]
-    for k in range(3):
-        setpoint[k] = attitude[k]
-    for k in range(own_errors.shape[0]):
-        errors[k] = own_errors[k]
-        rates[k] = own_rates[k]
-    return thrust
+    return virtual_constraints.answer(constants, memory, cascade, mixer, index, t, states,
+                                      vectors, masses, rows, kept, law_p, law_q, own_terms,
+                                      speeds, saturated, setpoint, errors, rates)

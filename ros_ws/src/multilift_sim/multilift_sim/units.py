@@ -82,7 +82,9 @@ SCENARIO_UNITS: dict[str, str] = {
     'wind.velocity': 'm/s',  # a wind model's keys: its UNITS (multilift_sim.wind)
     'formation.n': NO_UNIT, 'formation.geometry': NO_UNIT, 'formation.offsets': 'm',
     'formation.distance': 'm', 'formation.half_angle_deg': 'deg', 'formation.alpha_vc': '1/s',
-    'formation.beta_vc': '1/s',
+    'formation.beta_vc': '1/s', 'formation.reorganize': NO_UNIT, 'formation.min_spacing': 'm',
+    'formation.max_spread': 'm', 'formation.max_offset_rate': 'm/s',
+    'formation.thrust_margin_floor': NO_UNIT,  # a share of the largest thrust
     'control.mode': NO_UNIT, 'control.follower': NO_UNIT,
     'control.constant_rotor_speed': 'rad/s',
     **{f'control.{k}': u for k, u in GAINS.items()},

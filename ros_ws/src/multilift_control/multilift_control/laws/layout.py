@@ -111,3 +111,26 @@ FOLLOWER_LAST_T = 1     # time of the last tick [s] (NaN: none yet)
 FOLLOWER_LIFT = 2       # (3) the lift asked at the last tick R(eta_d) e_z u_T, world [N] (NaN)
 FOLLOWER_YAW = 5        # the heading held [rad] (NaN: the one measured at the first tick)
 FOLLOWER_MEMORY_SIZE = 6
+
+# --- a reorganising follower (`formation.reorganize: thrust_margin`, laws.reorganize): its
+# constants after the FOLLOWER_* slots ---
+REORGANIZE_PAYLOAD_MASS = FOLLOWER_SIZE       # m_p [kg]
+REORGANIZE_MIN_SPACING = FOLLOWER_SIZE + 1    # least horizontal distance between UAVs [m]
+REORGANIZE_MAX_SPREAD = FOLLOWER_SIZE + 2     # largest horizontal distance between UAVs [m]
+REORGANIZE_MAX_RATE = FOLLOWER_SIZE + 3       # largest speed of a follower's offset [m/s]
+REORGANIZE_FLOOR = FOLLOWER_SIZE + 4          # thrust margin floor [-]
+REORGANIZE_GAIN = FOLLOWER_SIZE + 5           # offset rate per unit of cost gradient [m^2/s]
+REORGANIZE_FILTER_TIME = FOLLOWER_SIZE + 6    # the apparent gravity's low-pass time [s]
+REORGANIZE_RADIUS = FOLLOWER_SIZE + 7         # cable_forces: the UAVs' horizontal distance
+#                                               from the payload at the start [m]
+REORGANIZE_MODE = FOLLOWER_SIZE + 8           # REORGANIZE_GRADIENT or REORGANIZE_ALLOCATE
+REORGANIZE_UAVS = FOLLOWER_SIZE + 9           # then a row of REORGANIZE_UAV_SIZE per UAV:
+REORGANIZE_UAV_MASS = 0                       # its vehicle's mass m_i [kg]
+REORGANIZE_UAV_LARGEST = 1                    # u_T,max,i, every rotor at its limit [N]
+REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]
+REORGANIZE_UAV_SIZE = 3
+REORGANIZE_GRADIENT = 0.0  # thrust_margin: laws.reorganize.reorganize
+REORGANIZE_ALLOCATE = 1.0  # cable_forces: laws.reorganize.allocate
+# its memory after the FOLLOWER_* slots
+REORGANIZE_ACCELERATION = FOLLOWER_MEMORY_SIZE  # (3) the formation's filtered a [m/s^2]
+REORGANIZE_SHIFT = FOLLOWER_MEMORY_SIZE + 3     # (m) the rows' targets moved by [m]

@@ -95,6 +95,12 @@ class FormationConfig:
     half_angle: float                # gamma [rad] (v: vertex angle 2 gamma)
     alpha_vc: float                  # formation derivative gain (Table 4.2) [1/s]
     beta_vc: float                   # formation proportional gain (Table 4.2) [1/s]
+    # issue 35: the offsets moved online by thrust margin (scenario.reorganize); 'none': fixed
+    reorganize: str = 'none'
+    min_spacing: float = 1.0         # least horizontal distance between UAVs [m]
+    max_spread: float = math.inf     # largest horizontal distance between UAVs [m]
+    max_offset_rate: float = 0.2     # largest speed of a follower's offset [m/s]
+    thrust_margin_floor: float = 0.05  # [-] share of the largest thrust
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from multilift_sim.scenario.config import (FORMATION_GEOMETRIES,
 from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_controllers,
                                                 leader_controllers)
 from multilift_sim.scenario.limits import check_limits
+from multilift_sim.scenario import reorganize
 from multilift_sim.scenario.part_files import scenario_parts
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
@@ -182,6 +183,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
         max_tilt=math.radians(c.number('max_tilt_deg', 30.0, lambda a: 0 < a < 90,
                                        'must be within (0, 90) degrees')),
         **_payload_feedback(c, mode))
+    control = reorganize.control_of(c, formation, control)
     gains_pos.done()
     gains_att.done()
     c.done()
@@ -322,7 +324,8 @@ def _formation(f: Section, n: int) -> FormationConfig:
         raise f.fail('geometry', geometry, 'needs n >= 3')
     config = FormationConfig(geometry=geometry, offsets=tuple(offsets), distance=distance,
                              half_angle=half_angle, alpha_vc=f.non_negative('alpha_vc'),
-                             beta_vc=f.non_negative('beta_vc'))
+                             beta_vc=f.non_negative('beta_vc'),
+                             **reorganize.parse(f, n, geometry))
     f.done()
     return config
 
@@ -344,3 +347,4 @@ def _check_feasible(scenario: Scenario) -> None:
                             scenario.payload.attach_points)
         except ValueError as exc:
             raise ScenarioError(f'{scenario.source}: formation: {exc}') from None
+        reorganize.check_start(scenario.source, f, uavs)

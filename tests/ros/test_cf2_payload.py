@@ -5,30 +5,18 @@ headless to 1e-9 m; no rotor saturated; the payload follows its waypoints' minim
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 
+from conftest import flown_alike
 from multilift_sim import scenario as scenario_io
 from multilift_sim.missions.polynomials import evaluate
 
 
 def test_cf2_payload_flies_through_ros_as_headless_and_the_payload_follows(multilift_run,
                                                                            tmp_path):
-    from multilift_tools.bagdata import load_run
-    bags = tmp_path / 'ros', tmp_path / 'headless'
-    run = multilift_run('cf2_payload', bag=bags[0], startup_timeout=600)
-    assert run.wait(timeout=1200) == 0, run.output()[-2000:]
-    headless = subprocess.run([sys.executable, '-m', 'multilift_tools.cli', 'run', 'cf2_payload',
-                               '--headless', '--bag', str(bags[1])], capture_output=True,
-                              text=True, timeout=1200)
-    assert headless.returncode == 0, headless.stderr[-2000:]
-    ros, flown = (load_run(bag) for bag in bags)
-    assert np.array_equal(ros.t, flown.t)
-    assert np.abs(ros.uav_positions() - flown.uav_positions()).max() < 1e-9
-    assert np.abs(ros.payload_position() - flown.payload_position()).max() < 1e-9
-    summary = json.loads((bags[0] / 'summary.json').read_text())
+    ros, _ = flown_alike(multilift_run, 'cf2_payload', tmp_path)
+    summary = json.loads((tmp_path / 'ros' / 'summary.json').read_text())
     assert summary['sim']['saturated_time'] == [0.0, 0.0], summary['sim']
     assert min(summary['sim']['least_thrust_margin']) > 0.3  # room left on every rotor
     mission = scenario_io.load('cf2_payload').mission

@@ -224,19 +224,8 @@ def test_a_leader_and_a_follower_defined_here_fly_headless(tmp_path):
 
 
 def test_the_toys_fly_through_ros_as_headless(multilift_run, tmp_path):
-    from multilift_tools.bagdata import load_run
-    path = _toy_yaml(tmp_path / 'toy.yaml')
-    bags = tmp_path / 'ros', tmp_path / 'headless'
-    run = multilift_run(str(path), bag=bags[0], startup_timeout=600)
-    assert run.wait(timeout=1200) == 0, run.output()
-    headless = subprocess.run([sys.executable, '-m', 'multilift_tools.cli', 'run', str(path),
-                               '--headless', '--bag', str(bags[1])], capture_output=True,
-                              text=True, timeout=1200)
-    assert headless.returncode == 0, headless.stderr[-2000:]
-    ros, flown = (load_run(bag) for bag in bags)
-    assert np.array_equal(ros.t, flown.t)
-    assert np.abs(ros.uav_positions() - flown.uav_positions()).max() < 1e-9
-    assert np.abs(ros.payload_position() - flown.payload_position()).max() < 1e-9
+    from conftest import flown_alike  # (here: a scenario's `parts:` imports this file too)
+    ros, _ = flown_alike(multilift_run, _toy_yaml(tmp_path / 'toy.yaml'), tmp_path)
     # the toys flew it: the leader climbed to the place held
     assert abs(ros.uav_positions()[0][-1, 2] - CLIMB) < 0.01
 

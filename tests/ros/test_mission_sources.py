@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
+from conftest import flown_alike
 from multilift_sim import scenario as scenario_io
 from multilift_sim.missions.polynomials import evaluate
 
@@ -39,7 +40,6 @@ def _headless(path: Path, bag: Path) -> subprocess.CompletedProcess:
 
 @pytest.mark.parametrize('kind', ['waypoints', 'file'])
 def test_a_mission_source_flies_through_ros_as_headless(multilift_run, tmp_path, kind):
-    from multilift_tools.bagdata import load_run
     if kind == 'file':
         (tmp_path / 'path.csv').write_text('t,x,y,z,yaw\n' + ''.join(
             f'{w["time"]},{",".join(map(str, w["position"]))},{w.get("yaw", 0.0)}\n'
@@ -48,15 +48,7 @@ def test_a_mission_source_flies_through_ros_as_headless(multilift_run, tmp_path,
     else:
         mission = {'type': 'waypoints', 'waypoints': WAYPOINTS}
     path = _scenario(tmp_path, mission)
-    bags = tmp_path / 'ros', tmp_path / 'headless'
-    run = multilift_run(str(path), bag=bags[0], startup_timeout=600)
-    assert run.wait(timeout=1200) == 0, run.output()[-2000:]
-    headless = _headless(path, bags[1])
-    assert headless.returncode == 0, headless.stderr[-2000:]
-    ros, flown = (load_run(bag) for bag in bags)
-    assert np.array_equal(ros.t, flown.t)
-    assert np.abs(ros.uav_positions() - flown.uav_positions()).max() < 1e-9
-    assert np.abs(ros.payload_position() - flown.payload_position()).max() < 1e-9
+    ros, _ = flown_alike(multilift_run, path, tmp_path)
     # the leader passed its waypoints (the cascade lags a moving reference a little)
     leader, euler = ros.uav_positions()[0], ros.uav_euler()[0]
     for waypoint in WAYPOINTS:

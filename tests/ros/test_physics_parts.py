@@ -87,15 +87,12 @@ def _scenario_file(folder: Path, **edits) -> Path:
     return path
 
 
-@pytest.mark.parametrize('mode', ['ros', 'headless'])
 def test_a_payload_type_and_a_cable_model_from_a_test_file_fly_as_the_statics_say(
-        tmp_path, multilift_run, mode):
-    from multilift_tools.bagdata import load_run
+        tmp_path, multilift_run):
+    from conftest import flown_alike  # (here: a scenario's `parts:` imports this file too)
     path = _scenario_file(tmp_path)
-    run = multilift_run(str(path), bag=tmp_path / 'bag', headless=mode == 'headless')
-    assert run.wait(timeout=600) == 0, run.output()[-2000:]
-    bag = load_run(tmp_path / 'bag')
-    cable = bag.payload_position()[-1] - bag.uav_positions()[0][-1]  # UAV -> payload [m]
+    ros, _ = flown_alike(multilift_run, path, tmp_path)
+    cable = ros.payload_position()[-1] - ros.uav_positions()[0][-1]  # UAV -> payload [m]
     data = yaml.safe_load(path.read_text())
     drag = 0.5 * AIR_DENSITY * SPHERE_DRAG * math.pi * RADIUS ** 2 * WIND ** 2
     weight = data['payload']['mass'] * data['simulation']['gravity']

@@ -123,13 +123,18 @@ def test_every_reorganising_law_compiled_equals_its_uncompiled_run():
     check(laws.margin_cost, np.array([0.1, 0.12, 0.02]), 0.05)
     check(laws.target_places, constraints.rows, constraints.targets, np.zeros(6), 3)
     check(laws.within_limits, places, 2.0, 8.0)
-    for tick in range(5):
-        lifts = masses[:, None] * (np.array([0.0, 0.0, G]) + rng.normal(scale=0.5, size=(3, 3)))
-        check(laws.reorganize, constants, memory, 0.01 * tick, masses, constraints.rows,
-              constraints.targets, lifts)
-        laws.reorganize(constants, memory, 0.01 * tick, masses, constraints.rows,
-                        constraints.targets, lifts)
-        memory[1] = 0.01 * tick
+
+    def steps(step):  # a few ticks of `step` compiled against uncompiled, its memory advancing
+        for tick in range(5):
+            lifts = masses[:, None] * (np.array([0.0, 0.0, G])
+                                       + rng.normal(scale=0.5, size=(3, 3)))
+            check(step, constants, memory, 0.01 * tick, masses, constraints.rows,
+                  constraints.targets, lifts)
+            step(constants, memory, 0.01 * tick, masses, constraints.rows, constraints.targets,
+                 lifts)
+            memory[1] = 0.01 * tick
+
+    steps(laws.reorganize)
     check(laws._lowest, np.zeros(3), -math.inf, places[0] - [0, 0, 10.0],
           np.array([0.0, 0.0, -1.0]), places, np.full(3, 10.26))
     check(laws.filtered_gravity, constants, memory, 0.01, masses, masses[:, None] * [0, 0, G])
@@ -139,13 +144,7 @@ def test_every_reorganising_law_compiled_equals_its_uncompiled_run():
           places, places + 0.01)
     check(laws.load_shares, constants, effective)
     check(laws.allocated_places, constants, effective)
-    for tick in range(5):
-        lifts = masses[:, None] * (np.array([0.0, 0.0, G]) + rng.normal(scale=0.5, size=(3, 3)))
-        check(laws.allocate, constants, memory, 0.01 * tick, masses, constraints.rows,
-              constraints.targets, lifts)
-        laws.allocate(constants, memory, 0.01 * tick, masses, constraints.rows,
-                      constraints.targets, lifts)
-        memory[1] = 0.01 * tick
+    steps(laws.allocate)
     compiled = {name for name, value in vars(laws).items()
                 if hasattr(value, 'py_func') and value.__module__ == laws.__name__}
     assert {name.rsplit('.', 1)[1] for name in check.met} == compiled
@@ -194,22 +193,14 @@ def test_bad_reorganisation_keys_are_one_line(tmp_path, formation, rule):
     assert rule in str(error.value) and '\n' not in str(error.value)
 
 
-def test_a_circle_cannot_reorganise(tmp_path):
-    data = yaml.safe_load((SCENARIOS / 'circle3.yaml').read_text())
-    data['formation']['reorganize'] = 'thrust_margin'
-    path = tmp_path / 'circle.yaml'
-    path.write_text(yaml.safe_dump(data))
-    with pytest.raises(ScenarioError, match="moves linear or V offsets, not a 'circle'"):
-        scenario_io.load(str(path))
-
-
-def test_cable_forces_allocates_three_cables_only(tmp_path):
-    data = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
-    data['formation']['reorganize'] = 'cable_forces'
-    path = tmp_path / 'twin.yaml'
-    path.write_text(yaml.safe_dump(data))
-    with pytest.raises(ScenarioError, match='allocates three cables in closed form, not 2'):
-        scenario_io.load(str(path))
+@pytest.mark.parametrize('name,reorganize,rule', [
+    ('circle3', 'thrust_margin', "moves linear or V offsets, not a 'circle'"),
+    ('twin_lift', 'cable_forces', 'allocates three cables in closed form, not 2')])
+def test_a_reorganisation_the_formation_cannot_take_is_refused(name, reorganize, rule):
+    data = yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
+    data['formation']['reorganize'] = reorganize
+    with pytest.raises(ScenarioError, match=rule):
+        scenario_io.loads(yaml.safe_dump(data))
 
 
 def test_a_formation_of_one_cannot_reorganise_and_the_command_says_so(tmp_path, capsys):

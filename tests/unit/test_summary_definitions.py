@@ -94,3 +94,19 @@ def test_a_released_cable_leaves_the_swing_to_the_cables_that_hold_the_payload()
     sim = fly(scenario_io.load('v3_uav_loss')).summary()['sim']
     assert 0.0 < sim['max_payload_swing'] < 1.5, sim['max_payload_swing']
     assert sim['rms_payload_swing'] < 0.5, sim['rms_payload_swing']
+
+
+def test_three_taut_cables_leave_no_swing_and_the_summary_says_why():
+    """multi_lift's V of three: the three cables meet at one point under the UAVs, so the
+    payload's rest place is where it is and the swing reads 0.000 m; the summary says why
+    (a twin-lift's payload swings, and its summary has no such line)."""
+    lines = {}
+    for name in ('multi_lift', 'twin_lift'):
+        scenario = scenario_io.load(name).with_duration(SWING_FROM + 5.0)
+        out = io.StringIO()
+        with redirect_stdout(out):
+            print_summary(scenario.name, fly(scenario).summary(), None, scenario)
+        lines[name] = out.getvalue()
+    assert 'payload swing    max 0.000 m' in lines['multi_lift']
+    assert 'three or more taut cables hold the payload' in lines['multi_lift']
+    assert 'three or more taut cables' not in lines['twin_lift']

@@ -100,6 +100,10 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
                              f'{sim["rms_payload_swing"]:.3f} {unit_of("payload_swing_rms")} '
                              f'(horizontal, from its rest place under the UAVs, from t = '
                              f'{since:g} s: not the release)')
+                if scenario.n_uavs >= 3 and sim['max_payload_swing'] < 5e-4:  # prints 0.000
+                    lines.append('                   (three or more taut cables hold the payload '
+                                 'where they meet: it cannot swing under the UAVs, only with '
+                                 'them)')
         if scenario.gusts:
             lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} '
                          f'{unit_of("max_gust_speed")}')

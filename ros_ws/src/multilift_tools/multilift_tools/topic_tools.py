@@ -80,6 +80,9 @@ def _has_topic(node, topic: str):
 
 
 def _topic_info(node, args: argparse.Namespace) -> int:
+    # the topic first (a node may be seen a moment before its topics), then the graph settled
+    # (every publisher and subscription counted); an unknown topic waits DISCOVERY_WAIT
+    _spin_graph(node, until=_has_topic(node, args.topic))
     _spin_graph(node)
     types = dict(node.get_topic_names_and_types()).get(args.topic)
     if types is None:

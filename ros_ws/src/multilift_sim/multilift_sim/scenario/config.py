@@ -222,6 +222,7 @@ class Scenario:
                          baumgarte_beta: float | None = None) -> FormationParams:
         """Physics parameters of the formation DAE (optionally other Baumgarte gains)."""
         sim = self.simulation
+        ropes = any(u.cable_stiffness for u in self.uavs)  # cables that stretch (elastic)
         return FormationParams(
             uavs=tuple(u.vehicle for u in self.uavs),
             cable_lengths=tuple(u.cable_length for u in self.uavs),
@@ -235,10 +236,8 @@ class Scenario:
             payload_attach_points=self.payload.attach_points,
             uav_attach_points=(tuple(u.attach_point for u in self.uavs)
                                if any(any(u.attach_point) for u in self.uavs) else None),
-            cable_stiffness=(tuple(u.cable_stiffness for u in self.uavs)
-                             if any(u.cable_stiffness for u in self.uavs) else None),
-            cable_damping=(tuple(u.cable_damping for u in self.uavs)
-                           if any(u.cable_stiffness for u in self.uavs) else None),
+            cable_stiffness=tuple(u.cable_stiffness for u in self.uavs) if ropes else None,
+            cable_damping=tuple(u.cable_damping for u in self.uavs) if ropes else None,
             substeps=sim.substeps,
         )
 

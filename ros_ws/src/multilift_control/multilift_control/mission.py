@@ -148,9 +148,9 @@ class MissionPath:
 def shifted(mission: MissionConfig, offset: np.ndarray) -> MissionConfig:
     """`mission` with every position moved by `offset` (3,) [m], world: its start and, for a
     polynomial, each piece's constant term and its points."""
-    coefficients = np.array(mission.coefficients, dtype=float).reshape(
-        len(mission.coefficients), PIECE_AXES, -1)
-    if len(coefficients):
+    coefficients = np.array(mission.coefficients, dtype=float)
+    if len(coefficients):  # (a segments mission has none)
+        coefficients = coefficients.reshape(len(coefficients), PIECE_AXES, -1)
         coefficients[:, :3, 0] += offset
     return replace(
         mission, start=tuple(float(v) for v in np.add(mission.start, offset)),

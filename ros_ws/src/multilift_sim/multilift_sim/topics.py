@@ -21,6 +21,8 @@ TRACKING_REFERENCE_TYPE = 'multilift_msgs/msg/TrackingReference'
 FORMATION_ERROR_TYPE = 'multilift_msgs/msg/VirtualConstraintError'
 FORMATION_EVENT_TYPE = 'multilift_msgs/msg/FormationEvent'
 TF_TYPE = 'tf2_msgs/msg/TFMessage'
+POSE_STAMPED_TYPE = 'geometry_msgs/msg/PoseStamped'
+PATH_TYPE = 'nav_msgs/msg/Path'
 
 # topics of the whole run
 CLOCK = '/clock'                        # simulated time, the simulator only
@@ -33,6 +35,8 @@ MARKER_DECIMATION = 10                  # MARKERS every this many control ticks
 TF = '/tf'                              # world -> uav{i}/base_link, world -> payload
 EVENTS = '/formation/events'            # the scenario's events as they happen
 WIND = '/formation/wind'                # the air's velocity everywhere [m/s], world
+GOAL = '/formation/goal'                # a live goal for the leader (run --live), world
+PATH = '/formation/path'                # a live path for the leader (run --live), world
 
 # leaves of the per-UAV topics /uav{i}/{leaf}
 ODOM = 'odom'                           # UAV i's state (every UAV)
@@ -53,6 +57,8 @@ RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
 EVENT_TYPES = {EVENTS: FORMATION_EVENT_TYPE}
 # the topic of a run whose air moves everywhere (run_topics(wind=True), Scenario.has_wind)
 WIND_TYPES = {WIND: VECTOR3_STAMPED_TYPE}
+# the topics a live run's leader reads (run_topics(live=True), `multilift run --live`)
+LIVE_TYPES = {GOAL: POSE_STAMPED_TYPE, PATH: PATH_TYPE}
 
 _UAV_TOPIC = re.compile(r'^/uav([1-9][0-9]*)/(' + '|'.join(UAV_TYPES) + r')$')
 
@@ -84,21 +90,24 @@ def parse_uav_topic(topic: str) -> tuple[int, str] | None:
 
 def topic_type(topic: str) -> str | None:
     """The type a multilift topic has (`pkg/msg/Type`), or None for a name not of a run."""
-    if topic in RUN_TYPES or topic in EVENT_TYPES or topic in WIND_TYPES:
-        return {**RUN_TYPES, **EVENT_TYPES, **WIND_TYPES}[topic]
+    every = {**RUN_TYPES, **EVENT_TYPES, **WIND_TYPES, **LIVE_TYPES}
+    if topic in every:
+        return every[topic]
     parsed = parse_uav_topic(topic)
     return UAV_TYPES[parsed[1]] if parsed else None
 
 
 def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
-               sensors: bool = False, wind: bool = False) -> list[tuple[str, str]]:
+               sensors: bool = False, wind: bool = False, live: bool = False
+               ) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
     which has no reference, set-points or formation errors); with `events` (a scenario with
     `events:`), /formation/events; with `sensors` (a scenario with `sensors:`), every
-    /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind."""
+    /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind; with `live`
+    (`run --live`), /formation/goal and /formation/path."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
-        list(WIND_TYPES.items()) if wind else [])
+        list(WIND_TYPES.items()) if wind else []) + (list(LIVE_TYPES.items()) if live else [])
     if controllers:
         topics.append((REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE))
     for i in range(1, n_uavs + 1):
@@ -112,11 +121,12 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
     return topics
 
 
-def scenario_topics(scenario, controllers: bool = True) -> list[tuple[str, str]]:
+def scenario_topics(scenario, controllers: bool = True, live: bool = False
+                    ) -> list[tuple[str, str]]:
     """`run_topics` of a scenario (multilift_sim.scenario.Scenario): its n, and the topics its
-    `events:`, `sensors:` and wind add."""
+    `events:`, `sensors:` and wind add (and a live run's, `live`)."""
     return run_topics(scenario.n_uavs, controllers, bool(scenario.events),
-                      scenario.sensors is not None, scenario.has_wind)
+                      scenario.sensors is not None, scenario.has_wind, live)
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

@@ -43,6 +43,8 @@ DELEGATED = {
     'loads': ('multilift_tools.loads_cli', 'loads_main',
               "each cable's tension and each UAV's thrust margin, at hover and over the mission "
               '(statics of Eq. 2.73)'),
+    'goal': ('multilift_tools.goal_command', 'goal_main',
+             'send the formation a live goal: X Y Z [--yaw DEG] (run --live)'),
     'study': ('multilift_tools.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
     'bag': ('multilift_tools.bags.command', 'bag_main',
             'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),
@@ -88,6 +90,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument('--compose', action='store_true',
                      help='every controller node (leader and followers) in one process, one '
                           'executor: the same graph and bag, fewer processes')
+    run.add_argument('--live', action='store_true',
+                     help='the leader holds its start until a goal (/formation/goal, '
+                          '`multilift goal`) or a path (/formation/path) arrives '
+                          '(docs/missions.md)')
     run.set_defaults(func=cmd_run)
     node = sub.add_parser('node', help='run one node, like `ros2 run`')
     node.add_argument('package')

@@ -75,6 +75,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         if external:
             print('error: --external needs the ROS graph (not --headless)', file=sys.stderr)
             return 2
+        if args.live:
+            print('error: --live reads goals from the ROS graph (not --headless)',
+                  file=sys.stderr)
+            return 2
         return _run_headless(scenario, None if args.bag is None else Path(args.bag))
     scenario_path = str(scenario_io.resolve(args.scenario).resolve())
     work = Path(tempfile.mkdtemp(prefix=f'multilift-{scenario.name}-'))
@@ -85,7 +89,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         sim_exe = find_executable('multilift_sim', 'sim_node')
         recorder_exe = find_executable('multilift_sim', 'recorder_node')
-        controllers = _controller_children(scenario, external, args.compose, common, work)
+        controllers = _controller_children(scenario, external, args.compose, common, work,
+                                           args.live)
     except FileNotFoundError as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2
@@ -107,7 +112,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         ours = {f'/uav{i}/{leaf}' for i in external
                 for leaf in (ROTOR_CMD, REFERENCE, ATTITUDE_SETPOINT, FORMATION_ERROR)}
         topics = [f'{name}|{kind}' for name, kind in
-                  scenario_topics(scenario) if name not in ours]
+                  scenario_topics(scenario, live=args.live) if name not in ours]
         recorder = Child('recorder_node', [str(recorder_exe), *ros_args(
             {'bag': str(bag), 'topics': topics})], work / 'recorder_node.log', 'recorder')
         children.append(recorder)
@@ -150,23 +155,25 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _controller_children(scenario, external: list[int], compose: bool, common: dict,
-                         work: Path) -> list[Child]:
+                         work: Path, live: bool = False) -> list[Child]:
     """The processes of the controllers of every UAV but the external ones: a leader_node and
-    a follower_node each, or with `compose` one controllers_node holding them all."""
+    a follower_node each, or with `compose` one controllers_node holding them all; `live`: the
+    leader reads live goals (its `live` parameter)."""
     ours = [i for i in range(1, scenario.n_uavs + 1) if i not in external]
     if compose:
         if not ours:
             return []
         argv = [str(find_executable('multilift_control', 'controllers_node')),
                 common['scenario'], '--summary-dir', common['summary_dir']]
-        argv += (['--record'] if common['record'] else []) + (
+        argv += (['--record'] if common['record'] else []) + (['--live'] if live else []) + (
             ['--external', ','.join(f'uav{i}' for i in external)] if external else [])
         return [Child(f'controllers ({_uav_ranges(ours)})', argv, work / 'controllers_node.log',
                       'controller')]
     children = []
     for i in ours:
         if i == 1:
-            argv = [str(find_executable('multilift_control', 'leader_node')), *ros_args(common)]
+            argv = [str(find_executable('multilift_control', 'leader_node')),
+                    *ros_args(dict(common, live=True) if live else common)]
             children.append(Child('leader_node', argv, work / 'leader_node.log', 'controller'))
         else:
             argv = [str(find_executable('multilift_control', 'follower_node')),

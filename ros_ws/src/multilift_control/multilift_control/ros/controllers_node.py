@@ -6,7 +6,7 @@ those of separate processes: a user's tools see the same graph, one process fewe
 `multilift run SCENARIO --compose` starts it.
 
     ros2 run multilift_control controllers_node SCENARIO [--external uav1,uav3,...] [--record]
-        [--summary-dir DIR] [--ros-args ...]
+        [--live] [--summary-dir DIR] [--ros-args ...]
 
 The lockstep is the one of separate processes: the nodes still talk through the topics (the
 leader's command reaches the followers as a message), and a follower answers the state at t
@@ -33,7 +33,7 @@ from multilift_sim.topics import parse_external
 
 
 def controller_nodes(scenario: str, external: str = '', record: bool = False,
-                     summary_dir: str = '') -> Iterator[Node]:
+                     summary_dir: str = '', live: bool = False) -> Iterator[Node]:
     """The controller nodes of `scenario` (a name in scenarios/ or a YAML path), but those of
     the UAVs in `external` (`uav1,uav3`), with the parameters each would get alone."""
     n = scenario_io.load(scenario).n_uavs
@@ -47,7 +47,7 @@ def controller_nodes(scenario: str, external: str = '', record: bool = False,
               Parameter('summary_dir', value=summary_dir)]
     for i in range(1, n + 1):
         if i == 1 and i not in skipped:
-            yield LeaderNode(parameter_overrides=common)
+            yield LeaderNode(parameter_overrides=[*common, Parameter('live', value=live)])
         elif i not in skipped:
             yield FollowerNode(f'follower{i}', parameter_overrides=[
                 *common, Parameter('uav_index', value=i)])
@@ -62,11 +62,14 @@ def main(args: list[str] | None = None) -> NoReturn:
                         help='UAVs whose controllers run elsewhere: not composed here')
     parser.add_argument('--record', action='store_true',
                         help='a recorder records the run: wait for it before the first answer')
+    parser.add_argument('--live', action='store_true',
+                        help='the leader flies live goals and paths (multilift run --live)')
     parser.add_argument('--summary-dir', default='', metavar='DIR',
                         help="leave each node's run figures as DIR/<node>.json")
     options = parser.parse_args(remove_ros_args(args)[1:])
     run_nodes(lambda: controller_nodes(options.scenario, options.external, options.record,
-                                       options.summary_dir), serve, args, name='controllers')
+                                       options.summary_dir, options.live), serve, args,
+                           name='controllers')
 
 
 if __name__ == '__main__':

@@ -4,7 +4,8 @@ Subscribes `/formation/snapshot`; for every state it answers with `/uav1/rotor_c
 state's time, and publishes what it aimed at on `/uav1/reference` (mission reference) and
 `/uav1/attitude_setpoint` (outer-loop output). The control law and the statistics are the
 controller runtime's (multilift_control.runtime), shared with the headless loop.
-Parameters: scenario, record, summary_dir.
+Parameters: scenario, record, summary_dir, live (`multilift run --live`: the mission's start
+held until a goal on `/formation/goal` or a path on `/formation/path` arrives, `ros.live_input`).
 """
 from __future__ import annotations
 
@@ -15,7 +16,9 @@ from multilift_msgs.msg import (AttitudeSetpoint, FormationSnapshot, RotorComman
 from rclpy.node import Node
 
 from multilift_control.answer_messages import AnswerMessages
+from multilift_control.live_goals import LiveMission
 from multilift_control.ros.common import SNAPSHOT_TOPIC, SnapshotReader, serve
+from multilift_control.ros.live_input import LiveInput
 from multilift_control.runtime import ControllerRuntime, prepare_node_laws
 from multilift_sim import scenario as scenario_io
 from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, SUBSCRIBER_QOS, Fatal,
@@ -45,6 +48,8 @@ class LeaderNode(Node):
         self.outputs = RawPublishers(self.cmd_pub, self.ref_pub, self.setpoint_pub,
                                      confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         self.read_snapshot = SnapshotReader(scenario)
+        self.live = (LiveInput(self, LiveMission(self.runtime.leader, scenario))
+                     if self.declare_parameter('live', False).value else None)
         self.create_subscription(FormationSnapshot, SNAPSHOT_TOPIC, self.on_snapshot,
                                  SUBSCRIBER_QOS, raw=True)
 
@@ -53,6 +58,8 @@ class LeaderNode(Node):
 
     def on_snapshot(self, data: bytes) -> None:
         t_ns, states, _ = self.read_snapshot(data)
+        if self.live is not None:
+            self.live.apply(t_ns * 1e-9)
         self.outputs.send(self.packer.of(self.runtime.answer(t_ns, states)))
 
 

@@ -50,7 +50,8 @@ register, unregister, registered = (MISSION_SOURCES.register, MISSION_SOURCES.un
 def read_mission(top: Any, start: tuple[float, float, float]) -> Any:
     """The scenario's `mission:` (top: the file's `Section`) as a MissionConfig, read by the
     source its `type` names; `start` the leader's start position, world [m]."""
-    from multilift_sim.scenario.config import ScenarioError  # scenario imports this module
+    from multilift_sim.scenario.config import MissionConfig, ScenarioError  # (imports us)
+    config_defaults = MissionConfig(start=(0.0, 0.0, 0.0), segments=())
     m = top.section('mission')
     kind = m.text('type', DEFAULT_SOURCE, choices=tuple(MISSION_SOURCES))
     tracks = m.text('tracks', 'leader', choices=TRACKED)
@@ -59,9 +60,11 @@ def read_mission(top: Any, start: tuple[float, float, float]) -> Any:
     if tracks == 'payload' and kind == DEFAULT_SOURCE and not m.has('start'):
         raise ScenarioError(f'{top.where}: mission.start: missing key (with mission.tracks: '
                             f'payload the segments start at the payload\'s start position)')
+    limits = {key: m.positive(key, getattr(config_defaults, key))
+              for key in ('max_speed', 'max_acceleration')}  # a live goal's (run --live)
     config = MISSION_SOURCES[kind].read(m, start, folder)
     m.done()
-    return dataclasses.replace(config, type=kind, tracks=tracks)
+    return dataclasses.replace(config, type=kind, tracks=tracks, **limits)
 
 
 def source_of(mission: Any) -> Any:

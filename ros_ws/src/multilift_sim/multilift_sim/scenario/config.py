@@ -150,6 +150,9 @@ class MissionConfig:
     knots: tuple[float, ...] = ()
     coefficients: tuple[tuple[tuple[float, ...], ...], ...] = ()
     points: tuple[tuple[float, float, float], ...] = ()  # the points it passes, world [m]
+    # how fast a live goal is flown (`run --live`, multilift_control.live_goals) [m/s, m/s^2]
+    max_speed: float = 1.0
+    max_acceleration: float = 0.5
 
 
 @dataclass(frozen=True)

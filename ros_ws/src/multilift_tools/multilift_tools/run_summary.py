@@ -81,6 +81,11 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
         lines.extend(fault_lines(scenario, sim.get('events', []), sim.get('simulated_time')))
         lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} '
                      f'{unit_of("max_tension")}')
+        for i, (stretch, peak) in enumerate(zip(sim.get('max_stretch', []),
+                                                sim.get('peak_tension', []))):
+            lines.append(f'  rope {i + 1}           max stretch {stretch:.3g} '
+                         f'{unit_of("max_stretch")}, peak '
+                         f'tension {peak:.2f} {unit_of("peak_tension")} (at the control ticks)')
         if sim.get('compressed_time'):
             lines.append(f'  warning: a cable pushed for {sim["compressed_time"]:.2f} '
                          f'{unit_of("compressed_time")} (least tension {sim["min_tension"]:.2f} '

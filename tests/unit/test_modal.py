@@ -258,3 +258,14 @@ def test_modal_main_bad_scenario_is_one_line_and_exit_2(tmp_path, capsys):
     assert modal_main([]) == 2
     assert capsys.readouterr().err.count('\n') == 1
     assert not any(tmp_path.iterdir())
+
+
+def test_modal_main_refuses_elastic_cables_in_one_line(tmp_path, capsys):
+    """The linearisation eliminates each cable's length: ropes that stretch have modes it
+    cannot give (issue 32), so it says why rather than analyse the wrong system."""
+    assert modal_main(['twin_lift_elastic', '--out', str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert err.startswith('error: cable_model: elastic: the modal analysis linearises cables '
+                          'of fixed length')
+    assert not any(tmp_path.iterdir())

@@ -109,3 +109,24 @@ def test_the_summary_gives_each_rope_s_stretch_and_peak_tension():
     rigid = yaml.safe_load((SCENARIOS / 'twin_lift.yaml').read_text())
     rigid['simulation']['duration'] = 1.0
     assert 'peak_tension' not in fly(scenario_io.loads(yaml.safe_dump(rigid))).summary()['sim']
+
+
+@pytest.mark.parametrize('cable, uav_cable, message', [
+    ({'stiffness': -500.0}, None, r'cable\.stiffness: -500\.0 must be > 0'),
+    ({'axial_stiffness': 0.0}, None, r'cable\.axial_stiffness: 0\.0 must be > 0'),
+    ({'stiffness': 500.0, 'damping': -1.0}, None, r'cable\.damping: -1\.0 must be >= 0'),
+    ({'stiffness': 'stiff'}, None, r'cable\.stiffness: .stiff. must be a number'),
+    ({'stiffness': 500.0, 'stretch': 1.0}, None, r'cable.*stretch'),
+    ({'stiffness': 500.0}, {'stiffness': -1.0}, r'uavs\[0\]\.cable\.stiffness: -1\.0 must be > 0'),
+    ({'damping': 1.0}, None, r'needs stiffness \[N/m\] or axial_stiffness \[N\]'),
+])
+def test_bad_rope_keys_are_one_line(cable, uav_cable, message):
+    """What no rope is (negative or zero stiffness, negative damping, a word, an unknown key,
+    a UAV's override, no stiffness at all) is refused in one line naming the key."""
+    data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
+    data.update(cable_model='elastic', cable=cable)
+    if uav_cable is not None:
+        data['uavs'][0]['cable'] = uav_cable
+    with pytest.raises(scenario_io.ScenarioError, match=message) as caught:
+        scenario_io.loads(yaml.safe_dump(data))
+    assert '\n' not in str(caught.value)

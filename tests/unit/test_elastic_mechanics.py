@@ -1,6 +1,7 @@
 """Elastic cables (`cable_model: elastic`, issue 32 item 4) against mechanics worked out here:
-the snap load of a payload dropped from slack under a held UAV (energy: m g (h + x) = k x^2 / 2)
-and the payload's path converging to the rigid cables' as the ropes stiffen."""
+the snap load of a payload dropped from slack under a held UAV (energy: m g (h + x) = k x^2 / 2),
+a held bounce's frequency and energy over 10 s, the payload's path converging to the rigid
+cables' as the ropes stiffen, the summary's rope figures and bad rope keys."""
 from __future__ import annotations
 
 import math
@@ -77,6 +78,43 @@ def test_a_payload_dropped_from_slack_feels_the_snap_load():
     slack_until = math.sqrt(2 * h / G)   # [s]: it falls freely until then
     first_taut = next(i for i, t in enumerate(tensions) if t > 0.0) / 2000.0
     assert first_taut == pytest.approx(slack_until, abs=1e-3)
+
+
+def test_a_held_bounce_keeps_its_frequency_and_energy_for_ten_seconds():
+    """Held UAV, no damping, no drag: the payload pulled 5 mm below its rest place (less than
+    the static stretch m g / k = 7.8 mm: the rope stays taut) bounces at sqrt(k / m) (its
+    zero crossings over 10 s, to 0.1 %), and kinetic + gravitational + elastic energy (the
+    held UAV's share and its rotors' constant force's work included) stays within 1e-6 of the
+    oscillation's own k A^2 / 2 over the 10 s (RK4 at omega h = 0.018)."""
+    k, amplitude = 500.0, 0.005
+    s, sim = _held_drop(k, 0.0, duration=10.0)
+    m, length = s.payload.mass, s.uavs[0].cable_length
+    layout = StateLayout(1)
+    x = sim.state
+    layout.payload_position(x)[2] -= m * G / k + amplitude   # below the rest length's end
+    sim.state = x
+    thrust = (HELD_MASS + m) * G   # [N]: the rotors lift the whole weight
+    speeds = [np.full(4, math.sqrt(thrust / (4 * s.uavs[0].vehicle.thrust_coefficient)))]
+    flags = [np.zeros(4, dtype=bool)]
+    energies, heights = [], []
+    while True:
+        x = sim.state
+        r, p = layout.uav_positions(x)[0], layout.payload_position(x)
+        v, w = layout.uav_velocities(x)[0], layout.payload_velocity(x)
+        stretch = np.linalg.norm(p - r) - length
+        energies.append(0.5 * HELD_MASS * v @ v + 0.5 * m * w @ w + m * G * p[2]
+                        + (HELD_MASS * G - thrust) * r[2] + 0.5 * k * max(stretch, 0.0) ** 2)
+        heights.append(p[2] - r[2])
+        if sim.finished:
+            break
+        sim.advance(speeds, flags)
+    assert np.ptp(energies) < 1e-6 * 0.5 * k * amplitude ** 2
+    offset = np.array(heights) - np.mean(heights)
+    t = np.arange(len(offset)) / 2000.0
+    up = np.flatnonzero((offset[:-1] < 0.0) & (offset[1:] >= 0.0))   # upward zero crossings
+    crossings = t[up] + (t[up + 1] - t[up]) * -offset[up] / (offset[up + 1] - offset[up])
+    period = (crossings[-1] - crossings[0]) / (len(crossings) - 1)  # [s]
+    assert 2 * math.pi / period == pytest.approx(math.sqrt(k / m), rel=1e-3)
 
 
 def test_the_payload_s_path_converges_to_the_rigid_cables_one():

@@ -1,5 +1,6 @@
 """An elastic twin-lift (`cable_model: elastic`, docs/cables.md) flies through ROS as headless:
-the same trajectories and tensions (the one tick), its ropes never pushing."""
+the same trajectories and tensions (the one tick), its ropes never pushing, and the same
+rope figures in summary.json (each rope's max stretch and peak tension)."""
 from __future__ import annotations
 
 import numpy as np
@@ -17,3 +18,8 @@ def test_an_elastic_twin_lift_flies_alike_through_ros_and_headless(tmp_path, mul
     ros, headless = flown_alike(multilift_run, path, tmp_path)
     assert np.abs(ros.tensions() - headless.tensions()).max() < 1e-6
     assert ros.tensions().min() >= 0.0 and ros.tensions().max() > 3.0  # ropes pull, never push
+    for key in ('max_stretch', 'peak_tension'):
+        np.testing.assert_allclose(ros.summary['sim'][key], headless.summary['sim'][key],
+                                   rtol=1e-9)
+    np.testing.assert_allclose(ros.summary['sim']['peak_tension'], ros.tensions().max(axis=0),
+                               rtol=1e-9)

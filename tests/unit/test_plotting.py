@@ -366,3 +366,20 @@ def test_compare_twin_and_multi(bags, tmp_path, capsys):
     swing = [float(v) for v in rows['payload swing, max [m]'][:2]]
     assert swing[0] == pytest.approx(0.8, abs=0.1)
     assert swing[1] == pytest.approx(0.3, abs=0.05)
+
+
+def test_plot_draws_the_ropes_of_an_elastic_run_only(bags, tmp_path, capsys):
+    """A run whose summary gives rope stretch (cable_model: elastic) gets rope_stretch.png;
+    the rigid twin-lift's bag skips it, saying why."""
+    path, _ = bags['twin']
+    assert plot_main([str(path), '--out', str(tmp_path / 'rigid')]) == 0
+    assert 'skipped rope_stretch: no elastic ropes' in capsys.readouterr().err
+    elastic = tmp_path / 'elastic'
+    make_bag(elastic, 2, scenario='twin_lift_elastic')
+    summary = json.loads((elastic / 'summary.json').read_text())
+    summary['sim'].update(max_stretch=[4e-4, 3e-4], peak_tension=[6.0, 5.0])
+    (elastic / 'summary.json').write_text(json.dumps(summary))
+    assert plot_main([str(elastic), '--out', str(tmp_path / 'figs')]) == 0
+    written = _printed_paths(capsys.readouterr().out)
+    assert {p.stem for p in written} == ALL_FIGURES | {'rope_stretch'}
+    _pngs_ok(written)

@@ -55,6 +55,11 @@ VEHICLE_UNITS: dict[str, str] = {
     'motor_rate_limit': 'rad/s^2', 'drag_coefficient': 'N s^2/m^2',
 }
 
+# an elastic rope's keys (`cable:` and `uavs[i].cable:`, multilift_sim.cables.elastic)
+ROPE_UNITS = {'stiffness': 'N/m', 'axial_stiffness': 'N', 'damping': 'N s/m'}
+# an elastic run's figures per cable (the summary's, not a sweep column)
+ROPE_FIGURE_UNITS = {'max_stretch': 'm', 'peak_tension': 'N'}
+
 GAINS = {'position_gains.kp': '1/s^2', 'position_gains.kd': '1/s', 'position_gains.ki': '1/s^3',
          'attitude_gains.kp': '1/s^2', 'attitude_gains.kd': '1/s'}
 
@@ -68,7 +73,8 @@ SCENARIO_UNITS: dict[str, str] = {
     'simulation.gravity': 'm/s^2', 'simulation.baumgarte_alpha': '1/s',
     'simulation.baumgarte_beta': '1/s', 'simulation.constraint_tolerance': 'm^2',
     'simulation.constraint_rate_tolerance': 'm^2/s', 'simulation.command_timeout': 's',
-    'simulation.integrator': NO_UNIT,
+    'simulation.integrator': NO_UNIT, 'simulation.substeps': NO_UNIT,
+    **{f'{where}cable.{k}': u for where in ('', 'uavs[].') for k, u in ROPE_UNITS.items()},
     **{f'vehicle.{k}': u for k, u in VEHICLE_UNITS.items()},
     **{f'uavs[].{k}': u for k, u in VEHICLE_UNITS.items()},
     'uavs[].cable_length': 'm', 'uavs[].position': 'm', 'uavs[].yaw': 'rad',
@@ -105,7 +111,8 @@ SCENARIO_UNITS: dict[str, str] = {
     'events[].velocity': 'm/s',
 }
 
-UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS}
+UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS,
+                         **ROPE_FIGURE_UNITS}
 
 _INDEX = re.compile(r'\[\d+\]')
 _WIND_KEY = re.compile(r'^wind\.(\w+)\.(\w+)(?:\[\])?$')  # wind.<model>.<key>

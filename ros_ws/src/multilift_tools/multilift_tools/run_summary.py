@@ -66,8 +66,10 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
                      f'{unit_of("wall_time")} wall '
                      f'({t / wall if wall else 0:.1f}x real time)')
         tol = scenario.simulation.constraint_tolerance
+        bound = (f'tolerance {tol:g}' if 'max_stretch' not in sim else
+                 'the ropes\' stretch: no tolerance, ropes are no constraints')
         lines.append(f'  max |g|          {sim["max_abs_constraint"]:.3g} {unit_of("max_abs_g")} '
-                     f'(tolerance {tol:g})')
+                     f'({bound})')
         lines.append(f'  max |g_dot|      {sim["max_abs_constraint_rate"]:.3g} '
                      f'{unit_of("max_abs_g_dot")}')
         margins = sim.get('least_thrust_margin') or [None] * len(sim['max_rotor_speed'])
@@ -81,6 +83,11 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
         lines.extend(fault_lines(scenario, sim.get('events', []), sim.get('simulated_time')))
         lines.append(f'  cable tension    {sim["min_tension"]:.2f} .. {sim["max_tension"]:.2f} '
                      f'{unit_of("max_tension")}')
+        for i, (stretch, peak) in enumerate(zip(sim.get('max_stretch', []),
+                                                sim.get('peak_tension', []))):
+            lines.append(f'  rope {i + 1}           max stretch {stretch:.3g} '
+                         f'{unit_of("max_stretch")}, peak '
+                         f'tension {peak:.2f} {unit_of("peak_tension")} (at the control ticks)')
         if sim.get('compressed_time'):
             lines.append(f'  warning: a cable pushed for {sim["compressed_time"]:.2f} '
                          f'{unit_of("compressed_time")} (least tension {sim["min_tension"]:.2f} '

@@ -17,6 +17,7 @@ from multilift_sim.analysis.coordinates import (coordinate_accelerations, displa
                                                 mass_matrix)
 from multilift_sim.analysis.equilibrium import Equilibrium, scenario_equilibrium
 from multilift_sim.analysis.modes import MODE_KINDS, mode_kind, motion_shares, real_shapes
+from multilift_sim.cables import CABLE_MODELS
 from multilift_sim.dynamics import FormationModel
 from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.physics.layout import POSITION, seed_payload_slot, seed_uav_slot
@@ -205,7 +206,14 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
 
 
 def scenario_modal_analysis(scenario: Scenario, **options: Any) -> ModalAnalysis:
-    """modal_analysis of a scenario's formation at its static equilibrium (Eq. 2.73)."""
+    """modal_analysis of a scenario's formation at its static equilibrium (Eq. 2.73).
+    ValueError (one line) for cables that stretch (`cable_model: elastic`): the linearisation
+    eliminates each cable's length (Eq. 2.71), so it has no rope's axial mode to give."""
+    if not CABLE_MODELS[scenario.cable_model].KEEPS_LENGTH:
+        raise ValueError(f'cable_model: {scenario.cable_model}: the modal analysis linearises '
+                         'cables of fixed length (their lengths are the constraints it '
+                         'eliminates, Eq. 2.71) and has no rope stretch to give axial modes; '
+                         'analyse the scenario with cable_model: rigid for its pendulum modes')
     return modal_analysis(scenario.formation_params(0.0, 0.0), scenario_equilibrium(scenario),
                           **options)
 

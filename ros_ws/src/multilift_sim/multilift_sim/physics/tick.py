@@ -19,7 +19,7 @@ from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.attitude import quaternion_norm_error
-from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_WIND,
+from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_ELASTIC, FORMATION_WIND,
                                           STATUS_FINISHED, STATUS_QUATERNION,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
                                           STATUS_OFF_RATE, STATUS_RUNNING,
@@ -30,7 +30,8 @@ from multilift_sim.physics.measurement import measured_states
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
                                                    run_add_compression, run_add_gust_speed,
-                                                   run_add_slack, run_add_tensions,
+                                                   run_add_ropes, run_add_slack,
+                                                   run_add_tensions,
                                                    run_add_thrust_margin, run_check)
 from multilift_sim.statistics.layout import (CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE,
                                              CHECK_QUATERNION)
@@ -144,6 +145,8 @@ def advance(a, m, b, speeds, saturated, tension):
         tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
     run_add_tensions(m.run[b], tension)
     run_add_compression(m.run[b], tension, period)
+    if formation[FORMATION_ELASTIC] != 0.0:  # each rope's stretch and tension at the tick
+        run_add_ropes(m.run[b], m.state[b], a.uavs[b], tension)
     if a.slack[b]:
         run_add_slack(m.run[b], m.taut[b], period)
     m.state[b, :] = state

@@ -15,16 +15,16 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import quaternion_norm_error
-from multilift_sim.physics.layout import POSITION, UAV_COORDINATES
+from multilift_sim.physics.layout import POSITION, UAV_COORDINATES, UAV_LENGTH_SQ
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, uav_attitude_slot,
                                                uav_slot)
 from multilift_sim.statistics.layout import (
     CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, CHECK_QUATERNION, FORMATION_MAX_ABS,
     FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ,
     QUATERNION_NORM_TOLERANCE, RUN_COMPRESSED_TIME, RUN_LEAST_THRUST_MARGIN, RUN_MAX_ABS_G,
-    RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION,
-    RUN_MIN_TENSION, RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME,
-    RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
+    RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_STRETCH,
+    RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
+    RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
 from multilift_sim.statistics.swing import swing_at
 
 
@@ -104,6 +104,26 @@ def run_add_tensions(run: np.ndarray, tension: np.ndarray) -> None:
         run[RUN_MIN_TENSION] = low
     if high > run[RUN_MAX_TENSION]:
         run[RUN_MAX_TENSION] = high
+
+
+@jit
+def run_add_ropes(run: np.ndarray, state: np.ndarray, uavs: np.ndarray,
+                  tension: np.ndarray) -> None:
+    """Elastic ropes (cable_model: elastic) at one tick: each rope's stretch L_i - l_i [m]
+    (L_i = |r_p - r_i| in the formation state x, l_i its rest length, sqrt of the UAVs'
+    UAV_LENGTH_SQ; negative when slack) and its tension T_i (n,) [N] raise its maxima
+    (RUN_MAX_STRETCH, RUN_PEAK_TENSION)."""
+    n = tension.shape[0]
+    p = payload_slot(n)
+    for i in range(n):
+        r = uav_slot(i) + POSITION
+        dx, dy, dz = state[p] - state[r], state[p + 1] - state[r + 1], state[p + 2] - state[r + 2]
+        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - math.sqrt(uavs[i, UAV_LENGTH_SQ])
+        block = RUN_SCALARS + RUN_UAV_COLUMNS * i
+        if stretch > run[block + RUN_MAX_STRETCH]:
+            run[block + RUN_MAX_STRETCH] = stretch
+        if tension[i] > run[block + RUN_PEAK_TENSION]:
+            run[block + RUN_PEAK_TENSION] = tension[i]
 
 
 @jit

@@ -17,10 +17,10 @@ from multilift_sim import kernels
 from multilift_sim.statistics.layout import (
     FORMATION_MAX_ABS, FORMATION_NORM_SUM, FORMATION_SAMPLES, FORMATION_SIZE, PEAK_MAX,
     PEAK_SAMPLES, PEAK_SIZE, PEAK_SUM_SQ, RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
-    RUN_LEAST_THRUST_MARGIN, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_TENSION,
-    RUN_MIN_TENSION,
-    RUN_SATURATED_TIME, RUN_SCALARS, RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING,
-    RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR, TRACKING_SIZE, run_size)
+    RUN_LEAST_THRUST_MARGIN, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_STRETCH,
+    RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
+    RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR,
+    TRACKING_SIZE, run_size)
 
 
 def compiled(module: str, name: str) -> Callable:
@@ -187,6 +187,8 @@ class RunStatistics:
             run[RUN_MIN_TENSION] = math.inf
             run[RUN_MAX_TENSION] = -math.inf
             run[RUN_SCALARS + RUN_LEAST_THRUST_MARGIN:run_size(n_uavs):RUN_UAV_COLUMNS] = math.inf
+            for column in (RUN_MAX_STRETCH, RUN_PEAK_TENSION):  # elastic ropes' only
+                run[RUN_SCALARS + column:run_size(n_uavs):RUN_UAV_COLUMNS] = -math.inf
         self.run = run
         self.swing = PeakRms(self.run, RUN_SWING)      # payload swing [m]
         self._functions = {name: compiled('accumulators', name) for name in (
@@ -223,6 +225,15 @@ class RunStatistics:
         """Per UAV, the least share of its largest thrust its commands left, 1 - u_T / u_T,max
         (rotor effectiveness included; None before a command)."""
         return [v if math.isfinite(v) else None for v in self._per_uav(RUN_LEAST_THRUST_MARGIN)]
+
+    @property
+    def rope_figures(self) -> dict:
+        """Elastic ropes' (cable_model: elastic) per cable: {'max_stretch': [m] (L_i - l_i),
+        'peak_tension': [N]}, sampled at every control tick; {} in any other run."""
+        stretch, peak = self._per_uav(RUN_MAX_STRETCH), self._per_uav(RUN_PEAK_TENSION)
+        if not any(math.isfinite(v) for v in stretch):
+            return {}
+        return {'max_stretch': stretch, 'peak_tension': peak}
 
     @property
     def min_tension(self) -> float:
@@ -296,4 +307,4 @@ class RunStatistics:
                 'max_payload_swing': self.swing.max,
                 'rms_payload_swing': self.swing.rms,
                 'swing_from': SWING_FROM,
-                'compressed_time': self.compressed_time}
+                'compressed_time': self.compressed_time, **self.rope_figures}

@@ -39,7 +39,10 @@ RUN_SATURATED_TIME = 1      # time with a rotor held at a speed limit the alloca
 RUN_SLACK_TIME = 2          # time its cable was slack (cable_model: slack) [s]
 RUN_LEAST_THRUST_MARGIN = 3  # least share of its largest thrust left by its commands (1 -
 #                              u_T / u_T,max with the rotors' effectiveness; +inf: none yet)
-RUN_UAV_COLUMNS = 4
+RUN_MAX_STRETCH = 4         # its rope's largest stretch L_i - l_i [m] (cable_model: elastic;
+#                             -inf: none yet, and in every other cable model's run)
+RUN_PEAK_TENSION = 5        # its rope's largest tension T_i [N] (cable_model: elastic; -inf)
+RUN_UAV_COLUMNS = 6
 
 
 def run_size(n_uavs: int) -> int:

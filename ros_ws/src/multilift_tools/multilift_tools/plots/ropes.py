@@ -1,0 +1,50 @@
+"""Elastic ropes' figure (`cable_model: elastic`, issue 32; docs/cables.md): each rope's
+stretch L_i - l_i [mm] (from the recorded constraint value g_i = L_i^2 - l_i^2 and the
+scenario's rest length l_i: L_i - l_i = g_i / (L_i + l_i)) and its tension T_i [N] over time,
+world frame, SI units (the stretch in mm)."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from multilift_tools.bagdata import Run, RunDataError
+from multilift_tools.plot_style import (Context, finish_time_axes, legend, plt, uav_color,
+                                        uav_width)
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+
+def lacks_ropes(run: Run) -> list[str]:
+    """Why the bag has no rope figure: its run's summary gives no rope stretch (a run on
+    cables that do not stretch, or a bag without summary.json)."""
+    if run.summary.get('sim', {}).get('max_stretch'):
+        return []
+    return ['no elastic ropes (the summary gives no max_stretch: cable_model is not elastic)']
+
+
+def fig_rope_stretch(ctx: Context) -> Figure:
+    """Each rope's stretch [mm] and tension [N] at the recorded ticks."""
+    run, scenario = ctx.run, ctx.scenario
+    if scenario is None:
+        raise RunDataError('the ropes\' rest lengths need the scenario (--scenario)')
+    t, g, tension = run.formation_time, run.g(), run.tensions()
+    rest = np.array([u.cable_length for u in scenario.uavs], dtype=float)
+    stretch = g / (np.sqrt(np.maximum(g + rest ** 2, 0.0)) + rest)   # L_i - l_i [m]
+    fig, (ax_s, ax_t) = plt.subplots(2, 1, sharex=True, figsize=(9, 6), layout='constrained')
+    for k in range(g.shape[1]):
+        i = k + 1
+        ax_s.plot(t, 1e3 * stretch[:, k], color=uav_color(i), lw=uav_width(i, 1.0),
+                  label=f'rope {i}: max {1e3 * stretch[:, k].max():.3f} mm')
+        ax_t.plot(t, tension[:, k], color=uav_color(i), lw=uav_width(i, 1.0),
+                  label=f'$T_{i}$: peak {tension[:, k].max():.2f} N')
+    ax_s.axhline(0.0, color='0.3', lw=0.7)
+    ax_s.set_ylabel('stretch $L_i - l_i$ [mm]\n(< 0: slack)')
+    ax_t.set_ylabel('rope tension $T_i$ [N]')
+    ax_s.set_title(f'{run.label}: elastic ropes, stretch and tension (at the control ticks)',
+                   fontsize='medium')
+    for ax in (ax_s, ax_t):
+        legend(ax, loc='upper right', ncols=min(g.shape[1], 4))
+    finish_time_axes([ax_s, ax_t])
+    return fig

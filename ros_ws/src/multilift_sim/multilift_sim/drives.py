@@ -67,13 +67,13 @@ def quintic_hermite(times: np.ndarray, positions: np.ndarray, velocities: np.nda
     out[:, :, 0], out[:, :, 1] = positions[:-1], velocities[:-1]
     out[:, :, 2] = 0.5 * accelerations[:-1]
     for k, duration in enumerate(durations):
-        powers = duration ** np.arange(6)
-        # c3, c4, c5 from the end's position, velocity and acceleration
-        system = np.array([[powers[3], powers[4], powers[5]],
-                           [3 * powers[2], 4 * powers[3], 5 * powers[4]],
-                           [6 * powers[1], 12 * powers[2], 20 * powers[3]]])
+        # c3, c4, c5 from the end's position, velocity and acceleration: the rows of
+        # d^order/dt^order t^j at t = duration, j = 3, 4, 5
+        system = np.array([[duration ** j for j in (3, 4, 5)],
+                           [j * duration ** (j - 1) for j in (3, 4, 5)],
+                           [j * (j - 1) * duration ** (j - 2) for j in (3, 4, 5)]])
         c0, c1, c2 = out[k, :, 0], out[k, :, 1], out[k, :, 2]
-        right = np.stack([positions[k + 1] - (c0 + c1 * duration + c2 * powers[2]),
+        right = np.stack([positions[k + 1] - (c0 + c1 * duration + c2 * duration ** 2),
                           velocities[k + 1] - (c1 + 2 * c2 * duration),
                           accelerations[k + 1] - 2 * c2])
         out[k, :, 3:6] = np.linalg.solve(system, right).T

@@ -184,7 +184,8 @@ def test_the_attitude_comes_from_the_file_else_level(tmp_path):
     (yaw turning at 0.2 rad/s: body rate r = 0.2); without them level at the UAV's yaw."""
     times = np.arange(0.0, 3.05, 0.05)
     path = tmp_path / 'turning.csv'
-    lines = ['t,x,y,z,roll,pitch,yaw'] + [f'{float(t)!r},0,0,10,0,0,{0.2 * float(t)!r}' for t in times]
+    lines = ['t,x,y,z,roll,pitch,yaw'] + [f'{float(t)!r},0,0,10,0,0,{0.2 * float(t)!r}'
+                                          for t in times]
     path.write_text('\n'.join(lines) + '\n')
     text = (Path(__file__).resolve().parents[2] / 'scenarios' / 'prescribed_swing.yaml'
             ).read_text()

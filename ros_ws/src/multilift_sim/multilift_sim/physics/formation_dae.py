@@ -23,6 +23,7 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  # noqa: F401
                                               attached_off_centre, cable_moment_arm,
                                               payload_force_per_mass, payload_motion,
+                                              payload_pulled,
                                               rotational_compliance,
                                               uav_attach_motion, uav_free_motion)
 from multilift_sim.physics.elastic_cables import elastic_solve
@@ -33,7 +34,7 @@ from multilift_sim.physics.rigid_payload import rigid_residuals, rigid_solve
 from multilift_sim.physics.layout import (
     BODY_ATTITUDE, BODY_RATES, CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET,
     CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_ELASTIC, FORMATION_GRAVITY,
-    FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
+    FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
     FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
     FORMATION_TIME, FORMATION_TWO_ALPHA, POSITION, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
@@ -168,7 +169,6 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     cable_multipliers(cables, formation[FORMATION_PAYLOAD_MASS], taut, multipliers)
     # q_ddot = M^-1 (f - G^T Lambda): UAV i gets +2 lambda_i d_i / m_i, the payload
     # -2 sum_i lambda_i d_i / m_p.
-    sum_x = sum_y = sum_z = 0.0
     for i in range(n):
         dx, dy, dz = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
             cables[i, CABLE_OFFSET + 2]
@@ -183,13 +183,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
             add_cable_torque(uavs, i, acc, uav_attitude_slot(n, i) - nq + BODY_RATES,
                              2.0 * multiplier, cables[i, CABLE_MOMENT],
                              cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
-        sum_x += multiplier * dx
-        sum_y += multiplier * dy
-        sum_z += multiplier * dz
-    pull = 2.0 * formation[FORMATION_INV_PAYLOAD_MASS]
-    acc[p] = drag_ax - pull * sum_x
-    acc[p + 1] = drag_ay - pull * sum_y
-    acc[p + 2] = drag_az - pull * sum_z - gravity
+    payload_pulled(cables, multipliers, formation, drag_ax, drag_ay, drag_az, acc, p)
 
 
 @jit

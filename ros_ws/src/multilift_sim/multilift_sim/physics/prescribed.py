@@ -21,7 +21,7 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import quaternion_rate
-from multilift_sim.physics.free_motion import payload_motion, uav_free_motion
+from multilift_sim.physics.free_motion import payload_motion, payload_pulled, uav_free_motion
 from multilift_sim.physics.layout import (
     BODY_QUATERNION, BODY_RATES, CABLE_OFFSET, CABLE_THRUST, DRIVE_AXES, DRIVE_EULER,
     DRIVE_KNOTS, DRIVE_ORDER, DRIVE_PIECES, DRIVE_POSITION, FORMATION_BETA_SQ,
@@ -172,20 +172,10 @@ def prescribed_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers
                     + cables[i, CABLE_OFFSET + 1] * cables[j, CABLE_OFFSET + 1]
                     + cables[i, CABLE_OFFSET + 2] * cables[j, CABLE_OFFSET + 2])
     multipliers[:] = dense_solve(system, rhs)
-    sum_x = sum_y = sum_z = 0.0
-    for i in range(n):
-        multiplier = multipliers[i]
-        dx, dy, dz = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
-            cables[i, CABLE_OFFSET + 2]
-        pull = 2.0 * multiplier * inverse_mass[i]
+    for i in range(n):  # a driven UAV's 1/m_i is 0: its drive's acceleration
+        pull = 2.0 * multipliers[i] * inverse_mass[i]
         r = uav_slot(i) + POSITION
-        acc[r] = cables[i, CABLE_THRUST] + pull * dx
-        acc[r + 1] = cables[i, CABLE_THRUST + 1] + pull * dy
-        acc[r + 2] = cables[i, CABLE_THRUST + 2] + pull * dz - gravity
-        sum_x += multiplier * dx
-        sum_y += multiplier * dy
-        sum_z += multiplier * dz
-    pull = 2.0 * formation[FORMATION_INV_PAYLOAD_MASS]
-    acc[p] = drag_ax - pull * sum_x
-    acc[p + 1] = drag_ay - pull * sum_y
-    acc[p + 2] = drag_az - pull * sum_z - gravity
+        for axis in range(3):
+            acc[r + axis] = cables[i, CABLE_THRUST + axis] + pull * cables[i, CABLE_OFFSET + axis]
+        acc[r + 2] -= gravity
+    payload_pulled(cables, multipliers, formation, drag_ax, drag_ay, drag_az, acc, p)

@@ -87,7 +87,6 @@ class FormationStates(tuple):
     @functools.cached_property
     def array(self) -> np.ndarray:
         out = np.array([state.row() for state in self]).reshape(len(self), UAV_STATE_SIZE)
-        out.flags.writeable = False
         return out
 
 
@@ -183,7 +182,6 @@ class CascadeController:
         self.constants[CASCADE_SWING_DAMPING] = gains.swing_damping
         self.constants[CASCADE_SWING_REST:CASCADE_SWING_REST + 2] = swing_rest
         self.constants[CASCADE_SWING_LIMIT] = gains.swing_limit
-        self.constants.flags.writeable = False
         # what the loop remembers (CASCADE_INTEGRAL, CASCADE_LAST_T: NaN before a tick)
         self.memory = np.zeros(CASCADE_MEMORY_SIZE)
         self.memory[CASCADE_LAST_T] = math.nan

@@ -150,6 +150,4 @@ class FaultReallocation:
             if what == 'mixer' and mixer is not None:
                 mixer.rows[:] = values[:mixer.rows.shape[0]]
             elif what == 'targets' and constraints is not None:
-                targets = values.copy()  # read-only, as VirtualConstraints makes it: the laws
-                targets.flags.writeable = False  # keep their compiled signature
-                constraints.targets = targets
+                constraints.targets = values.copy()  # writable, as the engine's: one signature

@@ -140,7 +140,6 @@ class FormationFollower:
         self.constants[FOLLOWER_FREE_MODE_GAIN] = (math.nan if free_mode_gain is None
                                                    else free_mode_gain)
         self.constants[FOLLOWER_LINEAR] = float(constraints.linear)
-        self.constants.flags.writeable = False
         # linear rows: the law's constant matrices P, Q (none for nonlinear rows)
         self.law_p, self.law_q = (self._linear_law_matrices() if constraints.linear
                                   else (np.zeros((3, 0)), np.zeros((3, 0))))
@@ -214,8 +213,6 @@ class FormationFollower:
         a_plus = _law_inverse(jac, np.repeat(1.0 / self.masses, 3))
         p = -(jac[:, 3 * self.index:3 * self.index + 3].T @ a_plus)
         q = p @ jac
-        for array in (p, q):
-            array.flags.writeable = False
         return p, q
 
     def desired_force(self, t: float, states: Sequence[UavState], thrust_vectors: np.ndarray

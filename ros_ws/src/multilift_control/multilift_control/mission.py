@@ -83,8 +83,6 @@ class MissionPath:
         else:
             self._segments(mission, shaper, period)
         self.mission[MISSION_FORM] = float(form)
-        for array in (self.mission, self.segments, self.steps):
-            array.flags.writeable = False
         self._law = laws.runnable(mission_reference)
 
     def _polynomial(self, mission: MissionConfig) -> None:

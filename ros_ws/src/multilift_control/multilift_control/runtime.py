@@ -88,7 +88,6 @@ class ThrustBook:
             del self.leader[stamp]
         self.thrusts[0] = self.leader.pop(t_ns)
         vectors = self._lift_vectors(FormationStates.of(states).array, self.thrusts)
-        vectors.flags.writeable = False
         self._formed = (t_ns, vectors)
         return vectors
 

@@ -145,8 +145,6 @@ class VirtualConstraints:
         self.rows[:, ROW_FIRST] = self.pairs[:, 0]
         self.rows[:, ROW_SECOND] = self.pairs[:, 1]
         self.rows[:, ROW_AXIS] = self.axes if self.linear else ROW_DISTANCE
-        for array in (self.pairs, self.axes, self.targets, self.rows):
-            array.flags.writeable = False
         (self._residual, self._jacobian, self._rates, self._jacobian_rate_product,
          self._free_follower_motions) = map(laws.runnable, (
             rows_laws.residual, rows_laws.jacobian, rows_laws.rates,

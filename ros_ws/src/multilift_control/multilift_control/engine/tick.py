@@ -23,11 +23,24 @@ from multilift_control.laws.reference import mission_reference
 from multilift_sim.physics import tick as physics
 from multilift_sim.physics.measurement import payload_position, payload_velocity
 from multilift_sim.statistics.accumulators import formation_error_add, tracking_add
+from multilift_sim.tick_arrays import PhysicsArrays, PhysicsMemory
+
+# how many of the engine's fields are the physics' (they come first: engine.arrays._joined)
+PHYSICS_ARRAY_FIELDS = len(PhysicsArrays._fields)
+PHYSICS_MEMORY_FIELDS = len(PhysicsMemory._fields)
 
 # the registered controllers' compiled dispatchers (multilift_control.controllers.compiled),
 # rebound when a registry changes (controllers.compiled.refresh)
 leader_answer = controllers.dispatchers().leader_answer
 followers_answer = controllers.dispatchers().followers_answer
+
+
+@jit(inline=True)
+def physics_view(a, m):
+    """The physics' own tuples (PhysicsArrays, PhysicsMemory) over the engine's arrays a and
+    memory m: the compiled physics is then the one the simulator node steps, compiled once for
+    both (a FormationArrays would be another type to numba, and its code compiled again)."""
+    return PhysicsArrays(*a[:PHYSICS_ARRAY_FIELDS]), PhysicsMemory(*m[:PHYSICS_MEMORY_FIELDS])
 
 
 @jit(inline=True)  # into formation_tick: no call passing the batch's tuples
@@ -89,7 +102,8 @@ def advance_formation(a, m, b, speeds, saturated, tension):
     its controllers told of the new tick's events (`tell_controllers`); the tension [N] into
     tension. The second half of a tick, whoever answered."""
     first = m.next_event[b]
-    physics.advance(a, m, b, speeds, saturated, tension)
+    own, memory = physics_view(a, m)
+    physics.advance(own, memory, b, speeds, saturated, tension)
     # only when there is something to tell: a call taking the batch's tuples counts every
     # array's reference in and out (a microsecond a tick)
     if m.next_event[b] > first or m.next_target[b] < a.target_schedule.shape[1]:
@@ -103,7 +117,8 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
     control period (RK4), then check; the tension T_i = 2 l_i lambda_i [N] at the tick into
     tension."""
     t = m.tick[b] * a.period_ns[b] * 1e-9
-    physics.measure(a, m, b, states)
+    own, memory = physics_view(a, m)
+    physics.measure(own, memory, b, states)
     if a.controlled[b]:
         answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
                          errors, rates)
@@ -122,8 +137,9 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
 def measure_all(a, m, states):
     """What every formation's controllers receive (B, n, UAV_STATE_SIZE) at its current tick
     (`measure`)."""
+    own, memory = physics_view(a, m)
     for b in range(m.state.shape[0]):
-        physics.measure(a, m, b, states[b])
+        physics.measure(own, memory, b, states[b])
 
 
 @jit
@@ -185,10 +201,11 @@ def start(a, m, which):
     """Each formation b with which[b] at its initial state, before its first tick: the
     physics' start (`multilift_sim.physics.tick.start`: residuals, events, check) and its
     controllers told of the events at t = 0."""
-    physics.start(a, m, which)
+    own, memory = physics_view(a, m)
+    physics.start(own, memory, which)
     for b in range(m.state.shape[0]):
         if which[b]:
-            tell_controllers(a, m, b, 0)
+            tell_controllers(a, m, b, np.int64(0))  # int64: one compiled signature
 
 
 @jit

@@ -133,15 +133,16 @@ def actuated_period(x, commands, rotors, actuators, effectiveness, allocation, u
     first = np.zeros(n)
     g = np.zeros(n)
     g_dot = np.zeros(n)
+    one = np.int64(1)  # not the literal 1: the periods compiled once for both paths' int64
     for step in range(steps * k):
         held_speeds(rotors, commands, actuators, step * h, h, speeds)
         rotor_wrenches(allocation, speeds, effectiveness, wrenches)
         if slack:
             state, multipliers, g, g_dot = slack_period(state, wrenches, uavs, gusts,
-                                                        formation, taut, released, h, 1)
+                                                        formation, taut, released, h, one)
         else:
             state, multipliers, g, g_dot = rigid_period(state, wrenches, uavs, gusts,
-                                                        formation, taut, h, 1)
+                                                        formation, taut, h, one)
         if step == 0:
             first[:] = multipliers
     rotor_speeds_at(rotors, commands, actuators, steps * dt, rotors)

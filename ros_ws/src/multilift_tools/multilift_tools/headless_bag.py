@@ -241,6 +241,8 @@ class HeadlessBag:
         messages += self._simulator.events(snap.t_ns, sim.happened_rows())
         if answers:
             self._applied = [a.output.rotor_speeds for a in answers]
+        elif not sim.scenario.controlled:  # every UAV prescribed: the idle commands held
+            self._applied = sim.idle_commands()[0]
         for answer in answers:
             messages += self._answers.of(answer)
         self._write(messages, snap.t_ns)

@@ -101,3 +101,15 @@ def test_a_payload_start_that_fits_is_the_runs_start(tmp_path):
     path.write_text(yaml.safe_dump(data))
     with pytest.raises(scenario_io.ScenarioError, match='cable 1 must span its length 2.5 m'):
         scenario_io.load(str(path))
+
+
+def test_a_copy_of_the_mapping_reads_the_trajectory_beside_its_scenario(tmp_path, monkeypatch):
+    """A sweep's run validates an edited copy of the mapping elsewhere (`anchored`): the
+    trajectory file is still the one beside the scenario file."""
+    data = yaml.safe_load((SCENARIOS / 'prescribed_swing.yaml').read_text())
+    monkeypatch.chdir(tmp_path)
+    copy = scenario_io.anchored(data, SCENARIOS)
+    assert copy['uavs'][0]['trajectory'] == str(SCENARIOS / 'prescribed_swing.csv')
+    assert data['uavs'][0]['trajectory'] == 'prescribed_swing.csv'  # the original untouched
+    scenario = scenario_io.from_mapping(copy)
+    assert scenario.uavs[0].trajectory.end == 20.0

@@ -113,3 +113,12 @@ def test_a_copy_of_the_mapping_reads_the_trajectory_beside_its_scenario(tmp_path
     assert data['uavs'][0]['trajectory'] == 'prescribed_swing.csv'  # the original untouched
     scenario = scenario_io.from_mapping(copy)
     assert scenario.uavs[0].trajectory.end == 20.0
+
+
+def test_a_payload_velocity_along_a_rigid_cable_is_one_line(tmp_path):
+    """Straight down along the hanging cable: g_dot = 2 l v = 2 m^2/s, beyond the scenario's
+    constraint_rate_tolerance 1: refused before the run (it would stop at t = 0)."""
+    path = swing_copy(tmp_path, payload={'initial_velocity': [0.0, 0.0, -1.0]})
+    with pytest.raises(scenario_io.ScenarioError,
+                       match=r'moves along cable 1: its rate g_dot = 2 m\^2/s must be within'):
+        scenario_io.load(str(path))

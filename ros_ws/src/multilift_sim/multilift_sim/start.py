@@ -77,13 +77,16 @@ def given_start(scenario: Scenario, state: np.ndarray) -> np.ndarray:
     return state
 
 
-def uav_start_positions(scenario: Scenario) -> np.ndarray:
-    """Where each cable holds its UAV at t = 0 (n, 3) [m], world: the UAVs' start places
-    (prescribed ones on their drives) plus the attach points' offsets."""
+def uav_start_motion(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """Where each cable holds its UAV at t = 0 (n, 3) [m] and the UAVs' velocities (n, 3)
+    [m/s], world: the UAVs' start places (prescribed ones on their drives, moving as they do;
+    the others at rest) plus the attach points' offsets."""
     layout = StateLayout(scenario.n_uavs, scenario.payload.type == 'rigid_body')
-    uavs = layout.uav_positions(given_start(scenario, hanging_start(scenario)))
+    state = given_start(scenario, hanging_start(scenario))
+    uavs = layout.uav_positions(state)
     offsets = uav_offsets(scenario)
-    return uavs.copy() if offsets is None else uavs + offsets
+    return (uavs.copy() if offsets is None else uavs + offsets,
+            layout.uav_velocities(state).copy())
 
 
 def hanging_start(scenario: Scenario) -> np.ndarray:

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from multilift_sim.drives import Drive, spline_drive
+from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario.config import Scenario, ScenarioError
 from multilift_sim.scenario.csv_table import read_table
 from multilift_sim.scenario.reading import Section
@@ -88,21 +89,37 @@ def check_prescribed(scenario: Scenario) -> None:
 def check_payload_start(scenario: Scenario) -> None:
     """`payload.initial_position` against the cables from the UAVs' start places: each
     chord within START_TOLERANCE of its cable's length (rigid or elastic: its start length),
-    at most the length for a slack cable; a rigid-body payload starts hanging."""
+    at most the length for a slack cable; `initial_velocity` with a rigid cable's rate
+    g_dot_i = 2 d_i . (v_p - v_i) within Algorithm 1's constraint_rate_tolerance (else the run
+    would stop at t = 0); a rigid-body payload starts hanging."""
     from multilift_sim.cables import CABLE_MODELS
-    from multilift_sim.start import start_lengths, uav_start_positions
+    from multilift_sim.start import initial_state, start_lengths, uav_start_motion
     payload = scenario.payload
     if payload.initial_position is None and payload.initial_velocity is None:
         return
     if payload.type != 'point':
         raise ScenarioError(f'{scenario.source}: payload.initial_position: a {payload.type} '
                             'payload starts hanging (a point payload only)')
+    slackens = CABLE_MODELS[scenario.cable_model].SLACKENS
+    ends, velocities = uav_start_motion(scenario)
+    if payload.initial_velocity is not None and CABLE_MODELS[scenario.cable_model].KEEPS_LENGTH \
+            and not slackens:
+        layout = StateLayout(scenario.n_uavs)
+        state = initial_state(scenario)
+        offsets = layout.payload_position(state) - ends
+        rates = 2.0 * np.sum(offsets * (layout.payload_velocity(state) - velocities), axis=1)
+        tolerance = scenario.simulation.constraint_rate_tolerance
+        for i, rate in enumerate(rates):
+            if abs(rate) > tolerance:
+                raise ScenarioError(
+                    f'{scenario.source}: payload.initial_velocity: '
+                    f'{list(payload.initial_velocity)} moves along cable {i + 1}: its rate '
+                    f'g_dot = {rate:.3g} m^2/s must be within simulation.'
+                    f'constraint_rate_tolerance ({tolerance:g})')
     if payload.initial_position is None:
         return
     start = np.asarray(payload.initial_position, dtype=float)
-    slackens = CABLE_MODELS[scenario.cable_model].SLACKENS
-    for i, (uav, length) in enumerate(zip(uav_start_positions(scenario),
-                                          start_lengths(scenario))):
+    for i, (uav, length) in enumerate(zip(ends, start_lengths(scenario))):
         chord = float(np.linalg.norm(start - uav))
         fits = chord <= length + START_TOLERANCE if slackens else \
             abs(chord - length) <= START_TOLERANCE

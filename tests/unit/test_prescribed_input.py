@@ -122,3 +122,15 @@ def test_a_payload_velocity_along_a_rigid_cable_is_one_line(tmp_path):
     with pytest.raises(scenario_io.ScenarioError,
                        match=r'moves along cable 1: its rate g_dot = 2 m\^2/s must be within'):
         scenario_io.load(str(path))
+
+
+def test_more_than_three_prescribed_uavs_are_refused(tmp_path):
+    """Four or more driven rigid cables on a point payload: more constraints than coordinates."""
+    data = yaml.safe_load((SCENARIOS / 'v5.yaml').read_text())
+    duration = data['simulation']['duration']
+    (tmp_path / 'still.csv').write_text(f't,x,y,z\n0,0,0,0\n{duration},0,0,0\n')
+    data['uavs'] = [{'trajectory': 'still.csv'} for _ in range(data['formation']['n'])]
+    path = tmp_path / 'v5.yaml'
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(scenario_io.ScenarioError, match='at most 3 prescribed UAVs'):
+        scenario_io.load(str(path))

@@ -74,6 +74,11 @@ def check_prescribed(scenario: Scenario) -> None:
                 f'{where}: uavs[{free}]: has no trajectory while uavs[{prescribed[0]}] has '
                 'one: either every UAV\'s motion is prescribed or none (a formation of both '
                 'is not built yet)')
+        if len(prescribed) > 3:  # D D^T of the driven cables (n x n, rank 3) is singular
+            raise ScenarioError(
+                f'{where}: uavs[3].trajectory: at most 3 prescribed UAVs: a point payload on '
+                f'{len(prescribed)} driven rigid cables is held by more constraints than it has '
+                'coordinates (their tensions are not determined)')
         for i in prescribed:
             if any(scenario.uavs[i].attach_point):
                 raise ScenarioError(f'{where}: uavs[{i}].attach_point: a prescribed UAV holds '

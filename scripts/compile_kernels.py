@@ -3,7 +3,7 @@ low), a stage per call, so scripts/setup runs independent stages in parallel pro
 machine's two cores (a kernel one stage compiled is loaded from the cache by the next):
 
 - `physics`: the physics' tick (multilift_sim.physics.tick) as the simulator node steps it
-  (rigid and slack cables, a rigid payload, events and sensors);
+  (rigid and slack cables, a rigid payload, events and sensors, a prescribed UAV's start);
 - `laws`: every controller's compiled laws as the controller nodes call them (the runtimes);
 - `engine`: the engine's tick over B formations (`run --headless`, sweeps), after the two;
 - `learning`: the engine's calls the learning environments make (answers, commanded ticks,
@@ -45,7 +45,7 @@ def _every_kind() -> scenario.Scenario:
 def physics() -> None:
     from multilift_sim.simulation import FormationSimulator
     for short in (_short('twin_lift'), _short('twin_lift', 'slack'), _short('box_lift'),
-                  _every_kind()):
+                  _every_kind(), _short('prescribed_swing')):  # its start: prescribe_state
         sim = FormationSimulator(short)
         speeds = [list(range(1400, 1400 + u.vehicle.n_rotors)) for u in short.uavs]
         flags = [[False] * u.vehicle.n_rotors for u in short.uavs]

@@ -42,7 +42,8 @@ def _same_bags(tmp_path, scenario, chunk: int, monkeypatch) -> tuple:
     ('circle3', 0.73, 'rigid', 7),          # 3 UAVs: markers, t_max mid-chunk
     ('circle3', 0.5, 'rigid', 50),          # t_max at a chunk's end
     ('twin_lift', 1.0, 'slack', 30),
-    ('single_lift_swing', 0.4, 'rigid', 16)])
+    ('single_lift_swing', 0.4, 'rigid', 16),
+    ('prescribed_swing', 0.45, 'rigid', 16)])  # no controller (issue 34): no command topic
 def test_the_engine_s_bag_is_the_per_object_path_s(tmp_path, monkeypatch, name, duration,
                                                     cables, chunk):
     engine_run, object_run = _same_bags(tmp_path, _short(name, duration, cables), chunk,

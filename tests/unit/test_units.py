@@ -103,7 +103,8 @@ def test_every_statistic_has_a_unit_and_the_readme_table_agrees():
 
 
 def _scenario(n: int):
-    uav = types.SimpleNamespace(vehicle=types.SimpleNamespace(rotor_speed_max=2100.0))
+    uav = types.SimpleNamespace(vehicle=types.SimpleNamespace(rotor_speed_max=2100.0),
+                                trajectory=None)
     return types.SimpleNamespace(
         simulation=types.SimpleNamespace(constraint_tolerance=0.02), uavs=[uav] * n, n_uavs=n,
         gusts=[1], control=types.SimpleNamespace(input_shaping='none', swing_stiffness=0.0,

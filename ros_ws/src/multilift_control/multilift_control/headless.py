@@ -67,8 +67,11 @@ def run_headless(scenario: Scenario, on_tick: TickObserver | None = None,
                 on_tick(sim, snapshot, answers)
             if sim.finished:
                 break
-            sim.advance([a.output.rotor_speeds for a in answers],
-                        [a.output.saturated for a in answers])
+            if scenario.controlled:
+                sim.advance([a.output.rotor_speeds for a in answers],
+                            [a.output.saturated for a in answers])
+            else:  # every UAV's motion prescribed: no controller answers
+                sim.advance(*sim.idle_commands())
     except SimulationStopped as exc:
         run.error = str(exc)
         if raise_on_stop:

@@ -154,13 +154,17 @@ def formation_runtimes(scenario: Scenario) -> list[ControllerRuntime]:
     ThrustBook, as they all see the same answers, so a tick notes each answer once (O(n),
     where a book per follower would be O(n^2))."""
     thrusts = ThrustBook(scenario)
-    return [ControllerRuntime(scenario, i, thrusts) for i in range(scenario.n_uavs)]
+    return [ControllerRuntime(scenario, i, thrusts) for i in range(scenario.n_uavs)] \
+        if scenario.controlled else []  # none: every UAV's motion is prescribed
 
 
 def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
                 states: Sequence[UavState]) -> list[ControllerAnswer]:
     """Every controller's answer to the state at t_ns, in the order the ROS graph gives them:
-    the leader first, then the followers, each of whose books then notes every answer."""
+    the leader first, then the followers, each of whose books then notes every answer; none
+    without controllers (every UAV prescribed)."""
+    if not runtimes:
+        return []
     leader = runtimes[0].answer(t_ns, states)
     books = list({id(r.thrusts): r.thrusts for r in runtimes[1:]}.values())
     for book in books:

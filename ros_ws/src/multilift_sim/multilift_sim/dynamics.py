@@ -47,7 +47,8 @@ from multilift_sim import kernels
 from multilift_sim.frames import seed_to_world_vector
 from multilift_sim.formation_params import (FormationParams, StateLayout, actuator_array,
                                              constant_arrays)
-from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_NULL_SPACE, FORMATION_WIND,
+from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_NULL_SPACE,
+                                          FORMATION_PRESCRIBED, FORMATION_TIME, FORMATION_WIND,
                                           WORK_ROWS, WRENCH_COLUMNS)
 
 
@@ -195,8 +196,14 @@ class FormationModel:
         """(acc, cable multipliers Lambda (n,) [N/m]) at time t [s] and state x: acc holds
         q_ddot (3n + 3,) [m/s^2] (world frame), then the rates of the bodies' attitude blocks
         (each quaternion's rate [1/s] and omega_dot [rad/s^2], body frame)."""
-        del t  # the model is autonomous: the inputs are held, gusts are stationary
+        self._at(t)  # autonomous (inputs held, gusts stationary) but for prescribed UAVs
         return self.accelerations_from_wrenches(x, self.wrenches(rotor_speeds))
+
+    def _at(self, t: float) -> None:
+        """The time [s] prescribed UAVs' drives are evaluated at (physics.prescribed), where
+        the formation has any."""
+        if self._formation[FORMATION_PRESCRIBED] != 0.0:
+            self._formation[FORMATION_TIME] = t
 
     def accelerations_from_wrenches(self, x: np.ndarray,
                                     wrenches: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -219,7 +226,7 @@ class FormationModel:
     def step(self, t: float, x: np.ndarray, rotor_speeds: Sequence[ArrayLike],
              dt: float) -> np.ndarray:
         """One classic RK4 step of length dt [s] from (t, x) with the rotor speeds held."""
-        del t  # autonomous, see accelerations()
+        self._at(t)  # see accelerations()
         out = np.empty(self.layout.size)
         self._physics()['rk4_step'](
             self._state_array(x), self.wrenches(rotor_speeds), self._uavs, self._gusts,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -18,7 +19,8 @@ from multilift_sim.physics.layout import (
     ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, FORMATION_BETA_SQ,
     FORMATION_DRAG, FORMATION_ELASTIC, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
     FORMATION_NULL_SPACE, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
-    FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE, FORMATION_SCALARS,
+    FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
+    FORMATION_SCALARS, FORMATION_TIME,
     FORMATION_SUBSTEPS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_COLUMNS,
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, UAV_ATTACH,
     UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA,
@@ -51,6 +53,9 @@ class FormationParams:
     cable_stiffness: tuple[float, ...] | None = None
     cable_damping: tuple[float, ...] | None = None
     substeps: int = 1                        # RK4 sub-steps per physics step (FORMATION_SUBSTEPS)
+    # prescribed motion (issue 34; physics.prescribed): each UAV's drives.Drive or None (None:
+    # no UAV's motion is prescribed)
+    drives: tuple[Any, ...] | None = None
 
     def __post_init__(self) -> None:
         uavs = tuple(self.uavs)
@@ -290,6 +295,11 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
         params.payload_attach_points if params.rigid_payload else 0.0)
     uavs[:, UAV_ATTACH:UAV_ATTACH + 3] = (0.0 if params.uav_attach_points is None
                                           else params.uav_attach_points)
+    formation[FORMATION_PRESCRIBED] = 0.0 if params.drives is None else 1.0
+    formation[FORMATION_TIME] = 0.0
+    if params.drives is not None:  # the drive table after the scalars (physics.layout DRIVE_*)
+        from multilift_sim.drives import drive_table
+        formation = np.concatenate([formation, drive_table(params.drives)])
     return uavs, gusts, formation
 
 

@@ -253,6 +253,12 @@ class FormationSimulator:
         self.happened = range(first, int(self.memory.next_event[0]))
         self._raise_if_stopped()
 
+    def idle_commands(self) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """(rotor speeds [rad/s], saturation flags) of 0 for every UAV: what a formation whose
+        UAVs' motion is all prescribed holds (no controller; the speeds move nothing)."""
+        return ([np.zeros(count) for count in self._rotor_counts],
+                [np.zeros(count, dtype=bool) for count in self._rotor_counts])
+
     def happened_rows(self) -> np.ndarray:
         """The rows (physics.layout EVENT_*) of the events the current tick is the first to
         show."""

@@ -33,7 +33,65 @@ def swing_sampling(n_uavs: int) -> int:
 
 def initial_state(scenario: Scenario) -> np.ndarray:
     """Initial formation state on the constraint manifold, at rest (elastic cables: each
-    stretched by its share of the hanging payload's weight, `start_lengths`)."""
+    stretched by its share of the hanging payload's weight, `start_lengths`); prescribed UAVs
+    (`uavs[i].trajectory`) where their drives are at t = 0 with the payload hanging under
+    them, and the payload where `payload.initial_position` / `initial_velocity` put it
+    (`given_start`)."""
+    state = hanging_start(scenario)
+    payload = scenario.payload
+    if scenario.prescribed or payload.initial_position is not None \
+            or payload.initial_velocity is not None:
+        return given_start(scenario, state)
+    return state
+
+
+def given_start(scenario: Scenario, state: np.ndarray) -> np.ndarray:
+    """`hanging_start`'s state with the prescribed UAVs on their drives at t = 0 (position,
+    velocity, attitude, body rates: `physics.prescribed.prescribe_state`, the tick's own), the
+    payload moved with them (one UAV: by its displacement, the release angles kept; more:
+    hanging under their places) unless `payload.initial_position` gives it, its velocity
+    `payload.initial_velocity` (else at rest)."""
+    from multilift_sim import kernels
+    from multilift_sim.formation_params import constant_arrays
+    from multilift_sim.physics.prescribed import prescribe_state
+    n = scenario.n_uavs
+    layout = StateLayout(n, scenario.payload.type == 'rigid_body')
+    state = state.copy()
+    before = layout.uav_positions(state).copy()
+    if scenario.prescribed:
+        formation = constant_arrays(scenario.formation_params())[2]
+        kernels.runnable(prescribe_state)(state, n, formation, 0.0)
+        uavs = layout.uav_positions(state)
+        if n == 1:
+            layout.payload_position(state)[:] += uavs[0] - before[0]
+        else:
+            offsets = uav_offsets(scenario)
+            _, hanging = hanging_payload(uavs.copy(), start_lengths(scenario),
+                                         scenario.payload.attach_points, offsets)
+            layout.payload_position(state)[:] = hanging
+    given = scenario.payload
+    if given.initial_position is not None:
+        layout.payload_position(state)[:] = given.initial_position
+    if given.initial_velocity is not None:
+        layout.payload_velocity(state)[:] = given.initial_velocity
+    return state
+
+
+def uav_start_motion(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """Where each cable holds its UAV at t = 0 (n, 3) [m] and the UAVs' velocities (n, 3)
+    [m/s], world: the UAVs' start places (prescribed ones on their drives, moving as they do;
+    the others at rest) plus the attach points' offsets."""
+    layout = StateLayout(scenario.n_uavs, scenario.payload.type == 'rigid_body')
+    state = given_start(scenario, hanging_start(scenario))
+    uavs = layout.uav_positions(state)
+    offsets = uav_offsets(scenario)
+    return (uavs.copy() if offsets is None else uavs + offsets,
+            layout.uav_velocities(state).copy())
+
+
+def hanging_start(scenario: Scenario) -> np.ndarray:
+    """The seed's start: the leader at its position, the followers at the formation's places,
+    the payload hanging at rest (one UAV: released at the angles alpha, beta)."""
     if scenario.n_uavs == 1:
         uav = scenario.uavs[0]
         return initial_state_single_lift(np.asarray(uav.position, dtype=float),

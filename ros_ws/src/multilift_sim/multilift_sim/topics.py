@@ -98,14 +98,16 @@ def topic_type(topic: str) -> str | None:
 
 
 def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
-               sensors: bool = False, wind: bool = False, live: bool = False
+               sensors: bool = False, wind: bool = False, commands: bool = True,
+               live: bool = False
                ) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
     which has no reference, set-points or formation errors); with `events` (a scenario with
     `events:`), /formation/events; with `sensors` (a scenario with `sensors:`), every
-    /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind; with `live`
-    (`run --live`), /formation/goal and /formation/path."""
+    /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind; without
+    `commands` (every UAV prescribed) not even the rotor commands; with `live` (`run --live`),
+    /formation/goal and /formation/path."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
         list(WIND_TYPES.items()) if wind else []) + (list(LIVE_TYPES.items()) if live else [])
     if controllers:
@@ -113,7 +115,7 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
     for i in range(1, n_uavs + 1):
         topics += [(uav_topic(i, leaf), UAV_TYPES[leaf])
                    for leaf in ((ODOM, ROTOR_CMD, ATTITUDE_SETPOINT) if controllers
-                                else (ODOM, ROTOR_CMD))]
+                                else (ODOM, ROTOR_CMD) if commands else (ODOM,))]
         if sensors:
             topics.append((uav_topic(i, MEASURED_ODOM), ODOMETRY_TYPE))
         if i > 1 and controllers:
@@ -124,9 +126,11 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
 def scenario_topics(scenario, controllers: bool = True, live: bool = False
                     ) -> list[tuple[str, str]]:
     """`run_topics` of a scenario (multilift_sim.scenario.Scenario): its n, and the topics its
-    `events:`, `sensors:` and wind add (and a live run's, `live`)."""
-    return run_topics(scenario.n_uavs, controllers, bool(scenario.events),
-                      scenario.sensors is not None, scenario.has_wind, live)
+    `events:`, `sensors:` and wind add (and a live run's, `live`); none of the controllers'
+    when every UAV's motion is prescribed (`uavs[i].trajectory`: no controller runs)."""
+    return run_topics(scenario.n_uavs, controllers and scenario.controlled,
+                      bool(scenario.events), scenario.sensors is not None, scenario.has_wind,
+                      commands=scenario.controlled, live=live)
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

@@ -63,6 +63,7 @@ class EngineBag:
                  controllers: bool = True) -> None:
         _add_topics(scenario, writer, controllers)
         self._controllers = controllers
+        self._commands = scenario.controlled  # none when every UAV's motion is prescribed
         self._scenario, self._engine, self._write = scenario, engine, writer.write_many
         self._simulator = SimulatorMessages(scenario)
         self._answers = AnswerMessages(scenario)
@@ -148,7 +149,7 @@ class EngineBag:
                                           payload_velocity[k], gusts[k], measured[k],
                                           winds[k], poses[k])
             messages += self._events_at(tick, t_ns)
-            for i in range(n):
+            for i in range(n if self._commands else 0):
                 if not self._controllers:
                     messages += command_of(i, t_ns, speed_lists[k][i], saturated[k][i])
                     continue
@@ -240,6 +241,8 @@ class HeadlessBag:
         messages += self._simulator.events(snap.t_ns, sim.happened_rows())
         if answers:
             self._applied = [a.output.rotor_speeds for a in answers]
+        elif not sim.scenario.controlled:  # every UAV prescribed: the idle commands held
+            self._applied = sim.idle_commands()[0]
         for answer in answers:
             messages += self._answers.of(answer)
         self._write(messages, snap.t_ns)

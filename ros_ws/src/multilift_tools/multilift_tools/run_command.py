@@ -67,6 +67,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f'error: --external: {exc}', file=sys.stderr)
         return 2
+    if external and not scenario.controlled:
+        print(f'error: --external: uav{external[0]}\'s motion is prescribed '
+              f'(uavs[{external[0] - 1}].trajectory): it has no controller', file=sys.stderr)
+        return 2
     if args.headless:
         if args.compose:
             print('error: --compose puts the controller nodes in one process; --headless starts '
@@ -159,7 +163,8 @@ def _controller_children(scenario, external: list[int], compose: bool, common: d
     """The processes of the controllers of every UAV but the external ones: a leader_node and
     a follower_node each, or with `compose` one controllers_node holding them all; `live`: the
     leader reads live goals (its `live` parameter)."""
-    ours = [i for i in range(1, scenario.n_uavs + 1) if i not in external]
+    ours = [i for i in range(1, scenario.n_uavs + 1) if i not in external] \
+        if scenario.controlled else []  # every UAV's motion prescribed: no controller
     if compose:
         if not ours:
             return []

@@ -75,6 +75,10 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
         margins = sim.get('least_thrust_margin') or [None] * len(sim['max_rotor_speed'])
         for i, (w, s, margin) in enumerate(zip(sim['max_rotor_speed'], sim['saturated_time'],
                                                margins)):
+            drive = scenario.uavs[i].trajectory
+            if drive is not None:  # no controller, no rotors flown (docs/prescribed.md)
+                lines.append(f'  uav{i + 1} prescribed  by {drive.source} (no controller)')
+                continue
             limit = scenario.uavs[i].vehicle.rotor_speed_max
             left = '' if margin is None else f', thrust margin least {100 * margin:.1f} %'
             lines.append(f'  uav{i + 1} rotors      max {w:.1f} {unit_of("max_rotor_speed")} '

@@ -43,6 +43,8 @@ class ControlArrays(NamedTuple):
     the formation's most has its rows padded: its rotors' slots past its count are never
     answered (their speeds 0, not saturated: what the physics pads its commands with)."""
     rotor_counts: np.ndarray      # (B, n) int: each UAV's rotors
+    controlled: np.ndarray        # (B,) bool: whether its controllers answer (not when every
+    #                               UAV's motion is prescribed: its commands stay 0, unused)
     cascade: np.ndarray           # (B, n, CASCADE_SIZE): every UAV's cascade constants
     fault_mixers: np.ndarray      # (B, k, rotors, MIXER_SIZE): faults.fault_mixers
     mixer_uavs: np.ndarray        # (B, k) int: the UAV each event's mixer is of (-1: none)
@@ -144,7 +146,7 @@ def formation_fields(scenario: Scenario) -> tuple[dict, dict]:
             law_p[i], law_q[i] = p, q
         own_rows[i] = len(constraints.rows_of(i))
     arrays.update(
-        rotor_counts=counts,
+        rotor_counts=counts, controlled=scenario.controlled,
         cascade=np.stack([c.constants for c in cascades]),
         fault_mixers=fault_mixers(scenario), mixer_uavs=mixer_uavs(scenario),
         target_schedule=target_schedule(scenario),

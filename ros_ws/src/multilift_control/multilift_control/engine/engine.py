@@ -215,8 +215,10 @@ class Engine:
             sim['wall_time'] = wall_time
         happened = event_records(self.arrays.events[b, :self.memory.next_event[b]])
         out = {'sim': dict(sim, error=self.stop_reason(b), scenario=self.scenarios[b].name,
-                           events=happened, seeds=run_seeds(self.scenarios[b])),
-               'leader': leader.as_dict()}
+                           events=happened, seeds=run_seeds(self.scenarios[b]))}
+        if not self.scenarios[b].controlled:  # every UAV prescribed: no controller to report
+            return out
+        out['leader'] = leader.as_dict()
         for i in range(1, self.n_uavs):
             follower = FormationErrorStatistics()
             follower.acc[:] = self.memory.formation_errors[b, i]

@@ -119,8 +119,17 @@ def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, refere
     t = m.tick[b] * a.period_ns[b] * 1e-9
     own, memory = physics_view(a, m)
     physics.measure(own, memory, b, states)
-    answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
-                     errors, rates)
+    if a.controlled[b]:
+        answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, reference,
+                         errors, rates)
+    else:  # every UAV's motion prescribed (physics.prescribed): no controller, no command
+        speeds[:] = 0.0
+        saturated[:] = False
+        setpoints[:] = math.nan
+        thrust[:] = 0.0
+        reference[:] = math.nan
+        errors[:] = math.nan
+        rates[:] = math.nan
     advance_formation(a, m, b, speeds, saturated, tension)
 
 
@@ -146,7 +155,7 @@ def answer_all(a, m, states, speeds, saturated):
     errors = np.full((n, max(rows, 1)), math.nan)
     rates = np.full((n, max(rows, 1)), math.nan)
     for b in range(m.state.shape[0]):
-        if m.status[b] != RUNNING:
+        if m.status[b] != RUNNING or not a.controlled[b]:
             continue
         t = m.tick[b] * a.period_ns[b] * 1e-9
         answer_formation(a, m, b, t, states[b], speeds[b], saturated[b], setpoints, thrust,

@@ -23,18 +23,20 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  # noqa: F401
                                               attached_off_centre, cable_moment_arm,
                                               payload_force_per_mass, payload_motion,
+                                              payload_pulled,
                                               rotational_compliance,
                                               uav_attach_motion, uav_free_motion)
 from multilift_sim.physics.elastic_cables import elastic_solve
 from multilift_sim.physics.nullspace import nullspace_solve, project, translational_masses
 from multilift_sim.physics.attitude import normalize_quaternion
+from multilift_sim.physics.prescribed import prescribed_solve
 from multilift_sim.physics.rigid_payload import rigid_residuals, rigid_solve
 from multilift_sim.physics.layout import (
     BODY_ATTITUDE, BODY_RATES, CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET,
     CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_ELASTIC, FORMATION_GRAVITY,
-    FORMATION_INV_PAYLOAD_MASS, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
-    FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
-    FORMATION_TWO_ALPHA, POSITION, UAV_LENGTH_SQ, UAV_MASS,
+    FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
+    FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
+    FORMATION_TIME, FORMATION_TWO_ALPHA, POSITION, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
                                                uav_attitude_slot, uav_slot)
@@ -114,6 +116,9 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     if formation[FORMATION_NULL_SPACE] != 0.0:  # the `nullspace` formulation (every cable taut)
         nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
         return
+    if formation[FORMATION_PRESCRIBED] != 0.0:  # driven UAVs (uavs[i].trajectory)
+        prescribed_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
+        return
     if x.shape[0] > attitude_slot(uavs.shape[0]):
         # a rigid-body payload (its attitude block after the UAVs': physics.rigid_payload)
         rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
@@ -164,7 +169,6 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     cable_multipliers(cables, formation[FORMATION_PAYLOAD_MASS], taut, multipliers)
     # q_ddot = M^-1 (f - G^T Lambda): UAV i gets +2 lambda_i d_i / m_i, the payload
     # -2 sum_i lambda_i d_i / m_p.
-    sum_x = sum_y = sum_z = 0.0
     for i in range(n):
         dx, dy, dz = cables[i, CABLE_OFFSET], cables[i, CABLE_OFFSET + 1], \
             cables[i, CABLE_OFFSET + 2]
@@ -179,13 +183,7 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
             add_cable_torque(uavs, i, acc, uav_attitude_slot(n, i) - nq + BODY_RATES,
                              2.0 * multiplier, cables[i, CABLE_MOMENT],
                              cables[i, CABLE_MOMENT + 1], cables[i, CABLE_MOMENT + 2])
-        sum_x += multiplier * dx
-        sum_y += multiplier * dy
-        sum_z += multiplier * dz
-    pull = 2.0 * formation[FORMATION_INV_PAYLOAD_MASS]
-    acc[p] = drag_ax - pull * sum_x
-    acc[p + 1] = drag_ay - pull * sum_y
-    acc[p + 2] = drag_az - pull * sum_z - gravity
+    payload_pulled(cables, multipliers, formation, drag_ax, drag_ay, drag_az, acc, p)
 
 
 @jit
@@ -204,6 +202,10 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
     k1, k2, k3, k4 = work[WORK_K1], work[WORK_K2], work[WORK_K3], work[WORK_K4]
     stage, acc = work[WORK_STAGE], work[WORK_ACC]
     later = work[WORK_MULTIPLIERS, :n]
+    # driven UAVs (physics.prescribed) are functions of time: each stage's time in the
+    # period's copy of the scalars, FORMATION_TIME (t0 + h at the end: the next step's start)
+    timed = formation[FORMATION_PRESCRIBED] != 0.0
+    start = formation[FORMATION_TIME]
     solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
     for j in range(nq):  # k = (q_dot, q_ddot, the blocks' rates): the state derivative
         k1[j] = x[nq + j]
@@ -212,6 +214,8 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
         k1[bodies + j] = acc[nq + j]
     for k in (WORK_K2, WORK_K3, WORK_K4):  # stage k from x + (h/2 k1, h/2 k2, h k3)
         step, previous = (h if k == WORK_K4 else half), work[k - 1]
+        if timed:
+            formation[FORMATION_TIME] = start + step
         for j in range(size):
             stage[j] = x[j] + step * previous[j]
         solve(stage, wrenches, uavs, gusts, formation, taut, acc, later, cables)
@@ -221,6 +225,8 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
             derivative[nq + j] = acc[j]
         for j in range(extra):
             derivative[bodies + j] = acc[nq + j]
+    if timed:
+        formation[FORMATION_TIME] = start + h
     for j in range(size):
         out[j] = x[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
     for j in range(bodies, size, BODY_ATTITUDE):

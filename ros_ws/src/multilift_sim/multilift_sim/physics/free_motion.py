@@ -11,7 +11,8 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import (quaternion_axis_z, quaternion_rate,
                                            quaternion_rotation)
 from multilift_sim.physics.layout import (
-    BODY_QUATERNION, BODY_RATES, FORMATION_DRAG, FORMATION_INV_PAYLOAD_MASS, FORMATION_WIND,
+    BODY_QUATERNION, BODY_RATES, CABLE_OFFSET, FORMATION_DRAG, FORMATION_GRAVITY,
+    FORMATION_INV_PAYLOAD_MASS, FORMATION_WIND,
     GUST_CENTER,
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, POSITION,
     UAV_ATTACH, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA, UAV_MASS, WRENCH_THRUST,
@@ -221,3 +222,22 @@ def add_cable_torque(uavs, i, rates, at, pull, k0, k1, k2):
     rates[at] += t0
     rates[at + 1] += t1
     rates[at + 2] += t2
+
+
+@jit
+def payload_pulled(cables, multipliers, formation, drag_ax, drag_ay, drag_az, acc, p):
+    """The point payload's q_ddot into acc[p:p + 3] [m/s^2], world: its drag over m_p (drag_a*)
+    less the cables' pull 2 sum_i lambda_i d_i / m_p (seed Eq. 2.70; d_i at CABLE_OFFSET of
+    `cables`, Lambda in `multipliers` [N/m]), less gravity. Both solves with multipliers end
+    with it (`formation_dae.solve`, `prescribed.prescribed_solve`)."""
+    sum_x = sum_y = sum_z = 0.0
+    for i in range(multipliers.shape[0]):
+        multiplier = multipliers[i]
+        sum_x += multiplier * cables[i, CABLE_OFFSET]
+        sum_y += multiplier * cables[i, CABLE_OFFSET + 1]
+        sum_z += multiplier * cables[i, CABLE_OFFSET + 2]
+    pull = 2.0 * formation[FORMATION_INV_PAYLOAD_MASS]
+    gravity = formation[FORMATION_GRAVITY]
+    acc[p] = drag_ax - pull * sum_x
+    acc[p + 1] = drag_ay - pull * sum_y
+    acc[p + 2] = drag_az - pull * sum_z - gravity

@@ -150,7 +150,23 @@ FORMATION_SUBSTEPS = 15      # RK4 sub-steps per physics step (>= 1; the formati
 #                                 stepped at that multiple of the physics rate: stiff cables)
 FORMATION_ELASTIC = 16      # 1: the cables are elastic ropes (physics.elastic_cables: no
 #                             multipliers, each pulls k stretch + c stretch rate when taut)
-FORMATION_SCALARS = 17
+FORMATION_PRESCRIBED = 17  # 1: some UAV's motion is prescribed (`uavs[i].trajectory`,
+#                             physics.prescribed): the drive table follows the scalars
+FORMATION_TIME = 18         # with FORMATION_PRESCRIBED: the time [s] the drives are evaluated
+#                             at (the RK4 stage's; a period's copy of these scalars holds it)
+FORMATION_SCALARS = 19
+
+# -- the drive table of prescribed UAVs (physics.prescribed), after the formation's scalars
+# when FORMATION_PRESCRIBED: n slots (UAV i's at FORMATION_SCALARS + i: the offset of its drive
+# in the formation's array, 0: not prescribed), then each drive: its piece count m, its
+# m + 1 knots [s], then m pieces of DRIVE_AXES x DRIVE_ORDER coefficients (piece k, axis a,
+# power j at DRIVE_KNOTS + m + 1 + (k DRIVE_AXES + a) DRIVE_ORDER + j: sum_j c_j (t - t_k)^j)
+DRIVE_PIECES = 0            # m
+DRIVE_KNOTS = 1             # t_0 .. t_m [s], increasing
+DRIVE_AXES = 6              # x, y, z [m], world z up; roll, pitch, yaw [rad] (ZYX)
+DRIVE_POSITION = 0          # the position axes (3)
+DRIVE_EULER = 3             # the attitude axes (3)
+DRIVE_ORDER = 6             # coefficients a piece and axis: degree 5 at most
 
 # -- per cable, what a solve keeps between its passes (scratch, (n, CABLE_COLUMNS)) ------------
 CABLE_OFFSET = 0            # d_i = r_p - r_i [m] (3 slots; from the attach points)

@@ -19,7 +19,8 @@ from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.attitude import quaternion_norm_error
-from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_ELASTIC, FORMATION_WIND,
+from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_ELASTIC,
+                                          FORMATION_PRESCRIBED, FORMATION_TIME, FORMATION_WIND,
                                           STATUS_FINISHED, STATUS_QUATERNION,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
                                           STATUS_OFF_RATE, STATUS_RUNNING,
@@ -27,6 +28,7 @@ from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_ELASTIC, FORM
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
                                                uav_attitude_slot)
 from multilift_sim.physics.measurement import measured_states
+from multilift_sim.physics.prescribed import prescribe_state
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
                                                    run_add_compression, run_add_gust_speed,
@@ -70,6 +72,18 @@ def period_formation(constants, series, tick):
     formation = constants.copy()
     period_wind(constants, series, tick, formation[FORMATION_WIND:FORMATION_WIND + 3])
     return formation
+
+
+@jit
+def timed_formation(formation, t):
+    """The scalars at time t [s] (FORMATION_TIME) where some UAV's motion is prescribed
+    (physics.prescribed: its drive is a function of time; a copy, the constants are not
+    written), else `formation` itself."""
+    if formation[FORMATION_PRESCRIBED] == 0.0:
+        return formation
+    timed = formation.copy()
+    timed[FORMATION_TIME] = t
+    return timed
 
 
 @jit
@@ -136,7 +150,8 @@ def advance(a, m, b, speeds, saturated, tension):
     run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
     run_add_thrust_margin(m.run[b], m.held[b], m.effectiveness[b], a.allocation[b],
                           a.rotor_speed_max[b])
-    formation = period_formation(a.formation[b], a.wind_series[b], m.tick[b])
+    formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
+                                m.tick[b] * a.period_ns[b] * 1e-9)
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
         a.uavs[b], a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
@@ -149,6 +164,11 @@ def advance(a, m, b, speeds, saturated, tension):
         run_add_ropes(m.run[b], m.state[b], a.uavs[b], tension)
     if a.slack[b]:
         run_add_slack(m.run[b], m.taut[b], period)
+    if formation[FORMATION_PRESCRIBED] != 0.0:
+        # the driven UAVs put back on their drives at the new tick (no drift; the payload
+        # keeps what it integrated against them): physics.prescribed
+        prescribe_state(state, n, formation, (m.tick[b] + 1) * a.period_ns[b] * 1e-9)
+        residuals(state, a.uavs[b], g, g_dot)
     m.state[b, :] = state
     m.g[b, :] = g
     m.g_dot[b, :] = g_dot
@@ -200,7 +220,8 @@ def tension_at(a, m, b, speeds, tension):
     x = m.state[b]
     acc = np.empty(x.shape[0] - rates_slot(n))  # q_ddot, then the attitude blocks' rates
     multipliers = np.empty(n)
-    formation = period_formation(a.formation[b], a.wind_series[b], m.tick[b])
+    formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
+                                m.tick[b] * a.period_ns[b] * 1e-9)
     solve(x, wrenches, a.uavs[b], a.gusts[b], formation, m.taut[b], acc, multipliers,
           np.empty((n, CABLE_COLUMNS)))
     for i in range(n):

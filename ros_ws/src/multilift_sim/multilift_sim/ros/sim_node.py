@@ -105,14 +105,14 @@ class SimNode(Node):
             self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events, *winds,
             *self.measured_pubs,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
-        self.commands: list[RotorCommand | None] = [None] * n
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)
         self.cmd_subs = [AdaptiveSubscription(
             self, RotorCommand, uav_topic(i + 1, ROTOR_CMD),
             lambda msg, i=i: self._on_command(i, msg), depth=PUBLISHER_QOS.depth,
             durability=DurabilityPolicy.VOLATILE if i + 1 in self.external else None)
-            for i in range(n)]
+            for i in range(n if scenario.controlled else 0)]  # none: every UAV prescribed
+        self.commands: list[RotorCommand | None] = [None] * len(self.cmd_subs)
 
     def _on_command(self, index: int, msg: RotorCommand) -> None:
         if ns_from_stamp(msg.header.stamp) == self.sim.t_ns:
@@ -223,7 +223,7 @@ class SimNode(Node):
         last_progress = 0.0
         try:
             while True:
-                self.commands = [None] * self.sim.n
+                self.commands = [None] * len(self.cmd_subs)
                 snap = self.publish_state()
                 if self.sim.finished:
                     # a run of duration T asks for commands for the states before T only: the
@@ -231,8 +231,11 @@ class SimNode(Node):
                     self.publish_formation(snap, self.sim.tick_cables(self.applied))
                     break
                 self.wait_for_commands()
-                speeds = [np.array(c.angular_velocity, dtype=float) for c in self.commands]
-                flags = [np.array(c.saturated, dtype=bool) for c in self.commands]
+                if self.scenario.controlled:
+                    speeds = [np.array(c.angular_velocity, dtype=float) for c in self.commands]
+                    flags = [np.array(c.saturated, dtype=bool) for c in self.commands]
+                else:  # every UAV's motion prescribed: no controller, no command
+                    speeds, flags = self.sim.idle_commands()
                 held = self.sim.tick_cables(speeds)
                 try:
                     self.sim.advance(speeds, flags)

@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from multilift_sim.drives import Drive
 from multilift_sim.events import moves_air
 from multilift_sim.formation_params import FormationParams
 from multilift_sim.formation_geometry import FORMATION_GEOMETRIES  # noqa: F401 (the registry)
@@ -68,6 +69,9 @@ class UavConfig:
     attach_point: tuple[float, float, float] = (0.0, 0.0, 0.0)
     cable_stiffness: float = 0.0     # k_i [N/m] of an elastic cable (cable_model: elastic)
     cable_damping: float = 0.0       # c_i [N s/m] of an elastic cable
+    # its prescribed motion (`trajectory:`, a file; issue 34): no controller, a kinematic
+    # driver of the DAE (physics.prescribed); None: flown by its controller
+    trajectory: Drive | None = None
 
 
 @dataclass(frozen=True)
@@ -84,6 +88,9 @@ class PayloadConfig:
     size: tuple[float, ...] = ()
     inertia: tuple[float, float, float] | None = None
     attach_points: tuple[tuple[float, float, float], ...] | None = None
+    # where it starts, world [m] and [m/s] (issue 34; None: hanging at rest under the UAVs)
+    initial_position: tuple[float, float, float] | None = None
+    initial_velocity: tuple[float, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -215,6 +222,17 @@ class Scenario:
         return len(self.uavs)
 
     @property
+    def prescribed(self) -> tuple[int, ...]:
+        """The UAVs (from 0) whose motion is prescribed (`uavs[i].trajectory`)."""
+        return tuple(i for i, u in enumerate(self.uavs) if u.trajectory is not None)
+
+    @property
+    def controlled(self) -> bool:
+        """Whether the formation has controllers: not when every UAV's motion is prescribed
+        (no controller nodes, the engine answers nothing)."""
+        return len(self.prescribed) < self.n_uavs
+
+    @property
     def has_wind(self) -> bool:
         """Whether the air moves everywhere (a steady wind, turbulence or an event that blows
         air: /formation/wind carries it), beyond the seed's gusts at places."""
@@ -242,6 +260,7 @@ class Scenario:
             cable_stiffness=tuple(u.cable_stiffness for u in self.uavs) if ropes else None,
             cable_damping=tuple(u.cable_damping for u in self.uavs) if ropes else None,
             substeps=sim.substeps,
+            drives=(tuple(u.trajectory for u in self.uavs) if self.prescribed else None),
         )
 
     def with_duration(self, duration: float) -> 'Scenario':

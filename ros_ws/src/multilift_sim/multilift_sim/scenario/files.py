@@ -48,7 +48,8 @@ def load(name_or_path: str) -> Scenario:
 
 
 def anchored(data: Any, folder: Path) -> Any:
-    """A scenario's mapping with its `parts:` files and its `mission.file` made absolute against
+    """A scenario's mapping with its `parts:` files, its `mission.file` and its UAVs'
+    `trajectory` files made absolute against
     `folder` (the file's own), for a copy validated elsewhere (a sweep's runs, `loads`)."""
     if isinstance(data, dict) and isinstance(data.get('parts'), list):
         data = dict(data, parts=[str((folder / p).resolve()) if isinstance(p, str) else p
@@ -56,6 +57,12 @@ def anchored(data: Any, folder: Path) -> Any:
     mission = data.get('mission') if isinstance(data, dict) else None
     if isinstance(mission, dict) and isinstance(mission.get('file'), str):  # mission.type file
         data = dict(data, mission=dict(mission, file=str((folder / mission['file']).resolve())))
+    uavs = data.get('uavs') if isinstance(data, dict) else None
+    if isinstance(uavs, list) and any(isinstance(u, dict) and isinstance(u.get('trajectory'), str)
+                                      for u in uavs):  # prescribed motion (issue 34)
+        data = dict(data, uavs=[dict(u, trajectory=str((folder / u['trajectory']).resolve()))
+                                if isinstance(u, dict) and isinstance(u.get('trajectory'), str)
+                                else u for u in uavs])
     return data
 
 

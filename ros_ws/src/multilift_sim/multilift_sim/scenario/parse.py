@@ -29,6 +29,8 @@ from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_contr
 from multilift_sim.scenario.limits import check_limits
 from multilift_sim.scenario import reorganize
 from multilift_sim.scenario.part_files import scenario_parts
+from multilift_sim.scenario.prescribed import (check_prescribed, finite_vector, read_trajectory,
+                                               scenario_folder)
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
                                             preset_values, vehicle_params)
@@ -110,13 +112,18 @@ def scenario_of(data: Any, where: str) -> Scenario:
         if i > 0 and u.has('position'):
             raise u.fail('position', u.data['position'],
                          'is not allowed: follower positions come from the formation geometry')
+        if u.has('position') and u.has('trajectory'):
+            raise u.fail('position', u.data['position'], 'is not allowed with trajectory: '
+                         'the file gives the start')
         length = u.positive('cable_length', default_cable)
         stiffness, damping = cables.parse_uav_cable(u, length, rope)
         uavs.append(UavConfig(vehicle=vehicle, cable_length=length,
                               position=u.vector('position', [0.0, 0.0, 0.0]),
                               yaw=u.number('yaw', 0.0),
                               attach_point=u.vector('attach_point', [0.0, 0.0, 0.0]),
-                              cable_stiffness=stiffness, cable_damping=damping))
+                              cable_stiffness=stiffness, cable_damping=damping,
+                              trajectory=read_trajectory(u, scenario_folder(where),
+                                                         u.number('yaw', 0.0))))
         u.done()
 
     p = top.section('payload')
@@ -129,7 +136,9 @@ def scenario_of(data: Any, where: str) -> Scenario:
                             beta=math.radians(p.number('beta_deg', 0.0, lambda a: abs(a) < 90,
                                                        'must be within (-90, 90) degrees')),
                             swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
-                                                        'must be within (-90, 90) degrees')))
+                                                        'must be within (-90, 90) degrees')),
+                            initial_position=finite_vector(p, 'initial_position'),
+                            initial_velocity=finite_vector(p, 'initial_velocity'))
     swing = math.degrees(payload.swing)
     payload = payload_type.parse(p, payload, len(uavs))
     p.done()
@@ -200,6 +209,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
                         wind_models=tuple(wind_models), sensors=sensors, parts=parts)
     _check_feasible(scenario)
     check_limits(scenario)
+    check_prescribed(scenario)  # the files cover the run, the payload's start fits the cables
     # what the scenario uses beyond the seed's formation, each modelled by some formulations
     lagging = [i + 1 for i, u in enumerate(scenario.uavs)
                if u.vehicle.motor_time_constant > 0 or math.isfinite(u.vehicle.motor_rate_limit)]
@@ -211,7 +221,9 @@ def scenario_of(data: Any, where: str) -> Scenario:
         ('lagging_rotors', f'vehicle.motor_time_constant / motor_rate_limit '
                            f'(uav{lagging[0] if lagging else 0})', lagging),
         ('attach_points', f'uavs[{off_centre[0] if off_centre else 0}].attach_point',
-         off_centre)) if uses}
+         off_centre),
+        ('prescribed', f'uavs[{scenario.prescribed[0] if scenario.prescribed else 0}]'
+                       '.trajectory', scenario.prescribed)) if uses}
     used.update({feature: f'payload.type: {payload_type.NAME}'
                  for feature in sorted(payload_type.NEEDS)})
     used.update({feature: f'cable_model: {cable_model}' for feature in sorted(cables.NEEDS)})

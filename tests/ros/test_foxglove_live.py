@@ -219,3 +219,49 @@ def test_a_short_full_speed_run_is_forwarded_from_its_first_message(bridge, ros_
         got = sorted(stamp(message) for _, message in client.messages[topic])
         assert got == stamps, (topic, got[:3], stamps[:3])
     assert client.messages['/clock'][0][0] == 0
+
+
+def test_a_client_s_goal_is_published_and_a_live_run_flies_it(bridge, ros_env, tmp_path):
+    """Capability clientPublish (issue 34: live goals through `multilift foxglove`): a client
+    advertises /formation/goal (cdr, geometry_msgs/msg/PoseStamped) and sends one; the leader of
+    a `run --live` flies it and the bag has it."""
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.serialization import serialize_message
+
+    from conftest import run_work_dir, simulated_time, wait_for
+    from multilift_tools.bagdata import load_run
+    client, _, _ = bridge
+    assert 'clientPublish' in client.info['capabilities']
+    assert client.info['supportedEncodings'] == ['cdr']
+    bag = tmp_path / 'bag'
+    run = subprocess.Popen([str(MULTILIFT), 'run', 'single_lift', '--live', '--realtime',
+                            '--duration', '20', '--bag', str(bag)], env=ros_env,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           start_new_session=True)
+    try:
+        work = run_work_dir(run)
+        wait_for(lambda: simulated_time(work) > 0.1, TIMEOUT, 'the run started')
+        client.ws.send(json.dumps({'op': 'advertise', 'channels': [{
+            'id': 7, 'topic': '/formation/goal', 'encoding': 'cdr',
+            'schemaName': 'geometry_msgs/msg/PoseStamped'}]}))
+        goal = PoseStamped()
+        goal.header.frame_id = 'world'
+        goal.header.stamp.sec = 3
+        goal.pose.position.x, goal.pose.position.y, goal.pose.position.z = 0.3, 0.2, 0.4
+        frame = struct.pack('<BI', 0x01, 7) + serialize_message(goal)
+        log = work / 'leader_node.log'
+
+        def taken() -> bool:  # sent again until the leader has it (the same goal, taken once)
+            client.ws.send(frame)
+            return log.exists() and 'goal flown from t = ' in log.read_text()
+        wait_for(taken, TIMEOUT, 'the leader flying the client\'s goal', poll=0.5)
+        _, err = run.communicate(timeout=300)
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+            run.wait(timeout=30)
+    assert run.returncode == 0, err[-2000:]
+    assert not client.errors
+    flown = load_run(bag)
+    assert abs(flown.reference_position()[-1] - [0.3, 0.2, 0.4]).max() < 1e-9
+    assert recorded_counts(bag)['/formation/goal'] >= 1

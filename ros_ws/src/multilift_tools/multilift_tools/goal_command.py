@@ -17,6 +17,9 @@ import time
 from multilift_sim.topics import CLOCK, GOAL
 from multilift_sim.wire.msgvalues import WORLD_FRAME
 
+SETTLE = 0.5  # [s] without a new reader of the goal before it is sent (discovery settled)
+UNKNOWN = '_NODE_NAME_UNKNOWN_'  # an endpoint's node before its participant's names arrive
+
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog='multilift goal', description=__doc__.split('\n')[0])
@@ -53,18 +56,26 @@ def goal_main(argv: list[str]) -> int:
             depth=10, reliability=ReliabilityPolicy.BEST_EFFORT,
             durability=DurabilityPolicy.VOLATILE))
         # reliable and transient local: the recorder (subscribed from the start with that
-        # request) and the leader (reliable, volatile) both match it at once
+        # request) matches it, and the leader's kept reader (ros.live_input) asks for it again
+        # if it matched after the message, so acknowledged is delivered
         publisher = node.create_publisher(PoseStamped, GOAL, QoSProfile(
             depth=1, reliability=ReliabilityPolicy.RELIABLE,
             durability=DurabilityPolicy.TRANSIENT_LOCAL))
         deadline = time.monotonic() + args.timeout
+        seen: list = [None, time.monotonic()]  # the readers last seen, since when
 
         def readers_matched() -> bool:
-            """Every reader of GOAL the graph shows is matched, a leader (not only a recorder)
-            among them: a volatile reader matched after the message would never get it."""
+            """Every reader of GOAL the graph shows is matched, named, a leader's (not only a
+            recorder's) among them, and none new for SETTLE s: a reader that matched the goal
+            after it was sent would never get it."""
             readers = node.get_subscriptions_info_by_topic(GOAL)
-            return (any(r.node_name != 'recorder' for r in readers)
-                    and publisher.get_subscription_count() >= len(readers))
+            names = sorted((r.node_name, r.node_namespace) for r in readers)
+            if names != seen[0]:
+                seen[:] = [names, time.monotonic()]
+            return (bool(readers) and UNKNOWN not in {r.node_name for r in readers}
+                    and any(r.node_name != 'recorder' for r in readers)
+                    and publisher.get_subscription_count() >= len(readers)
+                    and time.monotonic() - seen[1] >= SETTLE)
         while time.monotonic() < deadline and not (
                 readers_matched() and (clock or args.at is not None)):
             rclpy.spin_once(node, timeout_sec=0.05)

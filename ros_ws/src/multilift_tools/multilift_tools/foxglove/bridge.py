@@ -1,5 +1,6 @@
 """The bridge of `multilift foxglove`: a ROS node forwarding every topic of the live graph to a
-Foxglove WebSocket server.
+Foxglove WebSocket server, and publishing what its clients send (capability clientPublish:
+`publish`, a default publisher per topic, made when a client advertises the channel).
 
 A node (`multilift_foxglove`) subscribes raw to every topic that has a publisher (hidden topics
 and /parameter_events excepted) as soon as the graph shows it: a thread waits on the node's
@@ -85,9 +86,10 @@ class FoxgloveBridge:
         from rosgraph_msgs.msg import Clock
 
         self.log = log
+        self.publishers: dict[str, Any] = {}  # topic -> a publisher of clients' messages
         self.server = FoxgloveServer(host, port, 'multilift',
                                      {'ROS_DISTRO': os.environ.get('ROS_DISTRO') or 'jazzy'},
-                                     log)
+                                     log, on_publish=self.publish)
         self.node = Node('multilift_foxglove', start_parameter_services=False)
         self.channels: dict[str, int] = {}  # topic -> channel id
         self.subscriptions: dict[str, Any] = {}  # topic -> AdaptiveSubscription
@@ -209,6 +211,23 @@ class FoxgloveBridge:
             if taken is None:
                 return
             self._forward(topic, channel_id, taken[0])
+
+    def publish(self, topic: str, type_name: str, data: bytes | None) -> None:
+        """A client's message (CDR bytes of `type_name`) on `topic`, published as a default
+        node publishes (reliable, volatile, depth 10): a goal from Foxglove's publish panel
+        (`/formation/goal`, `multilift run --live`); data None: the client advertised the
+        channel (the publisher is made then). From the server's thread."""
+        from multilift_sim.ros import introspection
+        publisher = self.publishers.get(topic)
+        if publisher is None or publisher.msg_type.__name__ != type_name.split('/')[-1]:
+            if publisher is not None:
+                self.node.destroy_publisher(publisher)
+            publisher = self.node.create_publisher(
+                introspection.import_message_type(type_name), topic, 10)
+            self.publishers[topic] = publisher
+            self.log(f'publishing clients\' {topic} [{type_name}]')
+        if data is not None:
+            publisher.publish(data)
 
     def _on_clock(self, msg: Any) -> None:
         self.clock_ns = msg.clock.sec * 1_000_000_000 + msg.clock.nanosec

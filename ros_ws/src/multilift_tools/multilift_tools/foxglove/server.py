@@ -19,6 +19,7 @@ REPLAY = 1000  # last messages of a channel a new subscription gets first (as tr
 SUBPROTOCOL = 'foxglove.sdk.v1'
 SUBPROTOCOLS = ('foxglove.websocket.v1', SUBPROTOCOL)  # the app's, foxglove-sdk's
 MESSAGE_DATA, TIME = 0x01, 0x02  # binary opcodes (server -> client)
+CLIENT_MESSAGE_DATA = 0x01  # binary opcode (client -> server, capability clientPublish)
 
 
 class _Client:
@@ -28,17 +29,22 @@ class _Client:
         self.by_channel: dict[int, int] = {}  # channel id -> subscription id
         self.queue: collections.deque = collections.deque()
         self.ready = asyncio.Event()
+        self.advertised: dict[int, tuple[str, str]] = {}  # its channel id -> (topic, type)
 
 
 class FoxgloveServer:
     """A Foxglove WebSocket protocol server (the parts a live view uses: server info,
-    advertise/unadvertise, subscribe/unsubscribe, message data, time, status), on an asyncio
-    loop in a thread of its own. `add_channel`, `remove_channel`, `log`, `broadcast_time` and
-    `clear_session` may be called from any thread."""
+    advertise/unadvertise, subscribe/unsubscribe, message data, time, status; and clients'
+    messages, capability clientPublish: a client advertises a channel (topic, `cdr`, a schema
+    name such as geometry_msgs/msg/PoseStamped) and sends CDR bytes on it, handed to
+    `on_publish(topic, type, data)` on the server's thread, data None when it advertises), on
+    an asyncio loop in a thread of its own. `add_channel`, `remove_channel`, `log`,
+    `broadcast_time` and `clear_session` may be called from any thread."""
 
     def __init__(self, host: str, port: int, name: str, metadata: dict[str, str],
-                 log=print) -> None:
+                 log=print, on_publish=None) -> None:
         self.name, self.metadata, self.log_line = name, metadata, log
+        self.on_publish = on_publish
         self.channels: dict[int, dict] = {}
         self._ids: dict[str, int] = {}  # topic -> channel id (kept, reused on return)
         self._lock = threading.Lock()
@@ -117,8 +123,10 @@ class FoxgloveServer:
 
     # -- on the loop -----------------------------------------------------------------------
     def _server_info(self) -> dict:
-        return {'op': 'serverInfo', 'name': self.name, 'capabilities': ['time'],
-                'supportedEncodings': [], 'metadata': dict(self.metadata),
+        publish = ['clientPublish'] if self.on_publish is not None else []
+        return {'op': 'serverInfo', 'name': self.name, 'capabilities': ['time', *publish],
+                'supportedEncodings': ['cdr'] if publish else [],
+                'metadata': dict(self.metadata),
                 'sessionId': self.session_id}
 
     def _dispatch(self) -> None:
@@ -174,6 +182,8 @@ class FoxgloveServer:
             async for text in ws:
                 if isinstance(text, str):
                     self._on_client_message(client, text)
+                else:
+                    self._on_client_data(client, text)
         except Exception:  # noqa: BLE001 - a client that went away
             pass
         finally:
@@ -210,8 +220,37 @@ class FoxgloveServer:
                     client.queue.append(struct.pack('<BIQ', MESSAGE_DATA, sub_id, log_time)
                                         + data)
                 client.ready.set()
+        elif message.get('op') == 'advertise' and self.on_publish is not None:
+            for channel in message.get('channels', []):
+                if channel.get('encoding') != 'cdr':
+                    self._status(client, 2, f'channel {channel.get("topic")}: encoding '
+                                 f'{channel.get("encoding")!r} (this server takes cdr)')
+                    continue
+                advertised = (channel.get('topic'), channel.get('schemaName'))
+                client.advertised[channel.get('id')] = advertised
+                try:  # the publisher made now: its readers match it before the first message
+                    self.on_publish(*advertised, None)
+                except Exception as error:  # noqa: BLE001 - told to the client
+                    self._status(client, 2, f'{advertised[0]}: {error}')
+        elif message.get('op') == 'unadvertise':
+            for channel_id in message.get('channelIds', []):
+                client.advertised.pop(channel_id, None)
         elif message.get('op') == 'unsubscribe':
             for sub_id in message.get('subscriptionIds', []):
                 channel_id = client.subscriptions.pop(sub_id, None)
                 if channel_id is not None:
                     client.by_channel.pop(channel_id, None)
+
+    def _on_client_data(self, client: _Client, frame: bytes) -> None:
+        """A client's message on a channel it advertised (opcode, channel id, CDR bytes)."""
+        if len(frame) < 5 or frame[0] != CLIENT_MESSAGE_DATA or self.on_publish is None:
+            return
+        (channel_id,) = struct.unpack_from('<I', frame, 1)
+        advertised = client.advertised.get(channel_id)
+        if advertised is None:
+            self._status(client, 2, f'Unknown client channel ID: {channel_id}')
+            return
+        try:
+            self.on_publish(*advertised, bytes(frame[5:]))
+        except Exception as error:  # noqa: BLE001 - told to the client, the server goes on
+            self._status(client, 2, f'{advertised[0]}: {error}')

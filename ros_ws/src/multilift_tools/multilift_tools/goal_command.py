@@ -19,6 +19,8 @@ from multilift_sim.wire.msgvalues import WORLD_FRAME
 
 SETTLE = 0.5  # [s] without a new reader of the goal before it is sent (discovery settled)
 UNKNOWN = '_NODE_NAME_UNKNOWN_'  # an endpoint's node before its participant's names arrive
+RECORDER = 'recorder'  # the recorder node's name (multilift_sim.ros.recorder_node)
+LINGER = 2.0  # [s] the goal kept for readers that match after it was acknowledged
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -66,14 +68,17 @@ def goal_main(argv: list[str]) -> int:
 
         def readers_matched() -> bool:
             """Every reader of GOAL the graph shows is matched, named, a leader's (not only a
-            recorder's) among them, and none new for SETTLE s: a reader that matched the goal
-            after it was sent would never get it."""
+            recorder's) among them, the recorder's too when the graph has a recorder, and none
+            new for SETTLE s: a reader that matched the goal after it was sent would never get
+            it."""
             readers = node.get_subscriptions_info_by_topic(GOAL)
             names = sorted((r.node_name, r.node_namespace) for r in readers)
             if names != seen[0]:
                 seen[:] = [names, time.monotonic()]
-            return (bool(readers) and UNKNOWN not in {r.node_name for r in readers}
-                    and any(r.node_name != 'recorder' for r in readers)
+            reading = {r.node_name for r in readers}
+            return (bool(readers) and UNKNOWN not in reading
+                    and bool(reading - {RECORDER})
+                    and (RECORDER in reading or RECORDER not in node.get_node_names())
                     and publisher.get_subscription_count() >= len(readers)
                     and time.monotonic() - seen[1] >= SETTLE)
         while time.monotonic() < deadline and not (
@@ -101,6 +106,14 @@ def goal_main(argv: list[str]) -> int:
                 Duration(seconds=max(deadline - time.monotonic(), 1.0))):
             print(f'error: goal: {GOAL} not acknowledged by its readers', file=sys.stderr)
             return 1
+        # a reader that matches a moment later (a recorder discovered late on a loaded
+        # machine) asks for the kept message: stay for it, LINGER s after the last new one
+        readers, until = publisher.get_subscription_count(), time.monotonic() + LINGER
+        while time.monotonic() < until:
+            rclpy.spin_once(node, timeout_sec=0.05)
+            if publisher.get_subscription_count() > readers:
+                readers, until = publisher.get_subscription_count(), time.monotonic() + LINGER
+                publisher.wait_for_all_acked(Duration(seconds=LINGER))
         print(f'goal ({args.x:g}, {args.y:g}, {args.z:g}) m'
               + (f', yaw {args.yaw:g} deg' if args.yaw is not None else '')
               + f' from t = {stamp_ns * 1e-9:.3f} s')

@@ -133,3 +133,24 @@ def test_a_run_flies_at_least_one_control_period():
     for short in (0.004, 0.0, -1.0, math.nan, math.inf):
         with pytest.raises(scenario_io.ScenarioError, match='at least one control period'):
             scenario.with_duration(short)
+
+
+def test_exponent_numbers_without_a_dot_or_a_signed_exponent_are_numbers(tmp_path):
+    """YAML 1.1 (PyYAML) reads `1.5e5` as text; a scenario reads it as the number a user wrote
+    (as YAML 1.2 and JSON do), in a file and in a sweep's base."""
+    import yaml as _yaml
+
+    from multilift_sim import scenario as _scenario
+    assert _yaml.safe_load('k: 1.5e5')['k'] == '1.5e5'  # what PyYAML alone gives
+    text = _scenario.resolve('twin_lift').read_text()
+    data = _scenario.read_yaml(text)
+    data['cable_model'] = 'elastic'
+    data['cable'] = {'axial_stiffness': 'PLACEHOLDER', 'damping': 8.0}
+    data['simulation']['substeps'] = 4
+    path = tmp_path / 'rope.yaml'
+    path.write_text(_yaml.safe_dump(data, sort_keys=False).replace('PLACEHOLDER', '1.5e5'))
+    assert '1.5e5' in path.read_text()
+    loaded = _scenario.load(str(path))
+    assert loaded.cable_model == 'elastic'
+    assert _scenario.read_yaml('[1e5, 2.5E-3, -3e+2, 1.0, 7, 1e, e5]') == [
+        1e5, 2.5e-3, -300.0, 1.0, 7, '1e', 'e5']

@@ -19,6 +19,7 @@ from multilift_sim.scenario.controllers import (FOLLOWER_CONTROLLERS,  # noqa: F
                                                 LEADER_CONTROLLERS, follower_controllers,
                                                 leader_controllers)
 from multilift_sim.scenario.files import (anchored, from_mapping, load, loads,  # noqa: F401
+                                          read_yaml,
                                           resolve, scenario_dir)
 from multilift_sim.scenario.vehicle import (INERTIA_SOURCES, SEED_INERTIA,  # noqa: F401
                                             VEHICLE_KEYS)

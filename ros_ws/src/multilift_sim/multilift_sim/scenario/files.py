@@ -3,6 +3,7 @@ the repository's) or a YAML path, read and validated (`parse.scenario_of`)."""
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -37,11 +38,28 @@ def resolve(name_or_path: str) -> Path:
     return path
 
 
+class _ScenarioYaml(yaml.SafeLoader):
+    """PyYAML's safe loader (YAML 1.1), but a number in exponent form without a dot or a sign in
+    its exponent (`1.5e5`, `2e-3` has one, `1e5`) is a float, as YAML 1.2, JSON and a reader
+    take it: YAML 1.1 makes `1.5e5` a string, which the validation refused as not a number."""
+
+
+_ScenarioYaml.add_implicit_resolver(
+    'tag:yaml.org,2002:float',
+    re.compile(r'^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$'),
+    list('-+0123456789.'))
+
+
+def read_yaml(text: str) -> Any:
+    """A scenario file's text as its mapping (`_ScenarioYaml`); raises yaml.YAMLError."""
+    return yaml.load(text, Loader=_ScenarioYaml)  # noqa: S506 - a SafeLoader
+
+
 def load(name_or_path: str) -> Scenario:
     """Load and validate a scenario by name or path. Raises ScenarioError."""
     path = resolve(name_or_path)
     try:
-        data = yaml.safe_load(path.read_text())
+        data = read_yaml(path.read_text())
     except yaml.YAMLError as exc:
         raise ScenarioError(f'{path}: not valid YAML: {exc}'.replace('\n', ' ')) from None
     return scenario_of(data, str(path))
@@ -68,7 +86,7 @@ def anchored(data: Any, folder: Path) -> Any:
 
 def loads(text: str, where: str = '<string>') -> Scenario:
     """Validate a scenario given as YAML text (tests, tools)."""
-    return scenario_of(yaml.safe_load(text), where)
+    return scenario_of(read_yaml(text), where)
 
 
 def from_mapping(data: Any, where: str = '<mapping>') -> Scenario:

@@ -118,7 +118,7 @@ def load_base(name_or_path: str) -> tuple[str, dict]:
     """The scenario file (by name or path) -> (its path as text, its YAML mapping)."""
     path = scenario_io.resolve(name_or_path)
     try:
-        base = yaml.safe_load(path.read_text())
+        base = scenario_io.read_yaml(path.read_text())
     except yaml.YAMLError as exc:
         raise scenario_io.ScenarioError(f'{path}: not valid YAML: {exc}'
                                         .replace('\n', ' ')) from None

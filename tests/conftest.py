@@ -12,14 +12,16 @@ Tests live in two layers, each a folder and a marker (set here from the folder):
 from __future__ import annotations
 
 import _posixsubprocess
+import contextlib
 import itertools
 import os
 import re
 import select
+import signal
 import subprocess
 import time
 from pathlib import Path
-from typing import Callable, TypeVar
+from typing import Callable, Iterator, TypeVar
 
 import pytest
 
@@ -254,3 +256,20 @@ def wait_until_simulated(process: subprocess.Popen, t: float, timeout: float = 1
         now = simulated_time(work)
         return now if now >= t else 0.0
     return wait_for(reached, timeout, f'the run reaching t = {t} s simulated')
+
+
+@contextlib.contextmanager
+def started_run(args: list[str], env: dict) -> Iterator[tuple[subprocess.Popen, Path]]:
+    """`scripts/multilift run ARGS` (stdout and stderr piped, text) and its log directory, once
+    it simulated past t = 0.1 s; killed with its process group if the body leaves it running."""
+    run = subprocess.Popen([str(ROOT / 'scripts' / 'multilift'), 'run', *args], env=env,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           start_new_session=True)
+    try:
+        work = run_work_dir(run)
+        wait_for(lambda: simulated_time(work) > 0.1, 120, 'the run started')
+        yield run, work
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+            run.wait(timeout=30)

@@ -228,19 +228,14 @@ def test_a_client_s_goal_is_published_and_a_live_run_flies_it(bridge, ros_env, t
     from geometry_msgs.msg import PoseStamped
     from rclpy.serialization import serialize_message
 
-    from conftest import run_work_dir, simulated_time, wait_for
+    from conftest import started_run, wait_for
     from multilift_tools.bagdata import load_run
     client, _, _ = bridge
     assert 'clientPublish' in client.info['capabilities']
     assert client.info['supportedEncodings'] == ['cdr']
     bag = tmp_path / 'bag'
-    run = subprocess.Popen([str(MULTILIFT), 'run', 'single_lift', '--live', '--realtime',
-                            '--duration', '20', '--bag', str(bag)], env=ros_env,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                           start_new_session=True)
-    try:
-        work = run_work_dir(run)
-        wait_for(lambda: simulated_time(work) > 0.1, TIMEOUT, 'the run started')
+    with started_run(['single_lift', '--live', '--realtime', '--duration', '20', '--bag',
+                      str(bag)], ros_env) as (run, work):
         client.ws.send(json.dumps({'op': 'advertise', 'channels': [{
             'id': 7, 'topic': '/formation/goal', 'encoding': 'cdr',
             'schemaName': 'geometry_msgs/msg/PoseStamped'}]}))
@@ -256,10 +251,6 @@ def test_a_client_s_goal_is_published_and_a_live_run_flies_it(bridge, ros_env, t
             return log.exists() and 'goal flown from t = ' in log.read_text()
         wait_for(taken, TIMEOUT, 'the leader flying the client\'s goal', poll=0.5)
         _, err = run.communicate(timeout=300)
-    finally:
-        if run.poll() is None:
-            os.killpg(run.pid, signal.SIGKILL)
-            run.wait(timeout=30)
     assert run.returncode == 0, err[-2000:]
     assert not client.errors
     flown = load_run(bag)

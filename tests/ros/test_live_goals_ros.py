@@ -4,13 +4,11 @@ the formation follows, and /formation/goal is in the bag with its stamp. `--live
 `--headless` is exit 2, and `multilift goal` without a live run is exit 1."""
 from __future__ import annotations
 
-import os
-import signal
 import subprocess
 
 import numpy as np
 
-from conftest import ROOT, raw_messages, run_work_dir, simulated_time, wait_for
+from conftest import ROOT, raw_messages, started_run, wait_for
 from multilift_tools.bagdata import load_run
 from multilift_sim import scenario as scenario_io
 
@@ -23,13 +21,8 @@ def test_a_live_goal_is_flown_from_its_stamp_and_recorded(ros_env, tmp_path):
     bag = tmp_path / 'bag'
     start = np.array(scenario_io.load('single_lift').uavs[0].position)
     goal = start + np.array([0.4, -0.3, 0.3])
-    run = subprocess.Popen([MULTILIFT, 'run', 'single_lift', '--live', '--realtime',
-                            '--duration', str(DURATION), '--bag', str(bag)], env=ros_env,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                           start_new_session=True)
-    try:
-        work = run_work_dir(run)
-        wait_for(lambda: simulated_time(work) > 0.1, 120, 'the run started')
+    with started_run(['single_lift', '--live', '--realtime', '--duration', str(DURATION),
+                      '--bag', str(bag)], ros_env) as (run, work):
         sent = subprocess.run([MULTILIFT, 'goal', *map(str, goal), '--at', str(STAMP),
                                '--yaw', '20', '--timeout', '60'], env=ros_env,
                               capture_output=True, text=True, timeout=120)
@@ -42,10 +35,6 @@ def test_a_live_goal_is_flown_from_its_stamp_and_recorded(ros_env, tmp_path):
         assert ('goal flown from t = 4.000 s\n' in log.read_text()
                 or 'it came later' in log.read_text()), log.read_text()
         _, err = run.communicate(timeout=300)
-    finally:
-        if run.poll() is None:
-            os.killpg(run.pid, signal.SIGKILL)
-            run.wait(timeout=30)
     assert run.returncode == 0, err[-2000:]
     flown = load_run(bag)
     times, reference = flown.reference_time, flown.reference_position()

@@ -13,7 +13,7 @@ at or after it, in simulated time), starting from where the reference then is:
 A new reference starts at rest: a goal that replaces one still being flown steps the
 reference's velocity (as the seed's segments do at their corners). The points are the tracked
 point's (`mission.tracks`: the leader, or the payload, then flown at its offset as
-MissionPath does). ROS messages are read in `multilift_control.ros.leader_node`; this module
+MissionPath does). ROS messages are read in `multilift_control.ros.live_input`; this module
 has no rclpy. Not in the seed.
 """
 from __future__ import annotations
@@ -25,7 +25,7 @@ import numpy as np
 
 from multilift_control.controllers import tracked_offset
 from multilift_control.mission import MissionPath
-from multilift_sim.missions.polynomials import evaluate, minimum_snap, polynomial_mission
+from multilift_sim.missions.polynomials import minimum_snap, polynomial_mission
 from multilift_sim.scenario import MissionConfig
 
 
@@ -44,18 +44,12 @@ class LiveTarget:
         return 'goal' if len(self.times) == 0 else 'path'
 
 
-def _unit_peaks() -> tuple[float, float]:
-    """(max |s'|, max |s''|) of the rest-to-rest minimum-snap polynomial s from 0 to 1 over a
-    time of 1 (35 t^4 - 84 t^5 + 70 t^6 - 20 t^7): a distance D over T peaks at
-    max|s'| D / T [m/s] and max|s''| D / T^2 [m/s^2]."""
-    times = np.array([0.0, 1.0])
-    coefficients = minimum_snap(times, np.array([[0.0], [1.0]]))
-    grid = np.linspace(0.0, 1.0, 2001)
-    return tuple(max(abs(float(evaluate(times, coefficients, t, order)[0])) for t in grid)
-                 for order in (1, 2))
-
-
-UNIT_SPEED_PEAK, UNIT_ACCELERATION_PEAK = _unit_peaks()  # 35/16, 7.51
+# The rest-to-rest minimum-snap polynomial from 0 to 1 over a time of 1,
+# s = 35 t^4 - 84 t^5 + 70 t^6 - 20 t^7, peaks at |s'| = 35/16 (t = 1/2) and
+# |s''| = 84 sqrt(5) / 25 (t = 1/2 -+ sqrt(5)/10): a distance D flown in T peaks at
+# UNIT_SPEED_PEAK D / T [m/s] and UNIT_ACCELERATION_PEAK D / T^2 [m/s^2]
+UNIT_SPEED_PEAK = 35.0 / 16.0
+UNIT_ACCELERATION_PEAK = 84.0 * math.sqrt(5.0) / 25.0
 
 
 def goal_duration(distance: float, max_speed: float, max_acceleration: float) -> float:

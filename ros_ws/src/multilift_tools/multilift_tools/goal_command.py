@@ -15,7 +15,7 @@ import sys
 import time
 
 from multilift_sim.topics import CLOCK, GOAL
-from multilift_sim.wire.msgvalues import WORLD_FRAME
+from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp
 
 SETTLE = 0.5  # [s] without a new reader of the goal before it is sent (discovery settled)
 UNKNOWN = '_NODE_NAME_UNKNOWN_'  # an endpoint's node before its participant's names arrive
@@ -94,7 +94,7 @@ def goal_main(argv: list[str]) -> int:
         stamp_ns = round(args.at * 1e9) if args.at is not None else clock[-1]
         msg = PoseStamped()
         msg.header.frame_id = WORLD_FRAME
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp_ns, 1_000_000_000)
+        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp(stamp_ns)
         msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = args.x, args.y, args.z
         half = math.radians(args.yaw) / 2.0 if args.yaw is not None else None
         if half is not None:  # else the zero quaternion: keep the current heading

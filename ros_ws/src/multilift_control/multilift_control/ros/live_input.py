@@ -14,6 +14,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from multilift_control.live_goals import LiveMission, LiveTarget
+from multilift_sim.kinematics import euler_from_quaternion
 from multilift_sim.topics import GOAL, PATH
 from multilift_sim.wire.msgvalues import WORLD_FRAME
 
@@ -33,11 +34,12 @@ def _seconds(stamp) -> float:
 
 
 def _yaw(q) -> float:
-    """The heading [rad] of an orientation quaternion (ZYX yaw, world z up); NaN for the zero
-    quaternion (an orientation left unset: keep the current heading)."""
+    """The heading [rad] of an orientation quaternion (its ZYX yaw, world z up:
+    `kinematics.euler_from_quaternion`); NaN for the zero quaternion (an orientation left
+    unset: keep the current heading)."""
     if q.x == q.y == q.z == q.w == 0.0:
         return math.nan
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return float(euler_from_quaternion([q.x, q.y, q.z, q.w])[2])
 
 
 def _point(pose) -> list[float]:

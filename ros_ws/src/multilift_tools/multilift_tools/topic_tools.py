@@ -8,7 +8,8 @@
     node PKG EXECUTABLE [ARGS...]        exec <prefix>/lib/PKG/EXECUTABLE found on AMENT_PREFIX_PATH
 
 The topic tools wait up to DISCOVERY_WAIT [s] for the ROS graph to settle (ros2cli's daemonless mode
-waits too); set ROS_DOMAIN_ID / ROS_AUTOMATIC_DISCOVERY_RANGE as for the nodes you inspect.
+waits too), `info` and `echo` up to TOPIC_WAIT [s] for the topic they are given; set
+ROS_DOMAIN_ID / ROS_AUTOMATIC_DISCOVERY_RANGE as for the nodes you inspect.
 """
 
 from __future__ import annotations
@@ -24,6 +25,10 @@ from pathlib import Path
 from multilift_sim.wire.msgdefs import ament_prefixes
 
 DISCOVERY_WAIT = 3.0  # [s] longest wait for the graph (Fast DDS may take 2.5 s to discover)
+# [s] longest wait for a named topic to appear (the wait ends when it does): on a loaded machine
+# discovering a publisher took longer than DISCOVERY_WAIT (a fresh-clone CI run's `topic echo`
+# of a latched topic found no publisher in 3 s)
+TOPIC_WAIT = 15.0
 SETTLE = 0.5  # [s] without graph change, once another node is seen, that ends the wait
 HZ_WINDOW = 10000  # messages `topic hz` averages over by default (ros2 topic hz's default)
 HZ_DEPTH = 100  # keep_last depth of `topic hz`'s subscription
@@ -81,8 +86,8 @@ def _has_topic(node, topic: str):
 
 def _topic_info(node, args: argparse.Namespace) -> int:
     # the topic first (a node may be seen a moment before its topics), then the graph settled
-    # (every publisher and subscription counted); an unknown topic waits DISCOVERY_WAIT
-    _spin_graph(node, until=_has_topic(node, args.topic))
+    # (every publisher and subscription counted); an unknown topic waits TOPIC_WAIT
+    _spin_graph(node, until=_has_topic(node, args.topic), timeout=TOPIC_WAIT)
     _spin_graph(node)
     types = dict(node.get_topic_names_and_types()).get(args.topic)
     if types is None:
@@ -99,7 +104,7 @@ def _topic_echo(node, args: argparse.Namespace) -> int:
     from multilift_sim.ros import introspection
     type_name = args.type
     if type_name is None:
-        _spin_graph(node, until=_has_topic(node, args.topic))
+        _spin_graph(node, until=_has_topic(node, args.topic), timeout=TOPIC_WAIT)
         types = dict(node.get_topic_names_and_types()).get(args.topic)
         if not types:
             print(f"Could not determine the type for the passed topic '{args.topic}' "

@@ -21,7 +21,7 @@ from multilift_sim.physics.layout import (
     FORMATION_NULL_SPACE, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
     FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
     FORMATION_SCALARS, FORMATION_TIME, FORMATION_WINCH, UAV_WINCH_ACCELERATION_LIMIT,
-    UAV_WINCH_MAX_LENGTH, UAV_WINCH_MIN_LENGTH, UAV_WINCH_RATE_LIMIT,
+    UAV_REEL_LENGTH, UAV_WINCH_MAX_LENGTH, UAV_WINCH_MIN_LENGTH, UAV_WINCH_RATE_LIMIT,
     FORMATION_SUBSTEPS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_COLUMNS,
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, UAV_ATTACH,
     UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA,
@@ -301,7 +301,10 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     formation[FORMATION_PRESCRIBED] = 0.0 if params.drives is None else 1.0
     formation[FORMATION_TIME] = 0.0
     formation[FORMATION_WINCH] = 0.0 if params.winches is None else 1.0
-    uavs[:, UAV_WINCH_RATE_LIMIT:UAV_COLUMNS] = 0.0   # no winch (the reel slots: a period's)
+    uavs[:, UAV_WINCH_RATE_LIMIT:UAV_COLUMNS] = 0.0   # no winch
+    # the reel slots a period's copy sets (physics.winch.reel_period): here each cable at its
+    # own length, at rest, so that a solve of the constants alone sees the start's lengths
+    uavs[:, UAV_REEL_LENGTH] = params.cable_lengths
     for i, winch in enumerate(params.winches or ()):
         if winch is not None:
             uavs[i, [UAV_WINCH_RATE_LIMIT, UAV_WINCH_ACCELERATION_LIMIT, UAV_WINCH_MIN_LENGTH,

@@ -230,6 +230,11 @@ class Scenario:
         return tuple(i for i, u in enumerate(self.uavs) if u.trajectory is not None)
 
     @property
+    def winches(self) -> tuple[int, ...]:
+        """The UAVs (from 1) that carry a winch (`uavs[i].winch`)."""
+        return tuple(i + 1 for i, u in enumerate(self.uavs) if u.winch is not None)
+
+    @property
     def controlled(self) -> bool:
         """Whether the formation has controllers: not when every UAV's motion is prescribed
         (no controller nodes, the engine answers nothing)."""

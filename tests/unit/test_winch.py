@@ -166,3 +166,19 @@ def test_a_reeled_run_compiled_equals_its_uncompiled_source(monkeypatch):
         stretch = np.linalg.norm(layout.payload_position(compiled)
                                  - layout.uav_positions(compiled)[0])
         assert stretch > s.uavs[0].cable_length + 0.2    # paid out 0.24 m (a 0.8 s ramp)
+
+
+def test_a_winched_bag_carries_the_lengths_and_plots_them(tmp_path):
+    """The headless bag's /uav1/cable_length is the reel's length at every tick, which
+    `multilift plot` draws (cable_lengths.png) and the rope figure is skipped for."""
+    from multilift_tools.bagdata import load_run
+    from multilift_tools.figures import plot_main
+    from multilift_tools.headless_bag import record_headless
+    s = _single_lift([{'time': 0.5, 'type': 'winch_rate', 'uav': 1, 'rate': 0.3}], 3.0)
+    record_headless(s, tmp_path / 'bag')
+    t, lengths = load_run(tmp_path / 'bag').cable_lengths(1)
+    reel, _ = _reels(s)
+    np.testing.assert_array_equal(lengths, reel)          # every tick's, t = 0 to t_max
+    assert lengths[0] == 2.5 and lengths[-1] > 2.5 + 0.5 and t[-1] == pytest.approx(3.0)
+    assert plot_main([str(tmp_path / 'bag'), '--out', str(tmp_path / 'plots')]) == 0
+    assert (tmp_path / 'plots' / 'cable_lengths.png').stat().st_size > 0

@@ -182,3 +182,15 @@ def test_a_winched_bag_carries_the_lengths_and_plots_them(tmp_path):
     assert lengths[0] == 2.5 and lengths[-1] > 2.5 + 0.5 and t[-1] == pytest.approx(3.0)
     assert plot_main([str(tmp_path / 'bag'), '--out', str(tmp_path / 'plots')]) == 0
     assert (tmp_path / 'plots' / 'cable_lengths.png').stat().st_size > 0
+
+
+def test_an_elastic_rope_s_stepping_is_checked_at_the_winch_s_shortest_length():
+    """EA / l grows as the winch hauls in: a rope stepped well enough at its length is refused
+    when its winch may reel it to a quarter of it (omega h doubles), naming the sub-steps."""
+    data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
+    data.update(cable_model='elastic', cable={'axial_stiffness': 2e4})
+    data['simulation']['substeps'] = 4                            # omega h = 0.39
+    scenario_io.loads(yaml.safe_dump(data))                       # flies without a winch
+    data['uavs'][0]['winch'] = dict(WINCH, min_length=0.625)      # a quarter of 2.5 m
+    with pytest.raises(scenario_io.ScenarioError, match='set simulation.substeps >= '):
+        scenario_io.loads(yaml.safe_dump(data))

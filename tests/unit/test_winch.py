@@ -155,7 +155,7 @@ def test_a_reeled_run_compiled_equals_its_uncompiled_source(monkeypatch):
             data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
             data['uavs'][0]['winch'] = WINCH
             data.update(events=events, **cable)
-            data['simulation'].update(duration=1.2, substeps=2)
+            data['simulation'].update(duration=1.2, substeps=4)   # checked at min_length
             s = scenario_io.loads(yaml.safe_dump(data))
         monkeypatch.setenv('MULTILIFT_KERNEL', 'auto')
         compiled = run_headless(s).simulator.state
@@ -186,11 +186,11 @@ def test_a_winched_bag_carries_the_lengths_and_plots_them(tmp_path):
 
 def test_an_elastic_rope_s_stepping_is_checked_at_the_winch_s_shortest_length():
     """EA / l grows as the winch hauls in: a rope stepped well enough at its length is refused
-    when its winch may reel it to a quarter of it (omega h doubles), naming the sub-steps."""
+    when its winch may reel it to a fifth of it (omega h times sqrt 5), naming the sub-steps."""
     data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
     data.update(cable_model='elastic', cable={'axial_stiffness': 2e4})
-    data['simulation']['substeps'] = 4                            # omega h = 0.39
+    data['simulation']['substeps'] = 4                            # omega h = 0.25
     scenario_io.loads(yaml.safe_dump(data))                       # flies without a winch
-    data['uavs'][0]['winch'] = dict(WINCH, min_length=0.625)      # a quarter of 2.5 m
+    data['uavs'][0]['winch'] = dict(WINCH, min_length=0.5)        # 5x stiffer: omega h 0.56
     with pytest.raises(scenario_io.ScenarioError, match='set simulation.substeps >= '):
         scenario_io.loads(yaml.safe_dump(data))

@@ -241,7 +241,8 @@ class _Parser(argparse.ArgumentParser):
 def study_main(argv: list[str] | None = None) -> int:
     """`multilift study NAME [--out DIR] [--duration S] [--dt S] [--scenario S]` (argv without
     the word 'study'). NAME: baumgarte, swing_feedback (multilift_tools.swing_study) or
-    load_sharing (multilift_tools.load_study; both take --out only). Prints the table and writes the files to DIR (default runs/study).
+    load_sharing (multilift_tools.load_study; both take --out only). Prints the table and
+    writes the files to DIR (default runs/study).
     Exit 0, or 2 with one line on stderr for bad input."""
     parser = _Parser(prog='multilift study', description='numerical studies (seed Ch. 4)')
     parser.add_argument('study', choices=STUDIES)

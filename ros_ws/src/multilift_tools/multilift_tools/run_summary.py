@@ -194,7 +194,10 @@ def clearance_lines(sim: dict) -> list[str]:
     if 'clearance' not in sim:
         return []
     lines = []
-    for kind, figure in sim['clearance'].items():
+    for kind in CLEARANCE_WORDS:  # in one order whether read from summary.json or not
+        if kind not in sim['clearance']:
+            continue
+        figure = sim['clearance'][kind]
         first, second = figure['between']
         lines.append(f'  clearance {CLEARANCE_WORDS[kind]:<16} least {figure["value"]:.3f} '
                      f'{unit_of("least_clearance")} at t = {figure["time"]:.2f} s '

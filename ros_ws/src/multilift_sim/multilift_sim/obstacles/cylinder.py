@@ -26,8 +26,9 @@ def outline(half):
 @jit
 def distance(row, x, y, z, out):
     """The signed distance [m] from (x, y, z), world, to the cylinder of `row`, into out[0]."""
-    radial = math.hypot(x - row[OBSTACLE_CENTER], y - row[OBSTACLE_CENTER + 1]) \
-        - row[OBSTACLE_HALF]
+    dx, dy = x - row[OBSTACLE_CENTER], y - row[OBSTACLE_CENTER + 1]
+    radial = math.sqrt(dx * dx + dy * dy) - row[OBSTACLE_HALF]
     axial = abs(z - row[OBSTACLE_CENTER + 2]) - row[OBSTACLE_HALF + 2]
-    outside = math.hypot(max(radial, 0.0), max(axial, 0.0))
+    # (sqrt, not hypot: numba's hypot and CPython's differ in the last bit)
+    outside = math.sqrt(max(radial, 0.0) ** 2 + max(axial, 0.0) ** 2)
     out[0] = outside + min(max(radial, axial), 0.0)

@@ -45,3 +45,39 @@ def clearance_figures(scenario, clearance: np.ndarray, contact: np.ndarray) -> d
                    'between': list(contact_names(scenario, contact))}
     least = min((k['value'] for k in kinds.values()), default=None)
     return {'clearance': kinds, 'least_clearance': least, 'contact': touched}
+
+
+def clearance_series(scenario, uavs: np.ndarray, uav_quaternions: np.ndarray,
+                     payload: np.ndarray, payload_quaternions: np.ndarray | None = None
+                     ) -> np.ndarray:
+    """The clearance of each kind (T, CLEARANCE_KINDS) [m] (+inf: none measured) of T states
+    given by their parts: UAV positions (n, T, 3) [m] and attitudes (n, T, 4) (w, x, y, z),
+    world, the payload's positions (T, 3) [m] and a rigid payload's attitudes (T, 4); each
+    measured by the tick's own function (physics.clearance.measure): a recorded run's
+    clearance over time (`multilift plot`'s clearance figure)."""
+    from multilift_sim.formulations import make_formulation
+    from multilift_sim.physics.clearance import measure
+    from multilift_sim.scenario.world import world_arrays
+    n, samples = scenario.n_uavs, len(payload)
+    rigid = payload_quaternions is not None
+    state = np.zeros(layout.attitude_slot(n) + (layout.PAYLOAD_ATTITUDE if rigid else 0))
+    constants = make_formulation(scenario.simulation.integrator, scenario.formation_params(),
+                                 scenario.cable_model).physics_constants()[0]
+    world, obstacles, radii = world_arrays(scenario)
+    least = np.zeros((layout.CLEARANCE_KINDS, layout.CLEARANCE_COLUMNS))
+    contact = np.zeros(layout.CLEARANCE_COLUMNS)
+    out = np.empty((samples, layout.CLEARANCE_KINDS))
+    for k in range(samples):
+        state[:3 * n] = np.asarray(uavs[:, k], dtype=float).ravel()
+        state[layout.payload_slot(n):layout.payload_slot(n) + 3] = payload[k]
+        for i in range(n):
+            base = layout.uav_attitude_slot(n, i) + layout.BODY_QUATERNION
+            state[base:base + 4] = uav_quaternions[i, k]
+        if rigid:
+            base = layout.attitude_slot(n) + layout.PAYLOAD_QUATERNION
+            state[base:base + 4] = payload_quaternions[k]
+        least[:, layout.CLEARANCE_VALUE] = math.inf
+        contact[:] = -1.0
+        measure(world, obstacles, radii, constants, state, 0.0, least, contact)
+        out[k] = least[:, layout.CLEARANCE_VALUE]
+    return out

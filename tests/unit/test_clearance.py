@@ -157,8 +157,9 @@ def _formation_state(uavs: np.ndarray, payload: np.ndarray) -> np.ndarray:
     """A point payload's state of n UAVs at rest, level (unit quaternions)."""
     n = len(uavs)
     state = np.zeros(layout.attitude_slot(n))
-    state[:3 * n] = uavs.ravel()
-    state[3 * n:3 * n + 3] = payload
+    for i in range(n):
+        state[layout.uav_slot(i):layout.uav_slot(i) + 3] = uavs[i]
+    state[layout.payload_slot(n):layout.payload_slot(n) + 3] = payload
     for i in range(n):
         state[layout.uav_attitude_slot(n, i)] = 1.0
     return state

@@ -68,7 +68,8 @@ def clearance_series(scenario, uavs: np.ndarray, uav_quaternions: np.ndarray,
     contact = np.zeros(layout.CLEARANCE_COLUMNS)
     out = np.empty((samples, layout.CLEARANCE_KINDS))
     for k in range(samples):
-        state[:3 * n] = np.asarray(uavs[:, k], dtype=float).ravel()
+        for i in range(n):
+            state[layout.uav_slot(i) + layout.POSITION:layout.uav_slot(i) + 3] = uavs[i, k]
         state[layout.payload_slot(n):layout.payload_slot(n) + 3] = payload[k]
         for i in range(n):
             base = layout.uav_attitude_slot(n, i) + layout.BODY_QUATERNION

@@ -1,6 +1,6 @@
 """The formation seen in space: `fig_trajectories_3d` (paths, the cables and the payload at the
-start and the end) and `fig_top_view` (x-y paths, five snapshots, the gust regions), with the world's obstacles
-(`obstacles`). Cables end
+start and the end) and `fig_top_view` (x-y paths, five snapshots, the gust regions), with the
+world's obstacles (`obstacles`). Cables end
 at their attach points, a released cable is drawn only while it holds the payload, and a rigid
 payload is drawn as its body (`scene`). World frame, z up [m].
 """

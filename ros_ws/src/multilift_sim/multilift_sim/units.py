@@ -94,7 +94,7 @@ SCENARIO_UNITS: dict[str, str] = {
     'world.obstacles[].type': NO_UNIT, 'world.obstacles[].name': NO_UNIT,
     'world.obstacles[].center': 'm', 'world.obstacles[].size': 'm',
     'world.obstacles[].radius': 'm', 'world.obstacles[].height': 'm',
-    'world.obstacles[].yaw_deg': 'deg',
+    'world.obstacles[].yaw': 'rad',
     'gusts[].center': 'm', 'gusts[].direction': NO_UNIT, 'gusts[].gradient_distance': 'm',
     'gusts[].reference_speed': 'm/s',
     'wind.velocity': 'm/s',  # a wind model's keys: its UNITS (multilift_sim.wind)

@@ -10,7 +10,7 @@ generated from `multilift_sim.obstacles.OBSTACLE_TYPES`) and the ground (a plane
 
 Distances: point to obstacle is the type's; a segment to an obstacle is the least of the
 type's distance along it, which is convex for a convex obstacle (a signed distance of a convex
-set is convex; along a line it stays so), found by golden-section search to 1e-13 of the
+set is convex; along a line it stays so), found by golden-section search to 1e-10 of the
 segment; point to segment and segment to segment in closed form (the clamped projections of
 Ericson, Real-Time Collision Detection, 2005, §5.1.2 and §5.1.9). A sphere's clearance is its
 centre's distance less its radius. Units: SI, world frame z up. Slots: physics.layout
@@ -40,7 +40,7 @@ OBSTACLES = part_dispatch.declare(
 obstacle_distance = OBSTACLES.compiled()  # rebound when the registry changes (OBSTACLES.refresh)
 
 INVERSE_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-GOLDEN_STEPS = 64           # the search's interval shrinks to 0.618^64 = 4e-14 of the segment
+GOLDEN_STEPS = 48           # the search's interval shrinks to 0.618^48 = 1e-10 of the segment
 
 
 @jit

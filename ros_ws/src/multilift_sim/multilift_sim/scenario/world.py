@@ -1,6 +1,6 @@
 """The scenario's `world:` section (issue 34 item 5), validated once: `obstacles` (each of a
 registered type, multilift_sim.obstacles.OBSTACLE_TYPES: `type`, its size keys, `center`,
-optional `name` and `yaw_deg`), `ground` (a height [m] or null) and `on_contact` (stop or
+optional `name` and `yaw` [rad]), `ground` (a height [m] or null) and `on_contact` (stop or
 record); then `check_start`: no body of the formation starts touching the world or another
 (the clearances of the start, `physics.clearance.measure`). World frame (z up), SI units."""
 from __future__ import annotations
@@ -34,7 +34,7 @@ def read_world(top: Section) -> WorldConfig | None:
         half, bound = OBSTACLE_TYPES[kind].parse(o)
         obstacles.append(ObstacleConfig(
             name=name, type=kind, center=o.vector('center'), half=tuple(float(h) for h in half),
-            yaw=math.radians(o.number('yaw_deg', 0.0)), bound=float(bound)))
+            yaw=o.number('yaw', 0.0), bound=float(bound)))
         o.done()
     w.done()
     return WorldConfig(obstacles=tuple(obstacles), ground=ground, on_contact=on_contact)

@@ -11,7 +11,8 @@ generated from `multilift_sim.obstacles.OBSTACLE_TYPES`) and the ground (a plane
 Distances: point to obstacle is the type's; a segment to an obstacle is the least of the
 type's distance along it, which is convex for a convex obstacle (a signed distance of a convex
 set is convex; along a line it stays so), found by golden-section search to 1e-10 of the
-segment; point to segment and segment to segment in closed form (the clamped projections of
+segment (skipped where a lower bound shows it cannot matter); point to segment and segment to
+segment in closed form (the clamped projections of
 Ericson, Real-Time Collision Detection, 2005, §5.1.2 and §5.1.9). A sphere's clearance is its
 centre's distance less its radius. Units: SI, world frame z up. Slots: physics.layout
 OBSTACLE_*, WORLD_*, CLEARANCE_*.
@@ -189,9 +190,15 @@ def measure(world, obstacles, radii, uavs, state, t, clearance, contact):
                        state[uav_slot(i) + POSITION + 2])
             touched |= note(clearance, contact, CLEARANCE_UAV_WORLD,
                             point_distance(row, x, y, z, scratch) - radii[i], t, i, k)
-            # a cable whose segment stays farther from the centre than the bound and the
-            # least of its kind cannot lower it: not searched
-            floor = point_segment(cx, cy, cz, ends[i, 0], ends[i, 1]) - bound
+            # a lower bound of the cable's distance (the segment's from the centre less the
+            # bounding radius; the distance at its middle less half its length, a signed
+            # distance changing at most as fast as the point moves): not searched when the
+            # bound cannot lower the least of its kind nor touch
+            a, b = ends[i, 0], ends[i, 1]
+            half = 0.5 * math.sqrt((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2 + (b[2] - a[2]) ** 2)
+            floor = max(point_segment(cx, cy, cz, a, b) - bound,
+                        point_distance(row, 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]),
+                                       0.5 * (a[2] + b[2]), scratch) - half)
             if floor <= 0.0 or floor < clearance[CLEARANCE_CABLE_WORLD, CLEARANCE_VALUE]:
                 touched |= note(clearance, contact, CLEARANCE_CABLE_WORLD,
                                 segment_distance(row, ends[i, 0], ends[i, 1], scratch), t, i, k)

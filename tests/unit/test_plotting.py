@@ -276,8 +276,8 @@ def _printed_paths(out: str) -> list[Path]:
 
 
 ALL_FIGURES = {'trajectories_3d', 'top_view', 'cable_constraints', 'cable_tensions',
-               'formation_errors', 'attitude', 'thrust', 'rotor_speeds', 'payload_position',
-               'leader_tracking'}
+               'formation_errors', 'attitude', 'thrust', 'rotor_speeds', 'thrust_margins',
+               'payload_position', 'leader_tracking'}
 
 
 def test_plot_writes_every_figure(bags, capsys):

@@ -235,3 +235,29 @@ def test_bad_worlds_are_one_line(world, message):
 
 def test_the_obstacle_registry_ships_three_types():
     assert list(OBSTACLE_TYPES) == ['box', 'cylinder', 'sphere']
+
+
+def test_a_rigid_payloads_cables_are_measured_against_each_other():
+    # two cables to a rigid body's ends, crossing in x-z at their middles in the planes
+    # y = +-0.05: 0.1 m apart; from (-0.5, 0.05, 1) to the attach point (0.5, 0.05, 0) and
+    # from (0.5, -0.05, 1) to (-0.5, -0.05, 0), the body level at the origin
+    n = 2
+    state = np.zeros(layout.attitude_slot(n) + layout.PAYLOAD_ATTITUDE)
+    state[layout.uav_slot(0):layout.uav_slot(0) + 3] = (-0.5, 0.05, 1.0)
+    state[layout.uav_slot(1):layout.uav_slot(1) + 3] = (0.5, -0.05, 1.0)
+    for i in range(n):
+        state[layout.uav_attitude_slot(n, i)] = 1.0
+    state[layout.attitude_slot(n) + layout.PAYLOAD_QUATERNION] = 1.0
+    constants = np.zeros((n, layout.UAV_COLUMNS))
+    constants[0, layout.UAV_PAYLOAD_ATTACH:layout.UAV_PAYLOAD_ATTACH + 3] = (0.5, 0.05, 0.0)
+    constants[1, layout.UAV_PAYLOAD_ATTACH:layout.UAV_PAYLOAD_ATTACH + 3] = (-0.5, -0.05, 0.0)
+    least = np.zeros((layout.CLEARANCE_KINDS, layout.CLEARANCE_COLUMNS))
+    least[:, layout.CLEARANCE_VALUE] = math.inf
+    contact = np.full(layout.CLEARANCE_COLUMNS, -1.0)
+    world = np.array([1.0, math.nan, 0.0, 0.0])  # checked, no ground
+    assert not clearance.measure(world, np.zeros((0, layout.OBSTACLE_COLUMNS)), np.zeros(n),
+                                 constants, state, 0.0, least, contact)
+    row = least[layout.CLEARANCE_CABLE_CABLE]
+    assert row[layout.CLEARANCE_VALUE] == pytest.approx(0.1, abs=1e-12)
+    assert (row[layout.CLEARANCE_FIRST], row[layout.CLEARANCE_SECOND]) == (0.0, 1.0)
+    assert math.isinf(least[layout.CLEARANCE_UAV_WORLD, layout.CLEARANCE_VALUE])  # no world

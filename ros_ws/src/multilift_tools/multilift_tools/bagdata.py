@@ -139,6 +139,10 @@ class Run:
         """(n, T, 3) UAV positions, world [m], on the time base `t`."""
         return self._uav_field('position')
 
+    def uav_orientations(self) -> np.ndarray:
+        """(n, T, 4) the UAVs' odometry quaternions (x, y, z, w), body FLU -> world."""
+        return self._uav_field('orientation')
+
     def uav_euler(self) -> np.ndarray:
         """(n, T, 3) ZYX Euler angles (roll, pitch, yaw) [rad] from the odometry quaternions."""
         return euler_from_quaternion(self._uav_field('orientation'))

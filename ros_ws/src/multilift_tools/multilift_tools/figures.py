@@ -27,6 +27,7 @@ from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, WORLD, Context,
                                         mark_events, parse_and_load, plot_context, plt,
                                         save_figure, shade_flags, uav_color, uav_label,
                                         uav_width)
+from multilift_tools.plots.obstacles import fig_clearance, lacks_world
 from multilift_tools.plots.ropes import (fig_cable_lengths, fig_rope_stretch, lacks_ropes,
                                          lacks_winches)
 from multilift_tools.plots.rotors import fig_rotor_speeds, fig_thrust, fig_thrust_margins
@@ -236,6 +237,7 @@ FIGURES: tuple[FigureSpec, ...] = (
     FigureSpec('cable_tensions', fig_tensions, _topics(FORMATION_STATE)),
     FigureSpec('rope_stretch', fig_rope_stretch, lacks_ropes),
     FigureSpec('cable_lengths', fig_cable_lengths, lacks_winches),
+    FigureSpec('clearance', fig_clearance, lacks_world),
     FigureSpec('formation_errors', fig_formation_errors, _lacks_followers),
     FigureSpec('attitude', fig_attitude, _topics()),
     FigureSpec('thrust', fig_thrust, _topics(uav_topic(1, ATTITUDE_SETPOINT))),

@@ -32,9 +32,10 @@ def test_registered_on_import_and_gymnasium_s_checker_passes(env_id):
     env = gymnasium.make(env_id, duration=0.1)
     check_env(env.unwrapped, skip_render_check=True)
     observation, info = env.reset(seed=0)
-    assert observation.shape == (len(observation_names(2)),) == (38,)
+    n = env.unwrapped.batch.n          # twin_lift's two UAVs; Navigate-v0's forest, three
+    assert observation.shape == (len(observation_names(n)),) == (38 if n == 2 else 54,)
     assert observation.dtype == np.float32
-    assert env.action_space.shape == (8,) and info['t'] == 0.0
+    assert env.action_space.shape == (4 * n,) and info['t'] == 0.0
 
 
 def _episode(env, seed: int, steps: int) -> list[np.ndarray]:

@@ -12,6 +12,11 @@ reward are built on that target (`multilift_learning.batch`).
 - `mission`: follow the scenario's mission (seed §4.2): the payload's target is the leader's
   mission reference (`multilift_control.laws.reference.mission_reference`) less the leader's
   start offset from the payload's rest place; its velocity the reference's.
+- `navigate` (issue 34 item 7): bring the payload to a goal past the world's obstacles
+  (`world:`, docs/obstacles.md): the target is where the mission leaves the payload, its
+  reference at the end less the leader's offset, held from the start (the scenario's own
+  leader flies the mission's waypoints around the obstacles: the baseline); a contact stops
+  the formation (Algorithm 1's stop, `physics.clearance`), which ends the episode.
 """
 from __future__ import annotations
 
@@ -42,6 +47,8 @@ class Task:
 TASKS = {
     'hover': Task('hover', 'hold the payload still at a point drawn near its start', False),
     'mission': Task('mission', "follow the scenario's mission with the payload", True),
+    'navigate': Task('navigate', "bring the payload to the mission's end past the world's "
+                     'obstacles; a contact ends the episode', True),
 }
 
 
@@ -134,11 +141,17 @@ class Targets:
         if self.target_radius < 0:
             raise ValueError(f'target_radius must be >= 0 [m], got {target_radius}')
         self.hold = start_payload.copy()            # hover's targets (B, 3)
+        if self.task.name == 'navigate':            # the mission's end, held from the start
+            end = self.arrays.tick_count * self.arrays.period_ns * 1e-9
+            self.hold = (self.references(end)[:, REFERENCE_POSITION:REFERENCE_POSITION + 3]
+                         - self.leader_offset)
 
     def reset(self, which: np.ndarray, rngs: list[np.random.Generator]) -> None:
         """New targets for the formations in `which` (B,) bool, each from its own generator;
         for hover the leader's mission (its positions: start, end, each segment's origin or
         each polynomial piece's constant term) moves with the target."""
+        if self.task.name != 'hover':   # the mission's targets move with it, navigate's stay
+            return
         a = self.arrays
         for b in np.flatnonzero(which):
             offset = np.zeros(3)
@@ -159,7 +172,7 @@ class Targets:
 
     def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(position, velocity) of each formation's target at its time t (B,) [s]."""
-        if self.task.name == 'hover':
+        if self.task.name in ('hover', 'navigate'):
             return self.hold, np.zeros_like(self.hold)
         reference = self.references(t)
         return (reference[:, REFERENCE_POSITION:REFERENCE_POSITION + 3] - self.leader_offset,

@@ -194,3 +194,12 @@ def test_an_elastic_rope_s_stepping_is_checked_at_the_winch_s_shortest_length():
     data['uavs'][0]['winch'] = dict(WINCH, min_length=0.5)        # 5x stiffer: omega h 0.56
     with pytest.raises(scenario_io.ScenarioError, match='set simulation.substeps >= '):
         scenario_io.loads(yaml.safe_dump(data))
+
+
+def test_the_foxglove_layout_plots_each_winch_s_length_only_where_there_are_winches():
+    from multilift_tools.foxglove.layout import layout
+    plot = layout(scenario_io.load('winch_lower'))['configById']['Plot!winches']
+    assert [p['value'] for p in plot['paths']] == ['/uav1/cable_length.data',
+                                                   '/uav2/cable_length.data']
+    assert {p['timestampMethod'] for p in plot['paths']} == {'receiveTime'}   # no header
+    assert 'Plot!winches' not in layout(scenario_io.load('twin_lift'))['configById']

@@ -4,7 +4,8 @@ The layout has the 3D panel (the markers of /visualization/markers and the tf fr
 following `world`) beside plots, every series against its message's header stamp: every
 cable's tension, every UAV's rotor speeds (as many as its frame type has), the leader's position
 against its mission reference, every UAV's attitude set-point, and every follower's formation
-(virtual-constraint) errors. A scenario with `events:` has, under the 3D panel, the messages
+(virtual-constraint) errors, and where UAVs carry winches each one's cable length. A scenario
+with `events:` has, under the 3D panel, the messages
 of /formation/events as they happen (docs/events.md).
 """
 from __future__ import annotations
@@ -18,8 +19,10 @@ COLORS = ['#4e98e2', '#f5774d', '#61cbff', '#b87fd6', '#71c26a', '#f7df71', '#e9
           '#9b9b9b']
 
 
-def _series(value: str, label: str, k: int) -> dict:
-    return {'value': value, 'enabled': True, 'timestampMethod': 'headerStamp',
+def _series(value: str, label: str, k: int, stamp: str = 'headerStamp') -> dict:
+    """A plot's series; `stamp` 'receiveTime' for a message without a header (the bridge's
+    time follows /clock: simulated)."""
+    return {'value': value, 'enabled': True, 'timestampMethod': stamp,
             'label': label, 'color': COLORS[k % len(COLORS)]}
 
 
@@ -92,6 +95,10 @@ def layout(scenario) -> dict:
             for j, (i, k) in enumerate((i, k) for i, rows in
                                        zip(range(2, n + 1), formation_rows(scenario))
                                        for k in range(rows))])
+    if scenario.winches:  # each winch's cable length (std_msgs/Float64, no header)
+        plots['Plot!winches'] = _plot('Cable length [m] (/uav{i}/cable_length)', [
+            _series(f'/uav{i}/cable_length.data', f'cable {i}', i - 1, 'receiveTime')
+            for i in scenario.winches])
     frames = ['world', 'payload'] + [f'uav{i}/base_link' for i in range(1, n + 1)]
     config = {'3D!multilift': _three_d(frames), **plots}
     scene: str | dict = '3D!multilift'

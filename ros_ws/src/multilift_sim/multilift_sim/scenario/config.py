@@ -196,6 +196,14 @@ class SensorConfig:
 
 
 @dataclass(frozen=True)
+class EstimatorConfig:
+    """The estimator of every UAV (`estimator:`, docs/estimation.md): a part of
+    multilift_sim.estimators.ESTIMATORS with its keys."""
+    model: str                       # its name in ESTIMATORS (`estimator.model`)
+    settings: Any                    # its own keys, as its `parse` read them
+
+
+@dataclass(frozen=True)
 class Scenario:
     name: str
     description: str
@@ -215,6 +223,9 @@ class Scenario:
     # the wind models `wind:` names: (name, its config) (multilift_sim.wind.WIND_MODELS)
     wind_models: tuple[tuple[str, Any], ...] = ()
     sensors: SensorConfig | None = None  # None: the controllers read the exact state
+    # the sensors of their own sections (`imu:`, `mocap:`), in the registry's order
+    sensor_suite: tuple[SensorConfig, ...] = ()
+    estimator: EstimatorConfig | None = None  # None: no estimator (`estimator: none`)
     parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
 
     @property

@@ -5,11 +5,11 @@ docs/estimation.md): IMU propagation of position, velocity, attitude and the IMU
 scenario's `imu:` and `mocap:`. The filter assumes the sensors' own noise model (their keys:
 densities, random walks, noise deviations), so its consistency can be checked (NEES, NIS).
 
-Delayed samples: a motion-capture sample taken `latency` ticks before it arrives is compared
-with the filter's nominal state at the tick it was taken (kept in a ring of the last latency
-+ 1 ticks, shifted by every correction since), and the correction applied now; the cross
-terms of the propagation between (PX4 fuses on a delayed horizon instead) are not modelled.
-With no latency the update is the exact EKF's.
+Delayed samples, as PX4's EKF2 fuses them: the filter itself runs on a delayed horizon, the
+motion capture's latency (L ticks) behind now, where each sample is fused at the tick it was
+taken (exact: the IMU's samples of the last L ticks wait in a ring); the estimate of now
+(what the controllers receive, its covariance) is that filter's state propagated over those L
+IMU samples, each tick (EKF2's output predictor, here with its covariance).
 
 What the controllers receive: the estimate's position [m] and velocity [m/s] (world), the ZYX
 Euler angles of its quaternion [rad] and the gyro's last rate less its estimated bias [rad/s]
@@ -29,7 +29,7 @@ from multilift_sim.estimators.error_state import (
     NOISE_GYRO, NOISE_GYRO_WALK, NOMINAL_GYRO_BIAS, NOMINAL_POSITION, NOMINAL_QUATERNION,
     NOMINAL_SIZE, NOMINAL_VELOCITY, fuse, inject, propagate)
 from multilift_sim.kernels import jit
-from multilift_sim.physics.attitude import attitude_difference, turn
+from multilift_sim.physics.attitude import attitude_difference
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY)
 from multilift_sim.physics.measurement import quaternion_euler
@@ -56,10 +56,13 @@ LAST_TICK = 0               # the tick estimated last (-1: none)
 NIS = 1                     # the normalised innovation squared of the last update
 NIS_TICK = 2                # the tick of that update (-1: none yet)
 RATE = 3                    # the gyro's last rate less the bias estimate [rad/s], body (3)
-NOMINAL = 6                 # the nominal state (error_state.NOMINAL_SIZE)
-COVARIANCE = NOMINAL + NOMINAL_SIZE  # P, row by row (ERROR_SIZE^2)
-HISTORY = COVARIANCE + ERROR_SIZE * ERROR_SIZE  # the ring: (p, q) of the last ticks (7 each)
-POSE = 7                    # a ring entry's length: p (3), q (w, x, y, z) (4)
+NOMINAL = 6                 # now: the nominal state (error_state.NOMINAL_SIZE)
+COVARIANCE = NOMINAL + NOMINAL_SIZE  # now: P, row by row (ERROR_SIZE^2)
+DELAYED = COVARIANCE + ERROR_SIZE * ERROR_SIZE  # the delayed horizon's nominal state
+DELAYED_COVARIANCE = DELAYED + NOMINAL_SIZE     # and its P
+HISTORY = DELAYED_COVARIANCE + ERROR_SIZE * ERROR_SIZE  # the ring of IMU samples, by tick %
+#                                             (L + 1): each its tick (-1: none), f (3), w (3)
+SAMPLE = 7                  # a ring entry's length
 UPDATE_DOF = 6              # the NIS's degrees of freedom: position and attitude
 
 
@@ -101,19 +104,10 @@ def constants(settings: EkfSettings, scenario, rows: dict) -> np.ndarray:
 
 def memory(settings: EkfSettings, scenario) -> np.ndarray:
     slots = _config(scenario, mocap.NAME).settings.latency_ticks + 1
-    row = np.zeros(HISTORY + slots * POSE)
+    row = np.zeros(HISTORY + slots * SAMPLE)
     row[LAST_TICK] = row[NIS_TICK] = -1.0
+    row[HISTORY::SAMPLE] = -1.0
     return row
-
-
-@jit
-def keep_pose(x, memory, slot):
-    """The nominal state x's position and quaternion into ring entry `slot`."""
-    base = HISTORY + slot * POSE
-    for j in range(3):
-        memory[base + j] = x[NOMINAL_POSITION + j]
-    for j in range(4):
-        memory[base + 3 + j] = x[NOMINAL_QUATERNION + j]
 
 
 @jit
@@ -134,59 +128,68 @@ def start(constants, aid, x, covariance):
 
 @jit
 def update(constants, aid, x, covariance, memory, tick):
-    """The motion-capture sample that arrived at `tick` fused (against the ring's pose at the
-    tick it was taken); its NIS kept."""
-    slots = int(constants[HISTORY_SLOTS])
-    base = HISTORY + (int(aid[TAKEN]) % slots) * POSE
+    """The motion-capture sample that arrived at `tick` fused into the delayed horizon's
+    nominal state x and covariance (the tick it was taken); its NIS kept."""
     correction = np.zeros(ERROR_SIZE)
     nis = 0.0
     for j in range(3):
         nis += fuse(covariance, correction, ERROR_POSITION + j,
-                    aid[OUTPUT + mocap.OUTPUT_POSITION + j] - memory[base + j],
+                    aid[OUTPUT + mocap.OUTPUT_POSITION + j] - x[NOMINAL_POSITION + j],
                     constants[POSITION_VARIANCE])
     q = OUTPUT + mocap.OUTPUT_QUATERNION
-    seen = attitude_difference(memory, base + 3, aid[q], aid[q + 1], aid[q + 2], aid[q + 3])
+    seen = attitude_difference(x, NOMINAL_QUATERNION, aid[q], aid[q + 1], aid[q + 2],
+                               aid[q + 3])
     for j in range(3):
         nis += fuse(covariance, correction, ERROR_ATTITUDE + j, seen[j],
                     constants[ATTITUDE_VARIANCE])
     inject(x, covariance, correction)
-    for slot in range(slots):  # the ring shifted as the state was
-        entry = HISTORY + slot * POSE
-        for j in range(3):
-            memory[entry + j] += correction[ERROR_POSITION + j]
-        turn(memory, entry + 3, correction[ERROR_ATTITUDE], correction[ERROR_ATTITUDE + 1],
-             correction[ERROR_ATTITUDE + 2])
     memory[NIS] = nis
     memory[NIS_TICK] = tick
 
 
 @jit
+def propagate_sample(constants, memory, tick, x, covariance):
+    """x and covariance propagated by the ring's IMU sample of `tick`, if it holds one."""
+    entry = HISTORY + (tick % int(constants[HISTORY_SLOTS])) * SAMPLE
+    if tick >= 1 and memory[entry] == tick:
+        propagate(x, covariance, memory[entry + 1:entry + 4], memory[entry + 4:entry + 7],
+                  constants[IMU_PERIOD], constants[GRAVITY], constants[NOISE:NOISE + 4])
+
+
+@jit
 def estimate(constants, sensors, memory, tick, received):
-    """At control tick `tick`: the IMU's sample of this tick propagated, the motion capture's
-    fused, the estimate into received (MEASURED_COLUMNS,). A second call at one tick writes
-    the same."""
+    """At control tick `tick`: the IMU's sample of this tick into the ring; the delayed
+    horizon (tick - L) propagated by the sample of its tick and the motion-capture sample
+    taken then fused; now's estimate that propagated over the ring's later samples, into
+    received (MEASURED_COLUMNS,). A second call at one tick writes the same."""
     x = memory[NOMINAL:NOMINAL + NOMINAL_SIZE]
     if memory[LAST_TICK] != tick:
         memory[LAST_TICK] = tick
         unit, aid = sensors[int(constants[IMU_ROW])], sensors[int(constants[AID_ROW])]
-        covariance = memory[COVARIANCE:HISTORY].copy().reshape((ERROR_SIZE, ERROR_SIZE))
         slots = int(constants[HISTORY_SLOTS])
+        delayed = memory[DELAYED:DELAYED + NOMINAL_SIZE]
+        shape = (ERROR_SIZE, ERROR_SIZE)
+        covariance = memory[DELAYED_COVARIANCE:HISTORY].copy().reshape(shape)
         if tick == 0:
-            start(constants, aid, x, covariance)
-            for slot in range(slots):
-                keep_pose(x, memory, slot)
-        else:
-            if unit[ARRIVED] == tick:
-                propagate(x, covariance, unit[OUTPUT + imu.OUTPUT_SPECIFIC_FORCE:],
-                          unit[OUTPUT + imu.OUTPUT_RATE:], constants[IMU_PERIOD],
-                          constants[GRAVITY], constants[NOISE:NOISE + 4])
-                for j in range(3):
-                    memory[RATE + j] = (unit[OUTPUT + imu.OUTPUT_RATE + j]
-                                        - x[NOMINAL_GYRO_BIAS + j])
-            keep_pose(x, memory, tick % slots)
-            if aid[ARRIVED] == tick:
-                update(constants, aid, x, covariance, memory, tick)
-        memory[COVARIANCE:HISTORY] = covariance.reshape(ERROR_SIZE * ERROR_SIZE)
+            start(constants, aid, delayed, covariance)
+        if unit[ARRIVED] == tick and tick > 0:
+            entry = HISTORY + (tick % slots) * SAMPLE
+            memory[entry] = tick
+            for j in range(6):
+                memory[entry + 1 + j] = unit[OUTPUT + imu.OUTPUT_SPECIFIC_FORCE + j]
+        horizon = tick - slots + 1
+        propagate_sample(constants, memory, horizon, delayed, covariance)
+        if aid[ARRIVED] == tick and tick > 0 and aid[TAKEN] == horizon:
+            update(constants, aid, delayed, covariance, memory, tick)
+        memory[DELAYED_COVARIANCE:HISTORY] = covariance.reshape(ERROR_SIZE * ERROR_SIZE)
+        x[:] = delayed
+        for later in range(max(horizon + 1, 1), tick + 1):  # the output predictor
+            propagate_sample(constants, memory, later, x, covariance)
+        memory[COVARIANCE:DELAYED] = covariance.reshape(ERROR_SIZE * ERROR_SIZE)
+        if unit[ARRIVED] == tick:
+            for j in range(3):
+                memory[RATE + j] = (unit[OUTPUT + imu.OUTPUT_RATE + j]
+                                    - x[NOMINAL_GYRO_BIAS + j])
     for j in range(3):
         received[MEASURED_POSITION + j] = x[NOMINAL_POSITION + j]
         received[MEASURED_VELOCITY + j] = x[NOMINAL_VELOCITY + j]

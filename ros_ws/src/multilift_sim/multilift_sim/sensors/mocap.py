@@ -126,7 +126,7 @@ def measure(constants, draws, memory, tick, truth, received):
     q = line + OUTPUT_QUATERNION
     memory[q], memory[q + 1], memory[q + 2], memory[q + 3] = w, x, y, z
     taken = 0 if tick == 0 else tick - slots + 1
-    if taken < 0 or taken % every != 0:
+    if taken < 0 or taken % every != 0 or (taken == 0 and tick > 0):  # tick 0's: at once
         return
     sample = taken // every
     if sample >= draws.shape[0] or (draws[sample, DRAW_DELIVERED] == 0.0 and tick > 0):

@@ -129,7 +129,7 @@ def scenario_topics(scenario, controllers: bool = True, live: bool = False
     `events:`, `sensors:` and wind add (and a live run's, `live`); none of the controllers'
     when every UAV's motion is prescribed (`uavs[i].trajectory`: no controller runs)."""
     return run_topics(scenario.n_uavs, controllers and scenario.controlled,
-                      bool(scenario.events), scenario.sensors is not None, scenario.has_wind,
+                      bool(scenario.events), scenario.measures, scenario.has_wind,
                       commands=scenario.controlled, live=live)
 
 

@@ -80,7 +80,7 @@ class EngineBag:
         self._real = np.concatenate([i * rotors + np.arange(c) for i, c in enumerate(counts)])
         self._edges = np.cumsum(counts)[:-1]  # each UAV's speeds in a row of the real ones
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
-        self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
+        self._sensors = scenario.measures  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
         # /formation/wind by tick (physics.tick.period_winds), where the air moves everywhere
         self._wind = None

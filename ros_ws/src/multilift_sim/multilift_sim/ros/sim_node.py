@@ -97,7 +97,7 @@ class SimNode(Node):
         # /uav{i}/measured_odom, what the controllers receive, where it has `sensors:`
         self.measured_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, MEASURED_ODOM),
                                                     PUBLISHER_QOS)
-                              for i in range(n)] if scenario.sensors is not None else []
+                              for i in range(n)] if scenario.measures else []
         # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
@@ -163,7 +163,7 @@ class SimNode(Node):
         """Whether a node publishing `command_topic` subscribes to one of the simulator's state
         topics. The graph lists a node's subscriptions once our participant discovered them,
         which is when our writers match them."""
-        wanted = set(state_topics(self.sim.n, self.scenario.sensors is not None))
+        wanted = set(state_topics(self.sim.n, self.scenario.measures))
         for info in self.get_publishers_info_by_topic(command_topic):
             if not info.node_namespace.startswith('/'):
                 continue  # the writer is known, its node not yet (_NODE_NAMESPACE_UNKNOWN_)
@@ -179,7 +179,7 @@ class SimNode(Node):
     def _state_topics_text(self, index: int) -> str:
         """The state topics in words for UAV `index`: its own odometry first."""
         own = uav_topic(index, ODOM)
-        others = [t for t in state_topics(self.sim.n, self.scenario.sensors is not None)
+        others = [t for t in state_topics(self.sim.n, self.scenario.measures)
                   if t != own]
         return ', '.join([own] + others)
 

@@ -238,6 +238,12 @@ class Scenario:
         return tuple(i for i, u in enumerate(self.uavs) if u.trajectory is not None)
 
     @property
+    def measures(self) -> bool:
+        """Whether the controllers receive something other than the state (`sensors:` or an
+        estimator): every /uav{i}/measured_odom carries what they received."""
+        return self.sensors is not None or self.estimator is not None
+
+    @property
     def controlled(self) -> bool:
         """Whether the formation has controllers: not when every UAV's motion is prescribed
         (no controller nodes, the engine answers nothing)."""

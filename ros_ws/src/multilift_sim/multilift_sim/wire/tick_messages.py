@@ -50,7 +50,7 @@ class SimulatorMessages:
                           for i in range(1, n + 1)]
         # what the controllers receive, UAV by UAV, where the scenario has `sensors:`
         self._measured = [(uav_topic(i, MEASURED_ODOM), cdr.Odometry(uav_frame(i)))
-                          for i in range(1, n + 1)] if scenario.sensors is not None else []
+                          for i in range(1, n + 1)] if scenario.measures else []
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
         self._gust = cdr.Vector3Stamped()
         self._wind = cdr.Vector3Stamped() if scenario.has_wind else None  # /formation/wind

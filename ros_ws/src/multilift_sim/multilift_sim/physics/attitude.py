@@ -1,8 +1,9 @@
 """A rigid body's attitude in the state: its block (layout BODY_*: the unit quaternion q =
 (w, x, y, z), body -> world, and the body rates omega [rad/s]) for every UAV and a rigid
 payload alike (issue 31, item 6). The rotation of a quaternion, the kinematics q_dot =
-q (x) (0, omega) / 2, a small turn and the renormalisation after an RK4 step: the one place
-of these equations for the compiled functions (the Euler angles the controllers read are
+q (x) (0, omega) / 2, a small turn and the renormalisation after an RK4 step, the product of
+quaternions, Exp and Log of a rotation vector (the IMU's, the motion capture's and the EKF's):
+the one place of these equations for the compiled functions (the Euler angles the controllers read are
 computed from q once, `measurement.quaternion_euler`). Slots are `physics.layout`'s.
 """
 import math

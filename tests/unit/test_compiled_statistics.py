@@ -12,7 +12,7 @@ import pytest
 
 from multilift_sim import kernels
 from multilift_sim.formation_params import StateLayout
-from multilift_sim.physics.layout import UAV_COLUMNS
+from multilift_sim.physics.layout import REEL_COLUMNS
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                       TrackingStatistics, accumulators, figures, swing)
 from multilift_sim.statistics.layout import (CHECK_QUATERNION, CHECK_G, CHECK_G_DOT,
@@ -135,9 +135,10 @@ def test_the_accumulators_compiled_and_uncompiled_agree(n):
         tension = rng.normal(3.0, 2.0, n)
         tension[rng.integers(n)] = rng.choice([math.nan, 5.0])
         _same(accumulators.run_add_tensions, run, tension)
-        uavs = rng.uniform(0.5, 2.0, (n, UAV_COLUMNS))     # UAV_LENGTH_SQ among them
-        _same(accumulators.run_add_ropes, run, rng.normal(size=StateLayout(n).size), uavs,
-              tension)
+        _same(accumulators.run_add_ropes, run, rng.normal(size=StateLayout(n).size),
+              rng.uniform(0.5, 2.0, n), tension)
+        _same(accumulators.run_add_reel, run, rng.uniform(0.5, 2.0, (n, REEL_COLUMNS)),
+              rng.uniform(0.5, 2.0, n))
         _same(accumulators.run_add_slack, run, rng.random(n) < 0.5, 0.01)
         _same(accumulators.run_add_gust_speed, run, float(rng.choice([math.nan, 0.3, 2.0])))
         _same(accumulators.peak_rms_add, run, RUN_SWING, float(rng.uniform(0, 2)))

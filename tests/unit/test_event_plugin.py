@@ -28,7 +28,7 @@ SCENARIOS = ROOT / 'scenarios'  # (not conftest's: the runs of tests/ros/test_ev
 
 # -- the toy kind: every rotor of a UAV at `factor` times its effectiveness ----------------
 @jit
-def apply_rotor_scale(row, tick, effectiveness, taut, released, silent_until):
+def apply_rotor_scale(row, tick, effectiveness, taut, released, silent_until, reel):
     uav = int(row[EVENT_UAV])
     for r in range(effectiveness.shape[1]):
         effectiveness[uav, r] *= row[EVENT_VALUE]

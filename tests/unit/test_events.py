@@ -18,6 +18,7 @@ from multilift_control.headless import run_headless
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
 from multilift_sim.physics.events import apply_events
+from multilift_sim.physics.layout import REEL_COLUMNS
 from multilift_sim.start import initial_state
 from multilift_sim.schedules import event_array
 from multilift_sim.slack import SlackCableModel
@@ -144,7 +145,8 @@ def test_a_release_does_no_work_and_the_free_uav_flies_on(model_class):
     for tick in range(150):
         next_event = kernels.runnable(apply_events)(events, next_event, tick,
                                                     model.effectiveness, model._taut,
-                                                    model.released, np.zeros(2, np.int64))
+                                                    model.released, np.zeros(2, np.int64),
+                                                    np.zeros((2, REEL_COLUMNS)))
         if next_event and released_at is None:
             released_at = model.layout.uav_velocities(x)[1].copy()
         x = model.integrate(x, idle, 0.005, 2).state

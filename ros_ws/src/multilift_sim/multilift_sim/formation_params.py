@@ -20,7 +20,8 @@ from multilift_sim.physics.layout import (
     FORMATION_DRAG, FORMATION_ELASTIC, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
     FORMATION_NULL_SPACE, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
     FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
-    FORMATION_SCALARS, FORMATION_TIME,
+    FORMATION_SCALARS, FORMATION_TIME, FORMATION_WINCH, UAV_WINCH_ACCELERATION_LIMIT,
+    UAV_REEL_LENGTH, UAV_WINCH_MAX_LENGTH, UAV_WINCH_MIN_LENGTH, UAV_WINCH_RATE_LIMIT,
     FORMATION_SUBSTEPS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_COLUMNS,
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, UAV_ATTACH,
     UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA,
@@ -56,6 +57,8 @@ class FormationParams:
     # prescribed motion (issue 34; physics.prescribed): each UAV's drives.Drive or None (None:
     # no UAV's motion is prescribed)
     drives: tuple[Any, ...] | None = None
+    # winches (issue 32; physics.winch): each UAV's cables.winch.Winch or None (None: no winch)
+    winches: tuple[Any, ...] | None = None
 
     def __post_init__(self) -> None:
         uavs = tuple(self.uavs)
@@ -297,6 +300,16 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
                                           else params.uav_attach_points)
     formation[FORMATION_PRESCRIBED] = 0.0 if params.drives is None else 1.0
     formation[FORMATION_TIME] = 0.0
+    formation[FORMATION_WINCH] = 0.0 if params.winches is None else 1.0
+    uavs[:, UAV_WINCH_RATE_LIMIT:UAV_COLUMNS] = 0.0   # no winch
+    # the reel slots a period's copy sets (physics.winch.reel_period): here each cable at its
+    # own length, at rest, so that a solve of the constants alone sees the start's lengths
+    uavs[:, UAV_REEL_LENGTH] = params.cable_lengths
+    for i, winch in enumerate(params.winches or ()):
+        if winch is not None:
+            uavs[i, [UAV_WINCH_RATE_LIMIT, UAV_WINCH_ACCELERATION_LIMIT, UAV_WINCH_MIN_LENGTH,
+                     UAV_WINCH_MAX_LENGTH]] = (winch.rate_limit, winch.acceleration_limit,
+                                               winch.min_length, winch.max_length)
     if params.drives is not None:  # the drive table after the scalars (physics.layout DRIVE_*)
         from multilift_sim.drives import drive_table
         formation = np.concatenate([formation, drive_table(params.drives)])

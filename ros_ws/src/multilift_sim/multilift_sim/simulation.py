@@ -8,7 +8,8 @@ World frame, SI units.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,7 +20,8 @@ from multilift_sim.physics import tick as physics_tick
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS, MEASURED_EULER,
                                           MEASURED_POSITION, attitude_slot, MEASURED_VELOCITY,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
-                                          ODOMETRY_QUATERNION, ODOMETRY_ROTATION)
+                                          ODOMETRY_QUATERNION, ODOMETRY_ROTATION, REEL_COMMAND,
+                                          REEL_LENGTH)
 from multilift_sim.physics.measurement import odometry_states
 from multilift_sim.physics.rigid_payload import payload_rotation
 from multilift_sim.scenario import Scenario
@@ -60,6 +62,8 @@ class Snapshot:
     # a rigid payload's (orientation (x, y, z, w), body rates [rad/s], R_p (3, 3) payload frame
     # -> world); None for a point payload
     payload_attitude: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    # every cable's length [m] (n,): reeled by a winch (physics.winch), else its own
+    cable_lengths: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def stop_message(status: int, cable: int, value: float, t: float, sim, n_uavs: int) -> str:
@@ -216,7 +220,8 @@ class FormationSimulator:
             orientation=row[ODOMETRY_QUATERNION:ODOMETRY_QUATERNION + 4]) for row in odometry)
         attitude = payload_attitude(state, n) if self.model.layout.rigid_payload else None
         return Snapshot(self.t_ns, uavs, layout.payload_position(state).copy(),
-                        layout.payload_velocity(state).copy(), odometry, measured, attitude)
+                        layout.payload_velocity(state).copy(), odometry, measured, attitude,
+                        self.memory.reel[0, :, REEL_LENGTH].copy())
 
     # ------------------------------------------------------------------------- the cables
     def cable_state(self, rotor_speeds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray,
@@ -252,6 +257,17 @@ class FormationSimulator:
         self.last_tension = self._tension[0].copy()
         self.happened = range(first, int(self.memory.next_event[0]))
         self._raise_if_stopped()
+
+    def command_winch(self, uav: int, rate: float) -> None:
+        """UAV `uav`'s (from 0) winch commanded to reel at `rate` [m/s] (positive pays out) from
+        the period of the current tick on (a live /uav{i}/winch_cmd; physics.winch keeps it
+        within the winch's limits and stops); ValueError for a UAV without a winch or a rate
+        that is not finite."""
+        if uav + 1 not in self.scenario.winches:
+            raise ValueError(f'uav{uav + 1} has no winch')
+        if not math.isfinite(rate):
+            raise ValueError(f'a reel rate must be finite, got {rate!r}')
+        self.memory.reel[0, uav, REEL_COMMAND] = rate
 
     def idle_commands(self) -> tuple[list[np.ndarray], list[np.ndarray]]:
         """(rotor speeds [rad/s], saturation flags) of 0 for every UAV: what a formation whose

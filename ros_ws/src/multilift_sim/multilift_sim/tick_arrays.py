@@ -17,7 +17,8 @@ import numpy as np
 
 from multilift_sim.cables import CABLE_MODELS
 from multilift_sim.formulations import Formulation, make_formulation
-from multilift_sim.physics.layout import (STATUS_QUATERNION, STATUS_NOT_FINITE,
+from multilift_sim.physics.layout import (REEL_COLUMNS, REEL_LENGTH, STATUS_QUATERNION,
+                                          STATUS_NOT_FINITE,
                                           STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
 from multilift_sim.scenario import Scenario
 from multilift_sim.schedules import event_array, wind_series
@@ -81,6 +82,8 @@ class PhysicsMemory(NamedTuple):
     sensor_memory: np.ndarray     # (B, K, n, M): each sensor's memory of each UAV
     estimator_memory: np.ndarray  # (B, E, n, M): the estimator's memory of each UAV
     run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
+    reel: np.ndarray              # (B, n, REEL_COLUMNS): each cable's length [m], its reel's
+    #                               rate [m/s] and command [m/s] (physics.winch)
 
 
 def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tuple[dict, dict]:
@@ -119,8 +122,17 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         silent_until=np.zeros(n, dtype=np.int64), held=np.full(rotors, math.nan),
         held_saturated=np.zeros(rotors, dtype=bool), tick=0, status=STATUS_RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n), gust=np.zeros(3),
-        sensor_memory=sensors.memory, estimator_memory=estimator.memory, run=RunStatistics(n).run)
+        sensor_memory=sensors.memory, estimator_memory=estimator.memory,
+        run=RunStatistics(n).run, reel=reel_memory(scenario))
     return arrays, memory
+
+
+def reel_memory(scenario: Scenario) -> np.ndarray:
+    """Each cable's reel at the start (n, REEL_COLUMNS): its length [m], at rest, commanded
+    to rest (every cable's, with a winch or not: the tension's l_i)."""
+    reel = np.zeros((scenario.n_uavs, REEL_COLUMNS))
+    reel[:, REEL_LENGTH] = [u.cable_length for u in scenario.uavs]
+    return reel
 
 
 def stacked(name: str, values: Sequence) -> np.ndarray:

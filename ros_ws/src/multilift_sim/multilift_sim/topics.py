@@ -7,6 +7,7 @@ tools all name topics from here. UAV indices count from 1 (1 = the leader). Type
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 
 # message types
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
@@ -23,6 +24,7 @@ FORMATION_EVENT_TYPE = 'multilift_msgs/msg/FormationEvent'
 TF_TYPE = 'tf2_msgs/msg/TFMessage'
 POSE_STAMPED_TYPE = 'geometry_msgs/msg/PoseStamped'
 PATH_TYPE = 'nav_msgs/msg/Path'
+FLOAT64_TYPE = 'std_msgs/msg/Float64'
 
 # topics of the whole run
 CLOCK = '/clock'                        # simulated time, the simulator only
@@ -45,10 +47,13 @@ ROTOR_CMD = 'rotor_cmd'                 # UAV i's rotor speeds (every UAV)
 ATTITUDE_SETPOINT = 'attitude_setpoint'  # UAV i's outer-loop output (every UAV)
 REFERENCE = 'reference'                 # the mission reference (the leader only)
 FORMATION_ERROR = 'formation_error'     # follower i's rows of g_vc (followers only)
+CABLE_LENGTH = 'cable_length'           # UAV i's cable length [m] (a UAV with a winch)
+WINCH_CMD = 'winch_cmd'                 # a live reel rate for UAV i's winch [m/s] (run --live)
 
 UAV_TYPES = {ODOM: ODOMETRY_TYPE, MEASURED_ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
              ATTITUDE_SETPOINT: ATTITUDE_SETPOINT_TYPE, REFERENCE: TRACKING_REFERENCE_TYPE,
-             FORMATION_ERROR: FORMATION_ERROR_TYPE}
+             FORMATION_ERROR: FORMATION_ERROR_TYPE, CABLE_LENGTH: FLOAT64_TYPE,
+             WINCH_CMD: FLOAT64_TYPE}
 RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
              PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
@@ -99,7 +104,7 @@ def topic_type(topic: str) -> str | None:
 
 def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
                sensors: bool = False, wind: bool = False, commands: bool = True,
-               live: bool = False
+               live: bool = False, winches: Sequence[int] = ()
                ) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
@@ -107,7 +112,8 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
     `events:`), /formation/events; with `sensors` (a scenario with `sensors:`), every
     /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind; without
     `commands` (every UAV prescribed) not even the rotor commands; with `live` (`run --live`),
-    /formation/goal and /formation/path."""
+    /formation/goal and /formation/path; for each UAV of `winches` (from 1: those with a
+    winch) /uav{i}/cable_length, and with `live` /uav{i}/winch_cmd."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
         list(WIND_TYPES.items()) if wind else []) + (list(LIVE_TYPES.items()) if live else [])
     if controllers:
@@ -120,17 +126,20 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
             topics.append((uav_topic(i, MEASURED_ODOM), ODOMETRY_TYPE))
         if i > 1 and controllers:
             topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
+        if i in winches:
+            topics += [(uav_topic(i, leaf), FLOAT64_TYPE)
+                       for leaf in ((CABLE_LENGTH, WINCH_CMD) if live else (CABLE_LENGTH,))]
     return topics
 
 
 def scenario_topics(scenario, controllers: bool = True, live: bool = False
                     ) -> list[tuple[str, str]]:
     """`run_topics` of a scenario (multilift_sim.scenario.Scenario): its n, and the topics its
-    `events:`, `sensors:` and wind add (and a live run's, `live`); none of the controllers'
+    `events:`, `sensors:`, wind and winches add (and a live run's, `live`); none of the controllers'
     when every UAV's motion is prescribed (`uavs[i].trajectory`: no controller runs)."""
     return run_topics(scenario.n_uavs, controllers and scenario.controlled,
                       bool(scenario.events), scenario.measures, scenario.has_wind,
-                      commands=scenario.controlled, live=live)
+                      commands=scenario.controlled, live=live, winches=scenario.winches)
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

@@ -60,6 +60,10 @@ VEHICLE_UNITS: dict[str, str] = {
 ROPE_UNITS = {'stiffness': 'N/m', 'axial_stiffness': 'N', 'damping': 'N s/m'}
 # an elastic run's figures per cable (the summary's, not a sweep column)
 ROPE_FIGURE_UNITS = {'max_stretch': 'm', 'peak_tension': 'N'}
+# a winch's keys (`uavs[i].winch`, multilift_sim.cables.winch) and a winched run's figures
+WINCH_UNITS = {'rate_limit': 'm/s', 'acceleration_limit': 'm/s^2', 'min_length': 'm',
+               'max_length': 'm'}
+REEL_FIGURE_UNITS = {'shortest_cable': 'm', 'longest_cable': 'm'}
 
 GAINS = {'position_gains.kp': '1/s^2', 'position_gains.kd': '1/s', 'position_gains.ki': '1/s^3',
          'attitude_gains.kp': '1/s^2', 'attitude_gains.kd': '1/s'}
@@ -80,6 +84,7 @@ SCENARIO_UNITS: dict[str, str] = {
     **{f'uavs[].{k}': u for k, u in VEHICLE_UNITS.items()},
     'uavs[].cable_length': 'm', 'uavs[].position': 'm', 'uavs[].yaw': 'rad',
     'uavs[].attach_point': 'm', 'uavs[].trajectory': NO_UNIT,
+    **{f'uavs[].winch.{k}': u for k, u in WINCH_UNITS.items()},
     'payload.type': NO_UNIT, 'payload.mass': 'kg', 'payload.drag_coefficient': 'kg/m',
     'payload.alpha_deg': 'deg', 'payload.beta_deg': 'deg', 'payload.swing_deg': 'deg',
     'payload.shape': NO_UNIT, 'payload.size': 'm', 'payload.inertia': 'kg m^2',
@@ -110,11 +115,11 @@ SCENARIO_UNITS: dict[str, str] = {
     'mission.waypoints[].position': 'm', 'mission.waypoints[].yaw': 'rad',
     'events[].time': 's', 'events[].type': NO_UNIT, 'events[].uav': NO_UNIT,
     'events[].rotor': NO_UNIT, 'events[].effectiveness': NO_UNIT, 'events[].duration': 's',
-    'events[].velocity': 'm/s',
+    'events[].velocity': 'm/s', 'events[].rate': 'm/s',
 }
 
 UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS,
-                         **ROPE_FIGURE_UNITS}
+                         **ROPE_FIGURE_UNITS, **REEL_FIGURE_UNITS}
 
 _INDEX = re.compile(r'\[\d+\]')
 _WIND_KEY = re.compile(r'^wind\.(\w+)\.(\w+)(?:\[\])?$')  # wind.<model>.<key>

@@ -45,6 +45,8 @@ DELEGATED = {
               '(statics of Eq. 2.73)'),
     'goal': ('multilift_tools.goal_command', 'goal_main',
              'send the formation a live goal: X Y Z [--yaw DEG] (run --live)'),
+    'winch': ('multilift_tools.winch_command', 'winch_main',
+              "command a UAV's winch to a reel rate: UAV RATE [m/s] (run --live)"),
     'study': ('multilift_tools.studies', 'study_main', 'studies: baumgarte (seed Fig. 4.2-4.3)'),
     'bag': ('multilift_tools.bags.command', 'bag_main',
             'bag info DIR | play DIR | reindex DIR, like `ros2 bag`'),
@@ -93,7 +95,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument('--live', action='store_true',
                      help='the leader holds its start until a goal (/formation/goal, '
                           '`multilift goal`) or a path (/formation/path) arrives '
-                          '(docs/missions.md)')
+                          '(docs/missions.md); winches reel at live rates '
+                          '(/uav{i}/winch_cmd, `multilift winch`, docs/cables.md)')
     run.set_defaults(func=cmd_run)
     node = sub.add_parser('node', help='run one node, like `ros2 run`')
     node.add_argument('package')

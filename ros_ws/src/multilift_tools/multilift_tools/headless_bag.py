@@ -28,10 +28,11 @@ from multilift_control.runtime import ControllerAnswer
 from multilift_sim.bag import BagWriter
 from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
 from multilift_sim.formation_params import StateLayout
-from multilift_sim.formulations import make_formulation
 from multilift_sim import kernels
+from multilift_sim.physics import tick as physics_tick
 from multilift_sim.physics.tick import period_winds
-from multilift_sim.physics.layout import EVENT_TICK
+from multilift_sim.physics.layout import EVENT_TICK, REEL_LENGTH
+from multilift_sim.tick_arrays import PhysicsArrays, PhysicsMemory
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot, TickCables,
                                       payload_attitude)
@@ -78,7 +79,6 @@ class EngineBag:
         rotors = arrays.allocation.shape[-1]
         self._counts = None if min(counts) == rotors else counts
         self._real = np.concatenate([i * rotors + np.arange(c) for i, c in enumerate(counts)])
-        self._edges = np.cumsum(counts)[:-1]  # each UAV's speeds in a row of the real ones
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.measures  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
@@ -139,6 +139,7 @@ class EngineBag:
         rates = [record.rates[:count, 0, i, :rows[i]].tolist() for i in range(n)]
         tension, g = record.tension[:count, 0].tolist(), record.g[:count, 0].tolist()
         g_dot, taut = record.g_dot[:count, 0].tolist(), record.taut[:count, 0].tolist()
+        lengths = record.cable_length[:count, 0].tolist()
         simulator, answer_of, write = self._simulator, self._answers.answer_of, self._write
         command_of = self._answers.command_of
         for k in range(count):
@@ -147,7 +148,7 @@ class EngineBag:
             messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
                                           odometry[k], payload_position[k],
                                           payload_velocity[k], gusts[k], measured[k],
-                                          winds[k], poses[k])
+                                          winds[k], poses[k], lengths[k])
             messages += self._events_at(tick, t_ns)
             for i in range(n if self._commands else 0):
                 if not self._controllers:
@@ -179,17 +180,15 @@ class EngineBag:
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
                                              velocity, memory.gust[0].tolist(), measured,
                                              None if self._wind is None
-                                             else self._wind[tick].tolist(), pose)
+                                             else self._wind[tick].tolist(), pose,
+                                             memory.reel[0, :, REEL_LENGTH].tolist())
                     + self._events_at(tick, t_ns), t_ns)
-        scenario = self._scenario
-        model = make_formulation(scenario.simulation.integrator, scenario.formation_params(),
-                                 scenario.cable_model)
-        model.taut[:] = memory.taut[0]  # released cables (events), slack ones
-        model.effectiveness[:] = memory.effectiveness[0]
-        if len(engine.arrays.wind_series[0]):  # the last tick's wind, as FormationSimulator's
-            model.set_wind(self._wind[tick])
-        held = (np.split(self._held, self._edges) if self._held is not None else None)
-        tension = np.asarray(model.cable_tension(t_ns * 1e-9, state.copy(), held))
+        # the tension under the commands held since the tick before, as the simulator node's
+        # last tick solves it (physics.tick.tension_at, on the physics' arrays of the engine's)
+        tension = np.empty(n)
+        kernels.runnable(physics_tick.tension_at)(
+            PhysicsArrays(*engine.arrays[:len(PhysicsArrays._fields)]),
+            PhysicsMemory(*memory[:len(PhysicsMemory._fields)]), 0, memory.held[0], tension)
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
                         layout.uav_euler(state).tolist(), payload_position,

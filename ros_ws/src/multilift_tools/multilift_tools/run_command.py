@@ -99,6 +99,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f'error: {exc}', file=sys.stderr)
         return 2
     sim_params = dict(common, realtime=args.realtime, progress_file=str(work / 'progress'))
+    if args.live:  # the simulator reads live reel rates (/uav{i}/winch_cmd)
+        sim_params['live'] = True
     if external:
         sim_params['external'] = ','.join(f'uav{i}' for i in external)
     if args.startup_timeout is not None:

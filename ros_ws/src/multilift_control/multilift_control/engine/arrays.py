@@ -108,6 +108,7 @@ class TickRecord(NamedTuple):
     g_dot: np.ndarray             # (ticks, B, n) [m^2/s]
     taut: np.ndarray              # (ticks, B, n) bool, at the tick's start
     gust: np.ndarray              # (ticks, B, 3): the air velocity at the payload [m/s], world
+    cable_length: np.ndarray      # (ticks, B, n) [m]: each cable's, reeled by a winch or not
 
 
 def _padded(rows: np.ndarray, rotors: int) -> np.ndarray:
@@ -238,4 +239,4 @@ def empty_record(arrays: FormationArrays, ticks: int) -> TickRecord:
         rates=np.full((ticks, batch, n, rows), math.nan),
         tension=np.empty((ticks, batch, n)), g=np.empty((ticks, batch, n)),
         g_dot=np.empty((ticks, batch, n)), taut=np.empty((ticks, batch, n), dtype=bool),
-        gust=np.empty((ticks, batch, 3)))
+        gust=np.empty((ticks, batch, 3)), cable_length=np.empty((ticks, batch, n)))

@@ -21,6 +21,7 @@ from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UA
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
 from multilift_sim.physics import tick as physics
+from multilift_sim.physics.layout import REEL_LENGTH
 from multilift_sim.physics.measurement import payload_position, payload_velocity
 from multilift_sim.statistics.accumulators import formation_error_add, tracking_add
 from multilift_sim.tick_arrays import PhysicsArrays, PhysicsMemory
@@ -237,6 +238,8 @@ def run_ticks(a, m, ticks, record):
                 record.g_dot[k, b, :] = m.g_dot[b]
                 record.taut[k, b, :] = m.taut[b]
                 record.gust[k, b, :] = m.gust[b]
+                for i in range(n):
+                    record.cable_length[k, b, i] = m.reel[b, i, REEL_LENGTH]
             formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference,
                            errors, rates, tension)
             if recording:

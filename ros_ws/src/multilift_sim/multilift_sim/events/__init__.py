@@ -11,9 +11,10 @@ A kind's module declares:
   `earlier`: the events read before it;
 - `pack(event, row, rate)`: its slots of the event's row (physics.layout EVENT_*) beyond the
   common ones (tick, time, kind, uav, rotor), `rate` the control rate [Hz];
-- `apply(row, tick, effectiveness, taut, released, silent_until)`: compiled (`kernels.jit`),
-  what it changes in the physics' memory at its tick (one formation's arrays: the rotors'
-  effectiveness (n, rotors), taut (n,) bool, released (n,) bool, silent_until (n,) int);
+- `apply(row, tick, effectiveness, taut, released, silent_until, reel)`: compiled
+  (`kernels.jit`), what it changes in the physics' memory at its tick (one formation's
+  arrays: the rotors' effectiveness (n, rotors), taut (n,) bool, released (n,) bool,
+  silent_until (n,) int, reel (n, REEL_COLUMNS): each winch's length, rate and command);
 - `describe(row) -> (uav, rotor, value, sentence)`: what /formation/events and the summary say;
 - optionally `unsteady_wind(event, starts, period) -> (K, 3)`: air it blows [m/s], world, over
   each control period (`schedules.wind_series`), and `RELEASES_CABLE = True` when it lets a
@@ -26,7 +27,8 @@ from __future__ import annotations
 
 from types import ModuleType
 
-from multilift_sim.events import cable_release, controller_silence, gust, rotor_effectiveness
+from multilift_sim.events import (cable_release, controller_silence, gust, rotor_effectiveness,
+                                  winch_rate)
 from multilift_sim.registry import Registry
 
 
@@ -36,7 +38,7 @@ def _changed() -> None:
 
 
 EVENT_KINDS = Registry('event kind', ('NAME', 'KEYS', 'parse', 'pack', 'apply', 'describe'),
-                       (rotor_effectiveness, cable_release, controller_silence, gust),
+                       (rotor_effectiveness, cable_release, controller_silence, gust, winch_rate),
                        changed=_changed)
 register, unregister, registered = (EVENT_KINDS.register, EVENT_KINDS.unregister,
                                     EVENT_KINDS.registered)

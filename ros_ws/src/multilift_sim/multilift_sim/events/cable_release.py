@@ -30,7 +30,7 @@ def pack(event, row, rate):
 
 
 @jit
-def apply(row, tick, effectiveness, taut, released, silent_until):
+def apply(row, tick, effectiveness, taut, released, silent_until, reel):
     """The cable released ((n,) bool) and no longer taut: it no longer constrains."""
     uav = int(row[EVENT_UAV])
     released[uav] = True

@@ -24,7 +24,7 @@ def pack(event, row, rate):
 
 
 @jit
-def apply(row, tick, effectiveness, taut, released, silent_until):
+def apply(row, tick, effectiveness, taut, released, silent_until, reel):
     """silent_until (n,) int: the first tick whose command arrives again, the later one."""
     uav = int(row[EVENT_UAV])
     silent_until[uav] = max(silent_until[uav], int(row[EVENT_END_TICK]))

@@ -31,7 +31,7 @@ def pack(event, row, rate):
 
 
 @jit
-def apply(row, tick, effectiveness, taut, released, silent_until):
+def apply(row, tick, effectiveness, taut, released, silent_until, reel):
     """Nothing at its tick (the wind series carries it)."""
 
 

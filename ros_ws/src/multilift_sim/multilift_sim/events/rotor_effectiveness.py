@@ -23,7 +23,7 @@ def pack(event, row, rate):
 
 
 @jit
-def apply(row, tick, effectiveness, taut, released, silent_until):
+def apply(row, tick, effectiveness, taut, released, silent_until, reel):
     """The rotor's effectiveness (n, rotors) set."""
     effectiveness[int(row[EVENT_UAV]), int(row[EVENT_ROTOR])] = row[EVENT_VALUE]
 

@@ -57,6 +57,7 @@ FEATURES = {
     'slack': 'cable_model: slack needs',
     'elastic': 'cable_model: elastic needs',
     'prescribed': 'a prescribed motion needs',
+    'winch': 'a winch (uavs[i].winch) needs',
 }
 
 

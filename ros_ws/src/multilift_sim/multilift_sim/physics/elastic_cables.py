@@ -16,20 +16,23 @@ import math
 from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import payload_motion, uav_free_motion
 from multilift_sim.physics.layout import (FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
-                                          POSITION, UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS,
-                                          UAV_LENGTH_SQ, UAV_MASS)
+                                          FORMATION_TIME, FORMATION_WINCH, POSITION,
+                                          UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS, UAV_LENGTH_SQ,
+                                          UAV_MASS)
 from multilift_sim.physics.state_slots import payload_slot, rates_slot, uav_slot
+from multilift_sim.physics.winch import reel_at
 
 
 @jit
-def rope_tension(stiffness, damping, rest, dx, dy, dz, dvx, dvy, dvz):
+def rope_tension(stiffness, damping, rest, dx, dy, dz, dvx, dvy, dvz, rest_rate):
     """(T [N], L [m]) of a rope of stiffness k [N/m], damping c [N s/m] and rest length l [m]
-    whose ends are d = (dx, dy, dz) [m] apart, moving apart at dv [m/s]: k (L - l) + c L_dot
-    when L > l, floored at 0 (no push), else 0."""
+    (paid out at l_dot = rest_rate [m/s] by a winch, else 0) whose ends are d = (dx, dy, dz)
+    [m] apart, moving apart at dv [m/s]: k (L - l) + c (L_dot - l_dot) when L > l, floored at
+    0 (no push), else 0."""
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
     if length <= rest:
         return 0.0, length
-    rate = (dx * dvx + dy * dvy + dz * dvz) / length
+    rate = (dx * dvx + dy * dvy + dz * dvz) / length - rest_rate
     tension = stiffness * (length - rest) + damping * rate
     return (tension if tension > 0.0 else 0.0), length
 
@@ -53,11 +56,18 @@ def elastic_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         thrust_ax, thrust_ay, thrust_az = uav_free_motion(x, i, wrenches, uavs, formation, acc)
         dx, dy, dz = px - x[r], py - x[r + 1], pz - x[r + 2]
         rest = math.sqrt(uavs[i, UAV_LENGTH_SQ])
+        stiffness, damping = uavs[i, UAV_CABLE_STIFFNESS], uavs[i, UAV_CABLE_DAMPING]
+        reel_rate = 0.0
+        if formation[FORMATION_WINCH] != 0.0:  # a reeled rope (physics.winch): its rest length
+            # l(t), its stiffness and damping EA / l and c l_0 / l, its stretch rate L_dot - l_dot
+            reeled, reel_rate, _ = reel_at(uavs, i, formation[FORMATION_TIME])
+            stiffness, damping = stiffness * rest / reeled, damping * rest / reeled
+            rest = reeled
         tension, length = 0.0, 1.0
         if taut[i]:
-            tension, length = rope_tension(uavs[i, UAV_CABLE_STIFFNESS], uavs[i, UAV_CABLE_DAMPING],
-                                           rest, dx, dy, dz, pvx - x[nq + r],
-                                           pvy - x[nq + r + 1], pvz - x[nq + r + 2])
+            tension, length = rope_tension(stiffness, damping, rest, dx, dy, dz,
+                                           pvx - x[nq + r], pvy - x[nq + r + 1],
+                                           pvz - x[nq + r + 2], reel_rate)
         multipliers[i] = 0.5 * tension / rest
         per_length = tension / length if tension > 0.0 else 0.0   # T / L [N/m]
         pull = per_length / uavs[i, UAV_MASS]

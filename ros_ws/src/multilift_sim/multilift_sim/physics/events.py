@@ -14,22 +14,23 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import EVENT_KIND, EVENT_TICK
 
 EVENTS = part_dispatch.declare(
-    'events', 'apply_event(kind, row, tick, effectiveness, taut, released, silent_until)',
+    'events', 'apply_event(kind, row, tick, effectiveness, taut, released, silent_until, reel)',
     step='apply', caller=f'{__name__}.apply_events', parts=lambda: registry.EVENT_KINDS)
 apply_event = EVENTS.compiled()  # rebound when the registry changes (EVENTS.refresh)
 
 
 @jit
-def apply_events(events, next_event, tick, effectiveness, taut, released, silent_until):
+def apply_events(events, next_event, tick, effectiveness, taut, released, silent_until, reel):
     """Apply every event of `events` (k, EVENT_COLUMNS) from row `next_event` on whose tick is
     at or before `tick`, each by its kind's `apply` (what it may change: the rotors'
     effectiveness (n, rotors), taut (n,) bool, released (n,) bool: the cables let go of for
-    good, silent_until (n,) int: the first tick whose command arrives again). Returns the row
-    of the next event to come (k: none left)."""
+    good, silent_until (n,) int: the first tick whose command arrives again, reel (n,
+    REEL_COLUMNS): the winches' commands). Returns the row of the next event to come (k: none
+    left)."""
     k = next_event
     while k < events.shape[0] and events[k, EVENT_TICK] <= tick:
         apply_event(int(events[k, EVENT_KIND]), events[k], tick, effectiveness, taut, released,
-                    silent_until)
+                    silent_until, reel)
         k += 1
     return k
 

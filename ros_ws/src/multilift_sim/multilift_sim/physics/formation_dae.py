@@ -31,12 +31,13 @@ from multilift_sim.physics.nullspace import nullspace_solve, project, translatio
 from multilift_sim.physics.attitude import normalize_quaternion
 from multilift_sim.physics.prescribed import prescribed_solve
 from multilift_sim.physics.rigid_payload import rigid_residuals, rigid_solve
+from multilift_sim.physics.winch import reeled_cable
 from multilift_sim.physics.layout import (
     BODY_ATTITUDE, BODY_RATES, CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET,
     CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_ELASTIC, FORMATION_GRAVITY,
     FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
     FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
-    FORMATION_TIME, FORMATION_TWO_ALPHA, POSITION, UAV_LENGTH_SQ, UAV_MASS,
+    FORMATION_TIME, FORMATION_TWO_ALPHA, FORMATION_WINCH, POSITION, UAV_LENGTH_SQ, UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
                                                uav_attitude_slot, uav_slot)
@@ -131,7 +132,8 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
     gravity = formation[FORMATION_GRAVITY]
     for i in range(n):
-        length_sq = uavs[i, UAV_LENGTH_SQ]
+        # l_i^2 and a reeled length's terms of g_dot and g_ddot (physics.winch; 0 without)
+        length_sq, reel_rate, reel_acc = reeled_cable(uavs, formation, i)
         r = uav_slot(i) + POSITION
         rx, ry, rz = x[r], x[r + 1], x[r + 2]
         vx, vy, vz = x[nq + r], x[nq + r + 1], x[nq + r + 2]
@@ -154,8 +156,8 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
         cables[i, CABLE_RHS] = (
             2.0 * (dx * (drag_ax - free_x) + dy * (drag_ay - free_y)
                    + dz * (drag_az - free_z))                          # G M^-1 f
-            + 2.0 * (dvx * dvx + dvy * dvy + dvz * dvz)                # G_dot q_dot
-            + two_alpha * 2.0 * (dx * dvx + dy * dvy + dz * dvz)       # 2 alpha_f g_dot
+            + 2.0 * (dvx * dvx + dvy * dvy + dvz * dvz - reel_acc)     # G_dot q_dot
+            + two_alpha * 2.0 * (dx * dvx + dy * dvy + dz * dvz - reel_rate)  # 2 alpha_f g_dot
             + beta_sq * (offset_sq - length_sq))                       # beta_f^2 g
         # G M^-1 G^T = diag(4 |d_i|^2 / m_i) + 4 D D^T / m_p: 1 / delta_i of the diagonal
         # (held off its centre, the UAV's rotation adds 4 k_i . J_i^-1 k_i to delta_i)
@@ -202,9 +204,10 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
     k1, k2, k3, k4 = work[WORK_K1], work[WORK_K2], work[WORK_K3], work[WORK_K4]
     stage, acc = work[WORK_STAGE], work[WORK_ACC]
     later = work[WORK_MULTIPLIERS, :n]
-    # driven UAVs (physics.prescribed) are functions of time: each stage's time in the
-    # period's copy of the scalars, FORMATION_TIME (t0 + h at the end: the next step's start)
-    timed = formation[FORMATION_PRESCRIBED] != 0.0
+    # driven UAVs (physics.prescribed) and reeled cables (physics.winch) are functions of
+    # time: each stage's time in the period's copy of the scalars, FORMATION_TIME (t0 + h at
+    # the end: the next step's start)
+    timed = formation[FORMATION_PRESCRIBED] != 0.0 or formation[FORMATION_WINCH] != 0.0
     start = formation[FORMATION_TIME]
     solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
     for j in range(nq):  # k = (q_dot, q_ddot, the blocks' rates): the state derivative

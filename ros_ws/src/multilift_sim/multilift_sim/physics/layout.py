@@ -98,7 +98,19 @@ UAV_PAYLOAD_ATTACH = 9      # b_i [m]: where its cable holds a rigid payload, pa
 UAV_ATTACH = 12             # a_i [m]: where its cable holds the UAV, body FLU; 0: its centre (3)
 UAV_CABLE_STIFFNESS = 15    # k_i [N/m]: its cable's axial stiffness (`cable_model: elastic`)
 UAV_CABLE_DAMPING = 16      # c_i [N s/m]: its cable's axial damping (`cable_model: elastic`)
-UAV_COLUMNS = 17
+# its winch (`uavs[i].winch`, physics.winch; all 0: none): the reel's limits
+UAV_WINCH_RATE_LIMIT = 17   # the largest |l_dot| [m/s]
+UAV_WINCH_ACCELERATION_LIMIT = 18  # the largest |l_ddot| [m/s^2]
+UAV_WINCH_MIN_LENGTH = 19   # its stops: the shortest and longest cable [m] (2 slots)
+UAV_WINCH_MAX_LENGTH = 20
+# the reel's motion over the current control period (a period's copy of the rows holds them;
+# physics.winch.reel_period): from length l_0 [m] and rate v_0 [m/s] at time t_0 [s] towards
+# the target rate [m/s] at the acceleration limit
+UAV_REEL_START = 21         # t_0 [s]
+UAV_REEL_LENGTH = 22        # l_0 [m]
+UAV_REEL_RATE = 23          # v_0 [m/s]
+UAV_REEL_TARGET = 24        # the rate it heads for [m/s] (positive pays out)
+UAV_COLUMNS = 25
 
 # -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
@@ -123,6 +135,12 @@ EVENT_END_TICK = 6          # controller_silence: the first tick whose command a
 EVENT_DURATION = 7          # gust: how long it blows [s]
 EVENT_VELOCITY = 8          # gust: its peak velocity [m/s], world (3)
 EVENT_COLUMNS = 11
+
+# -- a UAV's winch as a tick leaves it (the memory's `reel`, (n, REEL_COLUMNS); physics.winch) --
+REEL_LENGTH = 0             # l_i [m]: its cable's (rest) length now
+REEL_RATE = 1               # l_i_dot [m/s], positive paying out
+REEL_COMMAND = 2            # the reel rate commanded [m/s] (events `winch`, /uav{i}/winch_cmd)
+REEL_COLUMNS = 3
 
 # -- a gust (seed Eq. 2.55; wind.gusts.Gust) --------------------------------------------------
 GUST_CENTER = 0             # (x, y) of its centre [m], world (2 slots)
@@ -152,9 +170,11 @@ FORMATION_ELASTIC = 16      # 1: the cables are elastic ropes (physics.elastic_c
 #                             multipliers, each pulls k stretch + c stretch rate when taut)
 FORMATION_PRESCRIBED = 17  # 1: some UAV's motion is prescribed (`uavs[i].trajectory`,
 #                             physics.prescribed): the drive table follows the scalars
-FORMATION_TIME = 18         # with FORMATION_PRESCRIBED: the time [s] the drives are evaluated
-#                             at (the RK4 stage's; a period's copy of these scalars holds it)
-FORMATION_SCALARS = 19
+FORMATION_TIME = 18         # with FORMATION_PRESCRIBED or FORMATION_WINCH: the time [s] the
+#                             drives and reels are evaluated at (the RK4 stage's; a period's
+#                             copy of these scalars holds it)
+FORMATION_WINCH = 19        # 1: some UAV carries a winch (physics.winch): cable lengths l_i(t)
+FORMATION_SCALARS = 20
 
 # -- the drive table of prescribed UAVs (physics.prescribed), after the formation's scalars
 # when FORMATION_PRESCRIBED: n slots (UAV i's at FORMATION_SCALARS + i: the offset of its drive

@@ -41,6 +41,7 @@ from multilift_sim.physics.layout import (
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
                                                uav_attitude_slot, uav_slot)
 from multilift_sim.physics.nullspace import dense_solve
+from multilift_sim.physics.winch import reeled_cable
 
 
 @jit
@@ -194,14 +195,15 @@ def rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cab
             cables[i, CABLE_PAYLOAD_MOMENT + 2]
         s0, s1, s2 = cross(w, (e0, e1, e2))
         cp0, cp1, cp2 = cross(w, (s0, s1, s2))  # w x (w x e_i)
-        cables[i, CABLE_RHS] = (2.0 * (v0 * v0 + v1 * v1 + v2 * v2)
+        length_sq, reel_rate, reel_acc = reeled_cable(uavs, formation, i)  # physics.winch
+        cables[i, CABLE_RHS] = (2.0 * (v0 * v0 + v1 * v1 + v2 * v2 - reel_acc)
                                 + 2.0 * (d0 * (drag0 - thrust0 - attach[2, 0])
                                          + d1 * (drag1 - thrust1 - attach[2, 1])
                                          + d2 * (drag2 - thrust2 - attach[2, 2]))
                                 + 2.0 * (c0 * alpha0[0] + c1 * alpha0[1] + c2 * alpha0[2])
                                 + 2.0 * (d0 * cp0 + d1 * cp1 + d2 * cp2)
-                                + two_alpha * 2.0 * (d0 * v0 + d1 * v1 + d2 * v2)
-                                + beta_sq * (offset_sq - uavs[i, UAV_LENGTH_SQ]))
+                                + two_alpha * 2.0 * (d0 * v0 + d1 * v1 + d2 * v2 - reel_rate)
+                                + beta_sq * (offset_sq - length_sq))
     rigid_multipliers(cables, formation, taut, multipliers)
     pull0 = pull1 = pull2 = 0.0     # sum_j lambda_j d_j (world)
     turn0 = turn1 = turn2 = 0.0     # sum_j lambda_j c_j (payload frame)

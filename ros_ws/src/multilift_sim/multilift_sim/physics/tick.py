@@ -21,6 +21,7 @@ from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.attitude import quaternion_norm_error
 from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_ELASTIC,
                                           FORMATION_PRESCRIBED, FORMATION_TIME, FORMATION_WIND,
+                                          FORMATION_WINCH, REEL_LENGTH,
                                           STATUS_FINISHED, STATUS_QUATERNION,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
                                           STATUS_OFF_RATE, STATUS_RUNNING,
@@ -30,10 +31,11 @@ from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rate
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.prescribed import prescribe_state
 from multilift_sim.estimators.estimation import estimated_states
+from multilift_sim.physics.winch import reel_end, reel_period
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
                                                    run_add_compression, run_add_gust_speed,
-                                                   run_add_ropes, run_add_slack,
+                                                   run_add_reel, run_add_ropes, run_add_slack,
                                                    run_add_tensions,
                                                    run_add_thrust_margin, run_check)
 from multilift_sim.statistics.layout import (CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE,
@@ -78,9 +80,9 @@ def period_formation(constants, series, tick):
 @jit
 def timed_formation(formation, t):
     """The scalars at time t [s] (FORMATION_TIME) where some UAV's motion is prescribed
-    (physics.prescribed: its drive is a function of time; a copy, the constants are not
-    written), else `formation` itself."""
-    if formation[FORMATION_PRESCRIBED] == 0.0:
+    (physics.prescribed: its drive is a function of time) or a cable reeled
+    (physics.winch), a copy (the constants are not written); else `formation` itself."""
+    if formation[FORMATION_PRESCRIBED] == 0.0 and formation[FORMATION_WINCH] == 0.0:
         return formation
     timed = formation.copy()
     timed[FORMATION_TIME] = t
@@ -151,18 +153,25 @@ def advance(a, m, b, speeds, saturated, tension):
     run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)
     run_add_thrust_margin(m.run[b], m.held[b], m.effectiveness[b], a.allocation[b],
                           a.rotor_speed_max[b])
+    t0 = m.tick[b] * a.period_ns[b] * 1e-9
     formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
-                                m.tick[b] * a.period_ns[b] * 1e-9)
+                                t0)
+    winched = formation[FORMATION_WINCH] != 0.0
+    # the UAVs' rows, with each reel's motion over the period where winches reel (physics.winch)
+    uavs = reel_period(a.uavs[b], m.reel[b], t0, period) if winched else a.uavs[b]
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
-        a.uavs[b], a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
+        uavs, a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
         a.physics_dt[b], a.physics_steps[b])
-    for i in range(n):
-        tension[i] = 2.0 * a.cable_lengths[b, i] * multipliers[i]
+    for i in range(n):  # l_i at the tick (a reeled cable's now)
+        tension[i] = 2.0 * m.reel[b, i, REEL_LENGTH] * multipliers[i]
     run_add_tensions(m.run[b], tension)
     run_add_compression(m.run[b], tension, period)
     if formation[FORMATION_ELASTIC] != 0.0:  # each rope's stretch and tension at the tick
-        run_add_ropes(m.run[b], m.state[b], a.uavs[b], tension)
+        run_add_ropes(m.run[b], m.state[b], m.reel[b, :, REEL_LENGTH], tension)
+    if winched:  # the reels at the new tick, g and g_dot of the reeled lengths there
+        reel_end(uavs, m.reel[b], (m.tick[b] + 1) * a.period_ns[b] * 1e-9, g, g_dot)
+        run_add_reel(m.run[b], m.reel[b], a.cable_lengths[b])
     if a.slack[b]:
         run_add_slack(m.run[b], m.taut[b], period)
     if formation[FORMATION_PRESCRIBED] != 0.0:
@@ -175,7 +184,7 @@ def advance(a, m, b, speeds, saturated, tension):
     m.g_dot[b, :] = g_dot
     m.tick[b] += 1
     m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b], m.effectiveness[b],
-                                   m.taut[b], m.released[b], m.silent_until[b])
+                                   m.taut[b], m.released[b], m.silent_until[b], m.reel[b])
     check(a, m, b)
     if m.status[b] == STATUS_RUNNING and m.tick[b] >= a.tick_count[b]:
         m.status[b] = STATUS_FINISHED
@@ -191,7 +200,7 @@ def start(a, m, which):
         residuals(m.state[b], a.uavs[b], m.g[b], m.g_dot[b])
         m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b],
                                        m.effectiveness[b], m.taut[b], m.released[b],
-                                       m.silent_until[b])
+                                       m.silent_until[b], m.reel[b])
         check(a, m, b)
         if m.status[b] == STATUS_RUNNING and m.tick[b] >= a.tick_count[b]:
             m.status[b] = STATUS_FINISHED
@@ -225,12 +234,15 @@ def tension_at(a, m, b, speeds, tension):
     x = m.state[b]
     acc = np.empty(x.shape[0] - rates_slot(n))  # q_ddot, then the attitude blocks' rates
     multipliers = np.empty(n)
+    t = m.tick[b] * a.period_ns[b] * 1e-9
     formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
-                                m.tick[b] * a.period_ns[b] * 1e-9)
-    solve(x, wrenches, a.uavs[b], a.gusts[b], formation, m.taut[b], acc, multipliers,
+                                t)
+    winched = formation[FORMATION_WINCH] != 0.0
+    uavs = reel_period(a.uavs[b], m.reel[b], t, a.period_ns[b] * 1e-9) if winched else a.uavs[b]
+    solve(x, wrenches, uavs, a.gusts[b], formation, m.taut[b], acc, multipliers,
           np.empty((n, CABLE_COLUMNS)))
     for i in range(n):
         value = multipliers[i]
         if a.slack[b]:
             value = max(value, 0.0) if m.taut[b, i] else 0.0
-        tension[i] = 2.0 * a.cable_lengths[b, i] * value
+        tension[i] = 2.0 * m.reel[b, i, REEL_LENGTH] * value

@@ -27,8 +27,9 @@ from geometry_msgs.msg import Vector3Stamped
 from multilift_msgs.msg import FormationEvent, FormationSnapshot, FormationState, RotorCommand
 from nav_msgs.msg import Odometry
 from rclpy.node import Node, NodeNameNonExistentError
-from rclpy.qos import DurabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Float64
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
@@ -38,9 +39,9 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE,
+from multilift_sim.topics import (CABLE_LENGTH, CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE,
                                   MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
-                                  PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, parse_external,
+                                  PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, WINCH_CMD, parse_external,
                                   state_topics, uav_topic)
 from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, TickCables
 from multilift_sim.schedules import run_seeds
@@ -50,6 +51,9 @@ from multilift_sim.wire.tick_messages import SimulatorMessages
 # [s] the graph stays complete this long before t = 0 when a user's node answers (see
 # missing_peers): discovery reaches every participant within milliseconds of each other
 EXTERNAL_SETTLE = 0.5
+# a live reel rate's subscription: reliable and volatile, what a default publisher
+# (create_publisher(Float64, topic, 10)) offers; a transient_local publisher matches it too
+WINCH_QOS = QoSProfile(depth=10)
 
 
 class SimNode(Node):
@@ -64,6 +68,7 @@ class SimNode(Node):
         external = str(self.declare_parameter('external', '').value)
         self.startup_timeout = float(self.declare_parameter('startup_timeout', 0.0).value) \
             or STARTUP_TIMEOUT
+        live = bool(self.declare_parameter('live', False).value)
         if not name:
             raise Fatal('parameter "scenario" is required (a name in scenarios/ or a path)')
         scenario = scenario_io.load(name)
@@ -98,12 +103,15 @@ class SimNode(Node):
         self.measured_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, MEASURED_ODOM),
                                                     PUBLISHER_QOS)
                               for i in range(n)] if scenario.measures else []
+        # /uav{i}/cable_length of each UAV with a winch
+        lengths = [self.create_publisher(Float64, uav_topic(i, CABLE_LENGTH), PUBLISHER_QOS)
+                   for i in scenario.winches]
         # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
             self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events, *winds,
-            *self.measured_pubs,
+            *self.measured_pubs, *lengths,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)
@@ -113,10 +121,26 @@ class SimNode(Node):
             durability=DurabilityPolicy.VOLATILE if i + 1 in self.external else None)
             for i in range(n if scenario.controlled else 0)]  # none: every UAV prescribed
         self.commands: list[RotorCommand | None] = [None] * len(self.cmd_subs)
+        # live reel rates (`run --live`) for each UAV with a winch, from the next period on
+        self.winch_subs = [self.create_subscription(
+            Float64, uav_topic(i, WINCH_CMD), lambda msg, i=i: self._on_winch(i, msg),
+            WINCH_QOS) for i in (scenario.winches if live else ())]
 
     def _on_command(self, index: int, msg: RotorCommand) -> None:
         if ns_from_stamp(msg.header.stamp) == self.sim.t_ns:
             self.commands[index] = msg
+
+    def _on_winch(self, index: int, msg: Float64) -> None:
+        """/uav{index}/winch_cmd: its winch reels at msg.data [m/s] from the period of the
+        tick being answered on (Float64 carries no stamp); a rate that is no number is logged
+        and ignored."""
+        try:
+            self.sim.command_winch(index - 1, float(msg.data))
+        except ValueError as error:
+            self.get_logger().warning(f'{uav_topic(index, WINCH_CMD)} ignored: {error}')
+            return
+        self.get_logger().info(f'uav{index} winch commanded to {msg.data:g} m/s at t = '
+                               f'{self.sim.t:.3f} s')
 
     _external_ready_since: float | None = None
 

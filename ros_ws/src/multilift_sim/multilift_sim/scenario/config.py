@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from multilift_sim.cables.winch import Winch
 from multilift_sim.drives import Drive
 from multilift_sim.events import moves_air
 from multilift_sim.formation_params import FormationParams
@@ -72,6 +73,8 @@ class UavConfig:
     # its prescribed motion (`trajectory:`, a file; issue 34): no controller, a kinematic
     # driver of the DAE (physics.prescribed); None: flown by its controller
     trajectory: Drive | None = None
+    # its winch (`winch:`, cables.winch; issue 32): the cable's length reeled; None: fixed
+    winch: Winch | None = None
 
 
 @dataclass(frozen=True)
@@ -244,6 +247,11 @@ class Scenario:
         return self.sensors is not None or self.estimator is not None
 
     @property
+    def winches(self) -> tuple[int, ...]:
+        """The UAVs (from 1) that carry a winch (`uavs[i].winch`)."""
+        return tuple(i + 1 for i, u in enumerate(self.uavs) if u.winch is not None)
+
+    @property
     def controlled(self) -> bool:
         """Whether the formation has controllers: not when every UAV's motion is prescribed
         (no controller nodes, the engine answers nothing)."""
@@ -278,6 +286,8 @@ class Scenario:
             cable_damping=tuple(u.cable_damping for u in self.uavs) if ropes else None,
             substeps=sim.substeps,
             drives=(tuple(u.trajectory for u in self.uavs) if self.prescribed else None),
+            winches=(tuple(u.winch for u in self.uavs) if any(u.winch for u in self.uavs)
+                     else None),
         )
 
     def with_duration(self, duration: float) -> 'Scenario':

@@ -12,7 +12,7 @@ from typing import Any
 from multilift_sim.wind import WIND_MODELS
 from multilift_sim.wind.gusts import Gust
 from multilift_sim.formation_geometry import hanging_payload, nominal_positions
-from multilift_sim.cables import CABLE_MODELS
+from multilift_sim.cables import CABLE_MODELS, winch
 from multilift_sim.formulations import FORMULATIONS, unsupported
 from multilift_sim.payloads import PAYLOAD_TYPES
 from multilift_sim.events import EVENT_KINDS
@@ -117,11 +117,12 @@ def scenario_of(data: Any, where: str) -> Scenario:
                          'the file gives the start')
         length = u.positive('cable_length', default_cable)
         stiffness, damping = cables.parse_uav_cable(u, length, rope)
+        reel = winch.parse_winch(u, length)
         uavs.append(UavConfig(vehicle=vehicle, cable_length=length,
                               position=u.vector('position', [0.0, 0.0, 0.0]),
                               yaw=u.number('yaw', 0.0),
                               attach_point=u.vector('attach_point', [0.0, 0.0, 0.0]),
-                              cable_stiffness=stiffness, cable_damping=damping,
+                              cable_stiffness=stiffness, cable_damping=damping, winch=reel,
                               trajectory=read_trajectory(u, scenario_folder(where),
                                                          u.number('yaw', 0.0))))
         u.done()
@@ -226,7 +227,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
         ('attach_points', f'uavs[{off_centre[0] if off_centre else 0}].attach_point',
          off_centre),
         ('prescribed', f'uavs[{scenario.prescribed[0] if scenario.prescribed else 0}]'
-                       '.trajectory', scenario.prescribed)) if uses}
+                       '.trajectory', scenario.prescribed),
+        ('winch', 'uavs[i].winch', any(u.winch for u in scenario.uavs))) if uses}
     used.update({feature: f'payload.type: {payload_type.NAME}'
                  for feature in sorted(payload_type.NEEDS)})
     used.update({feature: f'cable_model: {cable_model}' for feature in sorted(cables.NEEDS)})
@@ -236,7 +238,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
     if len(uavs) < payload_type.MIN_UAVS:
         raise ScenarioError(f'{where}: payload.type: {payload_type.NAME} needs n >= '
                             f'{payload_type.MIN_UAVS} UAVs')
-    refused = cables.check(scenario)
+    refused = cables.check(scenario) or winch.check(scenario)
     if refused:
         raise ScenarioError(f'{where}: {refused}')
     return scenario

@@ -15,7 +15,7 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import quaternion_norm_error
-from multilift_sim.physics.layout import POSITION, UAV_COORDINATES, UAV_LENGTH_SQ
+from multilift_sim.physics.layout import POSITION, REEL_LENGTH, UAV_COORDINATES
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, uav_attitude_slot,
                                                uav_slot)
 from multilift_sim.statistics.layout import (
@@ -23,7 +23,8 @@ from multilift_sim.statistics.layout import (
     FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ,
     QUATERNION_NORM_TOLERANCE, RUN_COMPRESSED_TIME, RUN_LEAST_THRUST_MARGIN, RUN_MAX_ABS_G,
     RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_STRETCH,
-    RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
+    RUN_LONGEST_CABLE, RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME,
+    RUN_SCALARS, RUN_SHORTEST_CABLE,
     RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
 from multilift_sim.statistics.swing import swing_at
 
@@ -107,23 +108,37 @@ def run_add_tensions(run: np.ndarray, tension: np.ndarray) -> None:
 
 
 @jit
-def run_add_ropes(run: np.ndarray, state: np.ndarray, uavs: np.ndarray,
+def run_add_ropes(run: np.ndarray, state: np.ndarray, lengths: np.ndarray,
                   tension: np.ndarray) -> None:
     """Elastic ropes (cable_model: elastic) at one tick: each rope's stretch L_i - l_i [m]
-    (L_i = |r_p - r_i| in the formation state x, l_i its rest length, sqrt of the UAVs'
-    UAV_LENGTH_SQ; negative when slack) and its tension T_i (n,) [N] raise its maxima
-    (RUN_MAX_STRETCH, RUN_PEAK_TENSION)."""
+    (L_i = |r_p - r_i| in the formation state x, l_i its rest length, `lengths` (n,) [m];
+    negative when slack) and its tension T_i (n,) [N] raise its maxima (RUN_MAX_STRETCH,
+    RUN_PEAK_TENSION)."""
     n = tension.shape[0]
     p = payload_slot(n)
     for i in range(n):
         r = uav_slot(i) + POSITION
         dx, dy, dz = state[p] - state[r], state[p + 1] - state[r + 1], state[p + 2] - state[r + 2]
-        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - math.sqrt(uavs[i, UAV_LENGTH_SQ])
+        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - lengths[i]
         block = RUN_SCALARS + RUN_UAV_COLUMNS * i
         if stretch > run[block + RUN_MAX_STRETCH]:
             run[block + RUN_MAX_STRETCH] = stretch
         if tension[i] > run[block + RUN_PEAK_TENSION]:
             run[block + RUN_PEAK_TENSION] = tension[i]
+
+
+@jit
+def run_add_reel(run: np.ndarray, reel: np.ndarray, lengths: np.ndarray) -> None:
+    """Winches at one tick: each cable's reeled length (reel (n, REEL_COLUMNS), physics.winch)
+    widens its range (RUN_SHORTEST_CABLE, RUN_LONGEST_CABLE); `lengths` (n,) [m] the start's,
+    which the range holds from the first tick."""
+    for i in range(reel.shape[0]):
+        block = RUN_SCALARS + RUN_UAV_COLUMNS * i
+        for length in (lengths[i], reel[i, REEL_LENGTH]):
+            if length < run[block + RUN_SHORTEST_CABLE]:
+                run[block + RUN_SHORTEST_CABLE] = length
+            if length > run[block + RUN_LONGEST_CABLE]:
+                run[block + RUN_LONGEST_CABLE] = length
 
 
 @jit

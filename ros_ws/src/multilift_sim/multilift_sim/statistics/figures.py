@@ -17,7 +17,8 @@ from multilift_sim import kernels
 from multilift_sim.statistics.layout import (
     FORMATION_MAX_ABS, FORMATION_NORM_SUM, FORMATION_SAMPLES, FORMATION_SIZE, PEAK_MAX,
     PEAK_SAMPLES, PEAK_SIZE, PEAK_SUM_SQ, RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
-    RUN_LEAST_THRUST_MARGIN, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_STRETCH,
+    RUN_LEAST_THRUST_MARGIN, RUN_LONGEST_CABLE, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED,
+    RUN_MAX_STRETCH, RUN_SHORTEST_CABLE,
     RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
     RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR,
     TRACKING_SIZE, run_size)
@@ -187,8 +188,9 @@ class RunStatistics:
             run[RUN_MIN_TENSION] = math.inf
             run[RUN_MAX_TENSION] = -math.inf
             run[RUN_SCALARS + RUN_LEAST_THRUST_MARGIN:run_size(n_uavs):RUN_UAV_COLUMNS] = math.inf
-            for column in (RUN_MAX_STRETCH, RUN_PEAK_TENSION):  # elastic ropes' only
+            for column in (RUN_MAX_STRETCH, RUN_PEAK_TENSION, RUN_LONGEST_CABLE):
                 run[RUN_SCALARS + column:run_size(n_uavs):RUN_UAV_COLUMNS] = -math.inf
+            run[RUN_SCALARS + RUN_SHORTEST_CABLE:run_size(n_uavs):RUN_UAV_COLUMNS] = math.inf
         self.run = run
         self.swing = PeakRms(self.run, RUN_SWING)      # payload swing [m]
         self._functions = {name: compiled('accumulators', name) for name in (
@@ -234,6 +236,16 @@ class RunStatistics:
         if not any(math.isfinite(v) for v in stretch):
             return {}
         return {'max_stretch': stretch, 'peak_tension': peak}
+
+    @property
+    def reel_figures(self) -> dict:
+        """Winches' (`uavs[i].winch`) per cable: {'shortest_cable', 'longest_cable'}: the
+        least and largest length [m] its reel gave it at the control ticks (a UAV without a
+        winch: its length); {} in a run without winches."""
+        shortest, longest = self._per_uav(RUN_SHORTEST_CABLE), self._per_uav(RUN_LONGEST_CABLE)
+        if not any(math.isfinite(v) for v in shortest):
+            return {}
+        return {'shortest_cable': shortest, 'longest_cable': longest}
 
     @property
     def min_tension(self) -> float:
@@ -307,4 +319,5 @@ class RunStatistics:
                 'max_payload_swing': self.swing.max,
                 'rms_payload_swing': self.swing.rms,
                 'swing_from': SWING_FROM,
-                'compressed_time': self.compressed_time, **self.rope_figures}
+                'compressed_time': self.compressed_time, **self.rope_figures,
+                **self.reel_figures}

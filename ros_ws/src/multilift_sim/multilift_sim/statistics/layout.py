@@ -42,7 +42,10 @@ RUN_LEAST_THRUST_MARGIN = 3  # least share of its largest thrust left by its com
 RUN_MAX_STRETCH = 4         # its rope's largest stretch L_i - l_i [m] (cable_model: elastic;
 #                             -inf: none yet, and in every other cable model's run)
 RUN_PEAK_TENSION = 5        # its rope's largest tension T_i [N] (cable_model: elastic; -inf)
-RUN_UAV_COLUMNS = 6
+RUN_SHORTEST_CABLE = 6      # its cable's shortest length l_i [m] reeled by its winch (+inf:
+#                             none yet, and in every run without winches)
+RUN_LONGEST_CABLE = 7       # its cable's longest length [m] (-inf)
+RUN_UAV_COLUMNS = 8
 
 
 def run_size(n_uavs: int) -> int:

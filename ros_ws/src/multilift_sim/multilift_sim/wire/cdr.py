@@ -29,6 +29,18 @@ class Clock:
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns))
 
 
+class Float64:
+    """std_msgs/Float64 (no header: a bag's log time stamps it)."""
+
+    def __init__(self) -> None:
+        layout = Layout()
+        layout.primitive('d')
+        self.layout, self._struct = layout, layout.compile()
+
+    def pack(self, value: float) -> bytes:
+        return self._struct.pack(ENCAPSULATION, value)
+
+
 class Odometry:
     """nav_msgs/Odometry with zero covariances, frame `frame`, child `child`."""
 

@@ -25,9 +25,9 @@ from multilift_sim.physics.measurement import odometry_rows, odometry_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.wire.scene import FormationScene
 from multilift_sim.simulation import Snapshot
-from multilift_sim.topics import (CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE, MARKERS,
-                                  MEASURED_ODOM, PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, WIND,
-                                  uav_topic)
+from multilift_sim.topics import (CABLE_LENGTH, CLOCK, EVENTS, FORMATION_SNAPSHOT,
+                                  FORMATION_STATE, MARKERS, MEASURED_ODOM, PAYLOAD_GUST,
+                                  PAYLOAD_ODOM, TF, ODOM, WIND, uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
 _ZERO = (0.0, 0.0, 0.0)
@@ -51,6 +51,9 @@ class SimulatorMessages:
         # what the controllers receive, UAV by UAV, where the scenario has `sensors:`
         self._measured = [(uav_topic(i, MEASURED_ODOM), cdr.Odometry(uav_frame(i)))
                           for i in range(1, n + 1)] if scenario.measures else []
+        # each winch's cable length (/uav{i}/cable_length), where UAVs carry winches
+        self._lengths = [(i - 1, uav_topic(i, CABLE_LENGTH), cdr.Float64())
+                         for i in scenario.winches]
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
         self._gust = cdr.Vector3Stamped()
         self._wind = cdr.Vector3Stamped() if scenario.has_wind else None  # /formation/wind
@@ -87,15 +90,16 @@ class SimulatorMessages:
             snap.t_ns, None if snapshot is None else np.concatenate(snapshot).tolist(),
             None if snapshot is None else len(snapshot[-1]), uavs,
             snap.payload_position.tolist(), payload_velocity, vec3(gust),
-            measured, None if wind is None else vec3(wind), payload_pose)
+            measured, None if wind is None else vec3(wind), payload_pose,
+            snap.cable_lengths.tolist())
 
     def state_of(self, t_ns: int, snapshot: list[float] | None, previous: int | None,
                  uavs: Sequence[Sequence[float]], payload_position: Sequence[float],
                  payload_velocity: Sequence[float], gust: Sequence[float],
                  measured: Sequence[Sequence[float]] | None = None,
                  wind: Sequence[float] | None = None,
-                 payload_pose: tuple[Sequence[float], Sequence[float]] | None = None
-                 ) -> list[Message]:
+                 payload_pose: tuple[Sequence[float], Sequence[float]] | None = None,
+                 cable_lengths: Sequence[float] = ()) -> list[Message]:
         """`state` from plain numbers (the one packing of both): `snapshot` the
         FormationSnapshot's numbers in a row (`cdr.FormationSnapshot.pack_row`; None at the
         last tick) with `previous` rotor speeds at its end, per UAV its odometry's 13 numbers
@@ -103,7 +107,8 @@ class SimulatorMessages:
         .odometry) and (with `sensors:`) those of what its controllers receive, the payload's
         position and velocity, the gust and (where the air moves everywhere) the wind, world
         [m, m/s]; a rigid payload's `payload_pose` (its orientation (x, y, z, w) and body rates
-        [rad/s]; its velocity then in its own frame, as nav_msgs/Odometry's twist is)."""
+        [rad/s]; its velocity then in its own frame, as nav_msgs/Odometry's twist is), and
+        every cable's length [m] (/uav{i}/cable_length of the UAVs with a winch)."""
         orientation, spin = (IDENTITY, _ZERO) if payload_pose is None else payload_pose
         out = [(CLOCK, self._clock.pack(t_ns))]
         if snapshot is not None:
@@ -113,6 +118,8 @@ class SimulatorMessages:
         if measured is not None:
             for uav, (topic, packer) in zip(measured, self._measured):
                 out.append((topic, packer.pack_row(t_ns, uav)))
+        for i, topic, packer in self._lengths:
+            out.append((topic, packer.pack(cable_lengths[i])))
         out.append((PAYLOAD_ODOM, self._payload.pack(t_ns, payload_position, orientation,
                                                      payload_velocity, spin)))
         out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *gust)))

@@ -3,8 +3,8 @@
 payload alike (issue 31, item 6). The rotation of a quaternion, the kinematics q_dot =
 q (x) (0, omega) / 2, a small turn and the renormalisation after an RK4 step, the product of
 quaternions, Exp and Log of a rotation vector (the IMU's, the motion capture's and the EKF's):
-the one place of these equations for the compiled functions (the Euler angles the controllers read are
-computed from q once, `measurement.quaternion_euler`). Slots are `physics.layout`'s.
+the one place of these equations for the compiled functions (the Euler angles the controllers
+read are computed from q once, `measurement.quaternion_euler`). Slots are `physics.layout`'s.
 """
 import math
 

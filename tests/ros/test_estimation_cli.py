@@ -26,8 +26,8 @@ def test_the_command_line_refuses_bad_input_in_one_line_with_exit_2(tmp_path):
 def test_the_estimator_flies_alike_through_ros_and_headless(tmp_path):
     """`twin_lift_realistic` (docs/estimation.md) through the ROS nodes and headless: the
     simulator node's estimator gives the controllers the numbers the engine's does (every
-    /uav{i}/measured_odom, the states to rounding); the estimate is not the state but within a
-    few mm of it; the summary records both sensors' seeds."""
+    /uav{i}/measured_odom and /uav{i}/estimate, the states to rounding); the estimate is not the
+    state but within a few mm of it; the summary records both sensors' seeds."""
     import json
     import os
 
@@ -53,6 +53,11 @@ def test_the_estimator_flies_alike_through_ros_and_headless(tmp_path):
         assert np.abs(ros['position'] - headless['position']).max() < 1e-9
         error = headless['position'] - headless_run.topic(f'/uav{i}/odom')['position']
         assert 1e-5 < np.abs(error).max() < 0.01
+        ros, headless = (run.topic(f'/uav{i}/estimate') for run in (ros_run, headless_run))
+        assert len(ros.t) == len(headless.t) == 201  # its estimate, with covariance
+        assert np.abs(ros['position'] - headless['position']).max() < 1e-9
+        assert np.array_equal(headless['position'],
+                              headless_run.topic(f'/uav{i}/measured_odom')['position'])
     for mode in ('ros', 'headless'):
         summary = json.loads((tmp_path / mode / 'summary.json').read_text())
         assert summary['sim']['seeds'] == {'imu': 1, 'mocap': 1}

@@ -18,7 +18,7 @@ import yaml
 
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
-from multilift_sim.estimators import ekf, error_state
+from multilift_sim.estimators import ekf, error_state, published
 from multilift_sim.estimators.consistency import mean_bounds, share_inside
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.estimators.error_state import (ERROR_ATTITUDE, ERROR_POSITION, ERROR_SIZE,
@@ -248,6 +248,7 @@ def test_every_estimation_function_compiled_equals_its_source_bit_for_bit():
         'start': (a.estimator_constants[0, 0], sensors[mocap_row], x, p),
         'update': (a.estimator_constants[0, 0], sensors[mocap_row], x, p, estimate_memory, 150),
         'propagate_sample': (a.estimator_constants[0, 0], estimate_memory, 150, x, p),
+        'publish': (a.estimator_constants[0, 0], x, p, estimate_memory),
         'quaternion_product': tuple(rng.normal(size=8)),
         'rotation_quaternion': tuple(rng.normal(size=3)),
         'quaternion_rotation_vector': tuple(q),
@@ -272,5 +273,31 @@ def test_every_estimation_function_compiled_equals_its_source_bit_for_bit():
             assert np.array_equal(np.asarray(c, dtype=float), np.asarray(u, dtype=float),
                                   equal_nan=True), (name, k)
         met.add(name)
-    assert len(met) == 14, sorted(met)
+    assert len(met) == 15, sorted(met)
     assert math.isfinite(p[0, 0])
+
+
+def test_the_published_estimate_is_the_filter_s_state_and_covariance_in_ros_axes():
+    """/uav{i}/estimate's numbers (estimators.published) against the filter's memory: the
+    position and quaternion, the pose covariance's position block P_pp and its attitude block
+    R P_theta R^T (the body-frame error turned to the world's axes), the velocity R^T v."""
+    from multilift_control.engine import Engine
+    engine = Engine(_realistic(1.0))
+    engine.step(60)
+    engine.measured()
+    memory = engine.memory.estimator_memory[0, 0, 1]
+    x = memory[ekf.NOMINAL:ekf.NOMINAL + NOMINAL_SIZE]
+    p = memory[ekf.COVARIANCE:ekf.DELAYED].reshape(ERROR_SIZE, ERROR_SIZE)
+    r = _rotation(x[NOMINAL_QUATERNION:NOMINAL_QUATERNION + 4])
+    pose = memory[published.ESTIMATE_POSE_COVARIANCE:][:36].reshape(6, 6)
+    assert np.array_equal(memory[published.ESTIMATE_POSITION:][:3], x[:3])
+    assert np.array_equal(memory[published.ESTIMATE_ORIENTATION:][:4],
+                          x[[NOMINAL_QUATERNION + k for k in (1, 2, 3, 0)]])
+    assert np.allclose(pose[:3, :3], p[:3, :3], rtol=1e-12, atol=0)
+    attitude_block = r @ p[ERROR_ATTITUDE:ERROR_ATTITUDE + 3, ERROR_ATTITUDE:ERROR_ATTITUDE + 3]
+    assert np.allclose(pose[3:, 3:], attitude_block @ r.T, rtol=1e-9, atol=1e-18)
+    assert np.allclose(pose, pose.T, rtol=1e-9, atol=1e-18)
+    assert np.linalg.eigvalsh(pose).min() > 0
+    assert np.allclose(memory[published.ESTIMATE_LINEAR:][:3], r.T @ x[3:6], atol=1e-15)
+    twist = memory[published.ESTIMATE_TWIST_COVARIANCE:][:36].reshape(6, 6)
+    assert np.linalg.eigvalsh(twist).min() > 0

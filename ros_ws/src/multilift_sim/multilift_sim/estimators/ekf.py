@@ -15,7 +15,9 @@ What the controllers receive: the estimate's position [m] and velocity [m/s] (wo
 Euler angles of its quaternion [rad] and the gyro's last rate less its estimated bias [rad/s]
 (body FLU). The filter starts at tick 0 from the first motion-capture sample (position and
 attitude, covariance that sample's noise), at rest (velocity 0 with `initial_velocity_noise`
-[m/s] of deviation), biases 0 (their variance grows from 0 by their random walks: the IMU's
+[m/s] of deviation, default 0.01: every run starts at rest, and a looser prior's first
+corrections jolt the seed's high-gain loops: 0.1 m/s pushed a cable in twin_lift_realistic's
+first 0.1 s), biases 0 (their variance grows from 0 by their random walks: the IMU's
 biases start at 0).
 """
 from __future__ import annotations
@@ -25,11 +27,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from multilift_sim.estimators.error_state import (
-    ERROR_ATTITUDE, ERROR_POSITION, ERROR_SIZE, ERROR_VELOCITY, NOISE_ACCEL, NOISE_ACCEL_WALK,
+    ERROR_ATTITUDE, ERROR_GYRO_BIAS, ERROR_POSITION, ERROR_SIZE, ERROR_VELOCITY, NOISE_ACCEL,
+    NOISE_ACCEL_WALK,
     NOISE_GYRO, NOISE_GYRO_WALK, NOMINAL_GYRO_BIAS, NOMINAL_POSITION, NOMINAL_QUATERNION,
     NOMINAL_SIZE, NOMINAL_VELOCITY, fuse, inject, propagate)
 from multilift_sim.kernels import jit
-from multilift_sim.physics.attitude import attitude_difference
+from multilift_sim.estimators.published import (
+    ESTIMATE_ANGULAR, ESTIMATE_COLUMNS, ESTIMATE_LINEAR, ESTIMATE_ORIENTATION,
+    ESTIMATE_POSE_COVARIANCE, ESTIMATE_POSITION, ESTIMATE_TWIST_COVARIANCE)
+from multilift_sim.physics.attitude import attitude_difference, quaternion_rotation
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY)
 from multilift_sim.physics.measurement import quaternion_euler
@@ -50,13 +56,15 @@ POSITION_VARIANCE = 8       # the motion capture's position noise variance [m^2]
 ATTITUDE_VARIANCE = 9       # its attitude noise variance [rad^2]
 INITIAL_VELOCITY_VARIANCE = 10  # [m^2/s^2]
 HISTORY_SLOTS = 11          # the ring's length: the motion capture's latency + 1 [ticks]
-CONSTANT_COLUMNS = 12
+RATE_VARIANCE = 12          # a gyro sample's white noise variance N^2 / dt [rad^2/s^2]
+CONSTANT_COLUMNS = 13
 # -- one UAV's memory --------------------------------------------------------------------------
-LAST_TICK = 0               # the tick estimated last (-1: none)
-NIS = 1                     # the normalised innovation squared of the last update
-NIS_TICK = 2                # the tick of that update (-1: none yet)
-RATE = 3                    # the gyro's last rate less the bias estimate [rad/s], body (3)
-NOMINAL = 6                 # now: the nominal state (error_state.NOMINAL_SIZE)
+#    first the estimate as published (estimators.published, ESTIMATE_COLUMNS), then
+LAST_TICK = ESTIMATE_COLUMNS  # the tick estimated last (-1: none)
+NIS = LAST_TICK + 1         # the normalised innovation squared of the last update
+NIS_TICK = LAST_TICK + 2    # the tick of that update (-1: none yet)
+RATE = LAST_TICK + 3        # the gyro's last rate less the bias estimate [rad/s], body (3)
+NOMINAL = LAST_TICK + 6     # now: the nominal state (error_state.NOMINAL_SIZE)
 COVARIANCE = NOMINAL + NOMINAL_SIZE  # now: P, row by row (ERROR_SIZE^2)
 DELAYED = COVARIANCE + ERROR_SIZE * ERROR_SIZE  # the delayed horizon's nominal state
 DELAYED_COVARIANCE = DELAYED + NOMINAL_SIZE     # and its P
@@ -72,7 +80,7 @@ class EkfSettings:
 
 
 def parse(d) -> EkfSettings:
-    return EkfSettings(initial_velocity_noise=d.non_negative('initial_velocity_noise', 0.1))
+    return EkfSettings(initial_velocity_noise=d.non_negative('initial_velocity_noise', 0.01))
 
 
 def needs(sensor_names) -> str:
@@ -99,6 +107,7 @@ def constants(settings: EkfSettings, scenario, rows: dict) -> np.ndarray:
     row[ATTITUDE_VARIANCE] = aid.attitude_noise ** 2
     row[INITIAL_VELOCITY_VARIANCE] = settings.initial_velocity_noise ** 2
     row[HISTORY_SLOTS] = aid.latency_ticks + 1
+    row[RATE_VARIANCE] = unit.noise_density[1] ** 2 / unit.period
     return row
 
 
@@ -157,6 +166,54 @@ def propagate_sample(constants, memory, tick, x, covariance):
 
 
 @jit
+def publish(constants, x, covariance, memory):
+    """The estimate as /uav{i}/estimate carries it into memory's first ESTIMATE_COLUMNS
+    (estimators.published): the pose, its covariance with the attitude error turned into the
+    world's axes (R P_theta R^T; the cross terms R P_p,theta), the velocity in the body frame
+    R^T v with its covariance (R^T P_v R, plus [v_b]x for the attitude error: v_b = Exp(-dtheta)
+    R^T v), the rate (the gyro less its bias: P_bg plus a sample's noise N^2 / dt)."""
+    q = NOMINAL_QUATERNION
+    rotation = quaternion_rotation(x, q)
+    for j in range(3):
+        memory[ESTIMATE_POSITION + j] = x[NOMINAL_POSITION + j]
+        memory[ESTIMATE_ANGULAR + j] = memory[RATE + j]
+    memory[ESTIMATE_ORIENTATION], memory[ESTIMATE_ORIENTATION + 1] = x[q + 1], x[q + 2]
+    memory[ESTIMATE_ORIENTATION + 2], memory[ESTIMATE_ORIENTATION + 3] = x[q + 3], x[q]
+    body = np.zeros(3)
+    for r in range(3):
+        for c in range(3):
+            body[r] += rotation[c, r] * x[NOMINAL_VELOCITY + c]
+        memory[ESTIMATE_LINEAR + r] = body[r]
+    pose = np.zeros((6, ERROR_SIZE))  # d(pose) / d(error state)
+    twist = np.zeros((6, ERROR_SIZE))  # d(twist) / d(error state)
+    for r in range(3):
+        pose[r, ERROR_POSITION + r] = 1.0
+        twist[3 + r, ERROR_GYRO_BIAS + r] = -1.0
+        for c in range(3):
+            pose[3 + r, ERROR_ATTITUDE + c] = rotation[r, c]
+            twist[r, ERROR_VELOCITY + c] = rotation[c, r]
+    # [v_b]x: the body velocity seen through the attitude error
+    twist[0, ERROR_ATTITUDE + 1], twist[0, ERROR_ATTITUDE + 2] = -body[2], body[1]
+    twist[1, ERROR_ATTITUDE], twist[1, ERROR_ATTITUDE + 2] = body[2], -body[0]
+    twist[2, ERROR_ATTITUDE], twist[2, ERROR_ATTITUDE + 1] = -body[1], body[0]
+    for jacobian, start in ((pose, ESTIMATE_POSE_COVARIANCE), (twist, ESTIMATE_TWIST_COVARIANCE)):
+        product = np.zeros((6, ERROR_SIZE))
+        for r in range(6):
+            for k in range(ERROR_SIZE):
+                if jacobian[r, k] != 0.0:
+                    for c in range(ERROR_SIZE):
+                        product[r, c] += jacobian[r, k] * covariance[k, c]
+        for r in range(6):
+            for c in range(6):
+                total = 0.0
+                for k in range(ERROR_SIZE):
+                    total += product[r, k] * jacobian[c, k]
+                memory[start + 6 * r + c] = total
+    for j in range(3):
+        memory[ESTIMATE_TWIST_COVARIANCE + 6 * (3 + j) + 3 + j] += constants[RATE_VARIANCE]
+
+
+@jit
 def estimate(constants, sensors, memory, tick, received):
     """At control tick `tick`: the IMU's sample of this tick into the ring; the delayed
     horizon (tick - L) propagated by the sample of its tick and the motion-capture sample
@@ -190,6 +247,7 @@ def estimate(constants, sensors, memory, tick, received):
             for j in range(3):
                 memory[RATE + j] = (unit[OUTPUT + imu.OUTPUT_RATE + j]
                                     - x[NOMINAL_GYRO_BIAS + j])
+        publish(constants, x, covariance, memory)
     for j in range(3):
         received[MEASURED_POSITION + j] = x[NOMINAL_POSITION + j]
         received[MEASURED_VELOCITY + j] = x[NOMINAL_VELOCITY + j]

@@ -39,7 +39,8 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import (CABLE_LENGTH, CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE,
+from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
+                                  FORMATION_STATE,
                                   MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
                                   PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, WINCH_CMD, parse_external,
                                   state_topics, uav_topic)
@@ -103,6 +104,9 @@ class SimNode(Node):
         self.measured_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, MEASURED_ODOM),
                                                     PUBLISHER_QOS)
                               for i in range(n)] if scenario.measures else []
+        # /uav{i}/estimate, each UAV's estimate with its covariance, with an estimator
+        estimates = [self.create_publisher(Odometry, uav_topic(i + 1, ESTIMATE), PUBLISHER_QOS)
+                     for i in range(n)] if scenario.estimator is not None else []
         # /uav{i}/cable_length of each UAV with a winch
         lengths = [self.create_publisher(Float64, uav_topic(i, CABLE_LENGTH), PUBLISHER_QOS)
                    for i in scenario.winches]
@@ -111,7 +115,7 @@ class SimNode(Node):
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
             self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events, *winds,
-            *self.measured_pubs, *lengths,
+            *self.measured_pubs, *estimates, *lengths,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)

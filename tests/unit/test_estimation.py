@@ -27,7 +27,7 @@ from multilift_sim.estimators.error_state import (ERROR_ATTITUDE, ERROR_POSITION
 from multilift_sim.physics import attitude
 from multilift_sim.physics.layout import MEASURED_COLUMNS, MEASURED_EULER, MEASURED_VELOCITY
 from multilift_sim.physics.measurement import quaternion_euler
-from multilift_sim.sensors import imu, mocap
+from multilift_sim.sensors import gnss, imu, mocap
 from multilift_sim.sensors.outputs import ARRIVED, OUTPUT, TAKEN
 from multilift_tools.estimation_study import monte_carlo
 
@@ -211,7 +211,7 @@ def test_a_small_monte_carlo_of_the_filter_is_consistent_and_a_mistuned_one_is_n
 
 
 def _compiled_functions():
-    modules = (error_state, ekf, imu, mocap)
+    modules = (error_state, ekf, imu, mocap, gnss)
     found = {f'{m.__name__}.{name}': value for m in modules for name, value in vars(m).items()
              if hasattr(value, 'py_func') and value.__module__ == m.__name__}
     for name in ('quaternion_product', 'rotation_quaternion', 'quaternion_rotation_vector',
@@ -259,7 +259,10 @@ def test_every_estimation_function_compiled_equals_its_source_bit_for_bit():
                       m.sensor_memory[0, imu_row, 0], 151, truth, np.zeros(MEASURED_COLUMNS)),
         mocap.measure: (a.sensor_constants[0, mocap_row], a.sensor_draws[0, mocap_row, 0],
                         m.sensor_memory[0, mocap_row, 0], 151, truth,
-                        np.zeros(MEASURED_COLUMNS))}
+                        np.zeros(MEASURED_COLUMNS)),
+        gnss.measure: (np.array([2.0, 3.0]), np.ones((100, gnss.DRAW_COLUMNS)),
+                       gnss.memory(gnss.GnssSettings(1.0, 2.0, 0.1, 0.0, 0.0, 3)), 151, truth,
+                       np.zeros(MEASURED_COLUMNS))}
     met = set()
     for name, function in _compiled_functions().items():
         short = name.rsplit('.', 1)[1]
@@ -273,7 +276,7 @@ def test_every_estimation_function_compiled_equals_its_source_bit_for_bit():
             assert np.array_equal(np.asarray(c, dtype=float), np.asarray(u, dtype=float),
                                   equal_nan=True), (name, k)
         met.add(name)
-    assert len(met) == 15, sorted(met)
+    assert len(met) == 16, sorted(met)
     assert math.isfinite(p[0, 0])
 
 
@@ -301,3 +304,29 @@ def test_the_published_estimate_is_the_filter_s_state_and_covariance_in_ros_axes
     assert np.allclose(memory[published.ESTIMATE_LINEAR:][:3], r.T @ x[3:6], atol=1e-15)
     twist = memory[published.ESTIMATE_TWIST_COVARIANCE:][:36].reshape(6, 6)
     assert np.linalg.eigvalsh(twist).min() > 0
+
+
+def test_gnss_draws_its_datasheet_noise_and_delivers_latency_ticks_late():
+    """`gnss_outdoor` (a u-blox M8: 2.5 m CEP, 0.05 m/s, 10 Hz, 110 ms): the drawn errors'
+    deviations per axis (CEP / 1.1774 horizontally, twice that vertically), and on a UAV
+    moving at 1 m/s along x each sample arrives 11 ticks late with the position of its tick."""
+    scenario = _realistic(1.0, gnss={'preset': 'gnss_outdoor', 'seed': 2})
+    config = next(c for c in scenario.sensor_suite if c.model == 'gnss')
+    assert config.rate == 10.0 and config.settings.latency_ticks == 11
+    rows = gnss.draws(config.settings, 2, 20000, 0.1, np.random.default_rng(5))
+    sigma = rows[:, :, gnss.DRAW_ERROR:gnss.DRAW_ERROR + 6].reshape(-1, 6).std(axis=0)
+    cep = 2.5 / math.sqrt(2.0 * math.log(2.0))
+    assert np.allclose(sigma, [cep, cep, 2 * cep, 0.05, 0.05, 0.05], rtol=0.02)
+    settings = gnss.GnssSettings(0.0, 0.0, 0.0, 0.03, 0.0, latency_ticks=3)
+    memory = gnss.memory(settings)
+    draws = np.zeros((10, gnss.DRAW_COLUMNS))
+    draws[:, gnss.DRAW_DELIVERED] = 1.0
+    arrivals = {}
+    for tick in range(12):
+        gnss.measure(gnss.constants(settings, 4), draws, memory, tick,
+                     _truth([0.01 * tick, 0.0, 0.0], [1.0, 0.0, 0.0], (1.0, 0, 0, 0)), None)
+        if memory[ARRIVED] == tick:
+            arrivals[tick] = (memory[TAKEN], round(memory[OUTPUT], 12), memory[OUTPUT + 3])
+    assert arrivals == {0: (0, 0.0, 1.0), 7: (4, 0.04, 1.0), 11: (8, 0.08, 1.0)}
+    with pytest.raises(scenario_io.ScenarioError, match=r"gnss\.preset: 'gps' must be one of"):
+        _realistic(1.0, gnss={'preset': 'gps'})

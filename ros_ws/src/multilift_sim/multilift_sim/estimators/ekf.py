@@ -2,8 +2,11 @@
 docs/estimation.md): IMU propagation of position, velocity, attitude and the IMU's biases
 (`error_state.propagate`, at the IMU's rate), motion-capture updates of position and attitude
 (`error_state.fuse`, each sample when it arrives), the way PX4's EKF2 is built. Needs the
-scenario's `imu:` and `mocap:`. The filter assumes the sensors' own noise model (their keys:
-densities, random walks, noise deviations), so its consistency can be checked (NEES, NIS).
+scenario's `imu:` and `mocap:`; without motion capture it fuses `gnss:` (position and
+velocity; its attitude then starts from a prior, level with yaw 0, `initial_attitude_noise`,
+and its yaw is seen only when the UAV accelerates). The filter assumes the sensors' own noise
+model (their keys: densities, random walks, noise deviations), so its consistency can be
+checked (NEES, NIS).
 
 Delayed samples, as PX4's EKF2 fuses them: the filter itself runs on a delayed horizon, the
 motion capture's latency (L ticks) behind now, where each sample is fused at the tick it was
@@ -39,25 +42,27 @@ from multilift_sim.physics.attitude import attitude_difference, quaternion_rotat
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
                                           MEASURED_POSITION, MEASURED_VELOCITY)
 from multilift_sim.physics.measurement import quaternion_euler
-from multilift_sim.sensors import imu, mocap
+from multilift_sim.sensors import gnss, imu, mocap
 from multilift_sim.sensors.outputs import ARRIVED, OUTPUT, TAKEN
 
 NAME = 'ekf'
-UNITS = {'initial_velocity_noise': 'm/s'}
-NEEDS = (imu.NAME, mocap.NAME)  # the sensors it reads
+UNITS = {'initial_velocity_noise': 'm/s', 'initial_attitude_noise': 'rad'}
+AIDS = (mocap.NAME, gnss.NAME)  # what it fuses: motion capture, else GNSS
 
 # -- its constants row -------------------------------------------------------------------------
 IMU_ROW = 0                 # the IMU's row in the run's sensor arrays
-AID_ROW = 1                 # the motion capture's
+AID_ROW = 1                 # the motion capture's (or the GNSS receiver's)
 IMU_PERIOD = 2              # the IMU's dt [s]
 GRAVITY = 3                 # g [m/s^2]
 NOISE = 4                   # the IMU's noise (4: error_state.NOISE_*)
-POSITION_VARIANCE = 8       # the motion capture's position noise variance [m^2]
-ATTITUDE_VARIANCE = 9       # its attitude noise variance [rad^2]
-INITIAL_VELOCITY_VARIANCE = 10  # [m^2/s^2]
-HISTORY_SLOTS = 11          # the ring's length: the motion capture's latency + 1 [ticks]
-RATE_VARIANCE = 12          # a gyro sample's white noise variance N^2 / dt [rad^2/s^2]
-CONSTANT_COLUMNS = 13
+AID_VARIANCE = 8            # the fused components' noise variances (6): motion capture's
+#                             position [m^2] and attitude [rad^2], GNSS's position, velocity
+INITIAL_VELOCITY_VARIANCE = 14  # [m^2/s^2]
+HISTORY_SLOTS = 15          # the ring's length: the aid's latency + 1 [ticks]
+RATE_VARIANCE = 16          # a gyro sample's white noise variance N^2 / dt [rad^2/s^2]
+AID_KIND = 17               # 0: motion capture, 1: GNSS
+INITIAL_ATTITUDE_VARIANCE = 18  # with GNSS: the level, yaw-0 prior's [rad^2]
+CONSTANT_COLUMNS = 19
 # -- one UAV's memory --------------------------------------------------------------------------
 #    first the estimate as published (estimators.published, ESTIMATE_COLUMNS), then
 LAST_TICK = ESTIMATE_COLUMNS  # the tick estimated last (-1: none)
@@ -76,43 +81,61 @@ UPDATE_DOF = 6              # the NIS's degrees of freedom: position and attitud
 
 @dataclass(frozen=True)
 class EkfSettings:
-    initial_velocity_noise: float    # [m/s], per axis
+    initial_velocity_noise: float    # [m/s], per axis (with motion capture)
+    initial_attitude_noise: float    # [rad], per axis (with GNSS: the prior level, yaw 0)
 
 
 def parse(d) -> EkfSettings:
-    return EkfSettings(initial_velocity_noise=d.non_negative('initial_velocity_noise', 0.01))
+    return EkfSettings(initial_velocity_noise=d.non_negative('initial_velocity_noise', 0.01),
+                       initial_attitude_noise=d.non_negative('initial_attitude_noise', 0.05))
 
 
 def needs(sensor_names) -> str:
-    """'' when the scenario has the sensors it reads, else what is missing."""
-    missing = [name for name in NEEDS if name not in sensor_names]
-    return f'needs the sensors {", ".join(missing)} (sections {missing[0]}: ...)' if missing \
-        else ''
+    """'' when the scenario has the sensors it reads (`imu`, and `mocap` or `gnss`), else
+    what is missing."""
+    if imu.NAME not in sensor_names:
+        return 'needs the sensors imu (section imu: ...)'
+    if not any(aid in sensor_names for aid in AIDS):
+        return 'needs the sensors mocap or gnss (section mocap: or gnss: ...)'
+    return ''
 
 
 def _config(scenario, name):
-    return next(c for c in scenario.sensor_suite if c.model == name)
+    return next((c for c in scenario.sensor_suite if c.model == name), None)
+
+
+def _aid(scenario):
+    """The sensor it fuses: the motion capture, else the GNSS receiver."""
+    return _config(scenario, mocap.NAME) or _config(scenario, gnss.NAME)
 
 
 def constants(settings: EkfSettings, scenario, rows: dict) -> np.ndarray:
-    """Its row from the scenario's IMU and motion capture (their settings: the filter assumes
-    the sensors' own noise)."""
-    unit, aid = _config(scenario, imu.NAME).settings, _config(scenario, mocap.NAME).settings
+    """Its row from the scenario's IMU and aid (their settings: the filter assumes the
+    sensors' own noise)."""
+    unit, config = _config(scenario, imu.NAME).settings, _aid(scenario)
+    aid = config.settings
     row = np.zeros(CONSTANT_COLUMNS)
-    row[IMU_ROW], row[AID_ROW] = rows[imu.NAME], rows[mocap.NAME]
+    row[IMU_ROW], row[AID_ROW] = rows[imu.NAME], rows[config.model]
     row[IMU_PERIOD], row[GRAVITY] = unit.period, unit.gravity
     row[NOISE + NOISE_ACCEL], row[NOISE + NOISE_GYRO] = unit.noise_density
     row[NOISE + NOISE_ACCEL_WALK], row[NOISE + NOISE_GYRO_WALK] = unit.random_walk
-    row[POSITION_VARIANCE] = aid.position_noise ** 2
-    row[ATTITUDE_VARIANCE] = aid.attitude_noise ** 2
+    if config.model == mocap.NAME:
+        row[AID_VARIANCE:AID_VARIANCE + 6] = np.repeat(
+            [aid.position_noise ** 2, aid.attitude_noise ** 2], 3)
+    else:
+        row[AID_KIND] = 1.0
+        row[AID_VARIANCE:AID_VARIANCE + 6] = np.array(
+            [aid.horizontal_position_noise] * 2 + [aid.vertical_position_noise]
+            + [aid.velocity_noise] * 3) ** 2
     row[INITIAL_VELOCITY_VARIANCE] = settings.initial_velocity_noise ** 2
+    row[INITIAL_ATTITUDE_VARIANCE] = settings.initial_attitude_noise ** 2
     row[HISTORY_SLOTS] = aid.latency_ticks + 1
     row[RATE_VARIANCE] = unit.noise_density[1] ** 2 / unit.period
     return row
 
 
 def memory(settings: EkfSettings, scenario) -> np.ndarray:
-    slots = _config(scenario, mocap.NAME).settings.latency_ticks + 1
+    slots = _aid(scenario).settings.latency_ticks + 1
     row = np.zeros(HISTORY + slots * SAMPLE)
     row[LAST_TICK] = row[NIS_TICK] = -1.0
     row[HISTORY::SAMPLE] = -1.0
@@ -121,36 +144,53 @@ def memory(settings: EkfSettings, scenario) -> np.ndarray:
 
 @jit
 def start(constants, aid, x, covariance):
-    """The nominal state and covariance at the first motion-capture sample (aid: its memory)."""
+    """The nominal state and covariance at the aid's first sample (aid: its memory): the
+    motion capture's pose (P its noise), at rest; or the GNSS's position and velocity (P its
+    noise), level with yaw 0 (the prior INITIAL_ATTITUDE_VARIANCE)."""
     x[:] = 0.0
-    for j in range(3):
-        x[NOMINAL_POSITION + j] = aid[OUTPUT + mocap.OUTPUT_POSITION + j]
-    for j in range(4):
-        x[NOMINAL_QUATERNION + j] = aid[OUTPUT + mocap.OUTPUT_QUATERNION + j]
     covariance[:, :] = 0.0
+    gnss_aid = constants[AID_KIND] == 1.0
     for j in range(3):
-        covariance[ERROR_POSITION + j, ERROR_POSITION + j] = constants[POSITION_VARIANCE]
-        covariance[ERROR_VELOCITY + j, ERROR_VELOCITY + j] = constants[
-            INITIAL_VELOCITY_VARIANCE]
-        covariance[ERROR_ATTITUDE + j, ERROR_ATTITUDE + j] = constants[ATTITUDE_VARIANCE]
+        x[NOMINAL_POSITION + j] = aid[OUTPUT + j]  # both outputs start with the position
+        covariance[ERROR_POSITION + j, ERROR_POSITION + j] = constants[AID_VARIANCE + j]
+        if gnss_aid:
+            x[NOMINAL_VELOCITY + j] = aid[OUTPUT + gnss.OUTPUT_VELOCITY + j]
+            covariance[ERROR_VELOCITY + j, ERROR_VELOCITY + j] = constants[AID_VARIANCE + 3 + j]
+            covariance[ERROR_ATTITUDE + j, ERROR_ATTITUDE + j] = constants[
+                INITIAL_ATTITUDE_VARIANCE]
+        else:
+            covariance[ERROR_VELOCITY + j, ERROR_VELOCITY + j] = constants[
+                INITIAL_VELOCITY_VARIANCE]
+            covariance[ERROR_ATTITUDE + j, ERROR_ATTITUDE + j] = constants[AID_VARIANCE + 3 + j]
+    if gnss_aid:
+        x[NOMINAL_QUATERNION] = 1.0
+    else:
+        for j in range(4):
+            x[NOMINAL_QUATERNION + j] = aid[OUTPUT + mocap.OUTPUT_QUATERNION + j]
 
 
 @jit
 def update(constants, aid, x, covariance, memory, tick):
-    """The motion-capture sample that arrived at `tick` fused into the delayed horizon's
-    nominal state x and covariance (the tick it was taken); its NIS kept."""
+    """The aid's sample that arrived at `tick` fused into the delayed horizon's nominal state x
+    and covariance (the tick it was taken): the motion capture's position and attitude, or the
+    GNSS's position and velocity; its NIS kept."""
     correction = np.zeros(ERROR_SIZE)
     nis = 0.0
     for j in range(3):
         nis += fuse(covariance, correction, ERROR_POSITION + j,
-                    aid[OUTPUT + mocap.OUTPUT_POSITION + j] - x[NOMINAL_POSITION + j],
-                    constants[POSITION_VARIANCE])
-    q = OUTPUT + mocap.OUTPUT_QUATERNION
-    seen = attitude_difference(x, NOMINAL_QUATERNION, aid[q], aid[q + 1], aid[q + 2],
-                               aid[q + 3])
-    for j in range(3):
-        nis += fuse(covariance, correction, ERROR_ATTITUDE + j, seen[j],
-                    constants[ATTITUDE_VARIANCE])
+                    aid[OUTPUT + j] - x[NOMINAL_POSITION + j], constants[AID_VARIANCE + j])
+    if constants[AID_KIND] == 1.0:
+        for j in range(3):
+            nis += fuse(covariance, correction, ERROR_VELOCITY + j,
+                        aid[OUTPUT + gnss.OUTPUT_VELOCITY + j] - x[NOMINAL_VELOCITY + j],
+                        constants[AID_VARIANCE + 3 + j])
+    else:
+        q = OUTPUT + mocap.OUTPUT_QUATERNION
+        seen = attitude_difference(x, NOMINAL_QUATERNION, aid[q], aid[q + 1], aid[q + 2],
+                                   aid[q + 3])
+        for j in range(3):
+            nis += fuse(covariance, correction, ERROR_ATTITUDE + j, seen[j],
+                        constants[AID_VARIANCE + 3 + j])
     inject(x, covariance, correction)
     memory[NIS] = nis
     memory[NIS_TICK] = tick

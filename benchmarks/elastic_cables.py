@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""What elastic cables cost (issue 32 item 7): the simulator's advance per control tick (the
-physics of a 10 ms tick: its RK4 steps and their sub-steps, the check, the statistics) of
-`twin_lift` on rigid cables against `twin_lift_elastic` (2 mm Dyneema, EA = 1.5e5 N) and the
-same twin-lift on stiffer ropes, each with the sub-steps its validation asks for; the rotors
+"""What elastic cables and winches cost (issue 32 item 7): the simulator's advance per control
+tick (the physics of a 10 ms tick: its RK4 steps and their sub-steps, the check, the
+statistics) of `twin_lift` on rigid cables against `twin_lift_elastic` (2 mm Dyneema, EA =
+1.5e5 N), the same twin-lift on stiffer ropes, each with the sub-steps its validation asks for,
+and both with winches reeling (0.1 m/s paid out from t = 0, `uavs[i].winch`); the rotors
 held at their hover speeds (no controller), CPU time per tick, the best of three passes; then
 the real-time factor of a whole `scripts/multilift run twin_lift_elastic --headless` (the
 process's wall time, start-up included, and the simulated time over the simulator's own).
@@ -46,6 +47,19 @@ def variant(name: str, seconds: float, axial_stiffness: float | None = None):
         except scenario_io.ScenarioError as exc:
             needed = re.search(r'substeps >= (\d+)', str(exc))
             data['simulation']['substeps'] = int(needed.group(1))
+    return scenario_io.loads(yaml.safe_dump(data))
+
+
+def reeling(scenario_name: str, seconds: float):
+    """Scenario `name` flown `seconds` [s] with a winch on each UAV paying out 0.1 m/s from
+    t = 0 (the reel's arithmetic in every RK4 stage)."""
+    data = yaml.safe_load(resolve(scenario_name).read_text())
+    data['simulation']['duration'] = seconds
+    for uav in data['uavs']:
+        uav['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5, 'min_length': 2.0,
+                        'max_length': 20.0}
+    data['events'] = [{'time': 0.0, 'type': 'winch_rate', 'uav': i + 1, 'rate': 0.1}
+                      for i in range(len(data['uavs']))]
     return scenario_io.loads(yaml.safe_dump(data))
 
 
@@ -95,6 +109,8 @@ def main() -> None:
              ('twin_lift_elastic (EA 1.5e5 N)', variant('twin_lift_elastic', args.seconds))]
     cases += [(f'twin_lift_elastic at EA {ea:.2g} N',
                variant('twin_lift_elastic', args.seconds, ea)) for ea in (1.5e6, 1.5e7)]
+    cases += [(f'{name} with winches reeling', reeling(name, args.seconds))
+              for name in ('twin_lift', 'twin_lift_elastic')]
     print(f'advance per control tick (100 Hz), {args.seconds:g} s at hover, CPU [us]:')
     rigid = None
     for label, scenario in cases:

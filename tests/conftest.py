@@ -273,3 +273,24 @@ def started_run(args: list[str], env: dict) -> Iterator[tuple[subprocess.Popen, 
         if run.poll() is None:
             os.killpg(run.pid, signal.SIGKILL)
             run.wait(timeout=30)
+
+
+def collide_scenario(on_contact: str) -> dict:
+    """A scenario's mapping built to collide (issue 34, tests of contact): cf2_payload flown
+    straight along x through a pillar (a cylinder 0.1 m thick) 1 m ahead of the leader, with
+    `world.on_contact` as given."""
+    import copy
+
+    import yaml
+    base = Path(__file__).resolve().parents[1] / 'scenarios' / 'cf2_payload.yaml'
+    data = copy.deepcopy(yaml.safe_load(base.read_text()))
+    data['name'] = f'collide_{on_contact}'
+    data['simulation']['duration'] = 6.0
+    data['vehicle']['radius'] = 0.06
+    data['payload']['radius'] = 0.02
+    data['mission']['waypoints'] = [data['mission']['waypoints'][0],
+                                    {'time': 4.0, 'position': [1.8, 0.0, 1.0417424305044158]}]
+    data['world'] = {'ground': 0.0, 'on_contact': on_contact, 'obstacles': [
+        {'name': 'pillar', 'type': 'cylinder', 'center': [1.0, 0.0, 1.0], 'radius': 0.1,
+         'height': 2.0}]}
+    return data

@@ -238,7 +238,7 @@ def test_the_registries_are_the_scenario_s_and_an_unknown_law_is_an_error():
     assert controllers.FOLLOWER_CONTROLLERS is scenario_io.FOLLOWER_CONTROLLERS
     assert list(scenario_io.leader_controllers()) == ['cascade', 'constant_rotor_speed']
     assert list(scenario_io.follower_controllers()) == ['virtual_constraints', 'thrust_margin',
-                                                       'cable_forces']
+                                                       'cable_forces', 'heading']
     leader = controllers.LeaderController(scenario_io.load('single_lift'))
     c = leader.cascade
     arguments = (leader.constants, leader.memory, c.constants, c.mixer.rows, leader.path.mission,

@@ -272,9 +272,9 @@ def test_every_command_of_the_user_guide(multilift_domain, tmp_path):
     assert int(counts['/visualization/markers']) in (1200, 1201)
     assert 'Duration:          120.0' in info
 
-    # plots: "Ten PNG figures"
-    assert 'Ten PNG figures' in page
-    assert len(list((runs / 'twin_lift' / 'plots').glob('*.png'))) == 10
+    # plots: "Eleven PNG figures"
+    assert 'Eleven PNG figures' in page
+    assert len(list((runs / 'twin_lift' / 'plots').glob('*.png'))) == 11
 
     # the headless run: 5 s simulated
     headless = json.loads((runs / 'twin_lift_5s' / 'summary.json').read_text())

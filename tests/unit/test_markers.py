@@ -152,3 +152,30 @@ def test_round_trip_and_five_uavs(twin):
     assert len(five.markers) == len(array.markers) + 3 * 3
     with pytest.raises(ValueError, match='2 UAVs'):
         formation_markers(snapshot, [4.0], scenario, 0)
+
+
+def test_obstacles_are_drawn_at_their_size_and_yaw():
+    # window's walls are boxes, forest's trees cylinders; a turned sphere-free box and a ball
+    # added to the window: each marker at its centre, its full size, turned by its yaw
+    import math
+
+    from multilift_sim.wire.scene import obstacle_specs
+    scenario = scenario_io.load('window')
+    ball = dataclasses.replace(scenario.world.obstacles[0], name='ball', type='sphere',
+                               half=(0.2, 0.2, 0.2), center=(3.0, 1.0, 1.0))
+    turned = dataclasses.replace(scenario.world.obstacles[0], name='turned',
+                                 yaw=math.radians(30.0))
+    world = dataclasses.replace(scenario.world,
+                                obstacles=scenario.world.obstacles + (ball, turned))
+    specs = obstacle_specs(dataclasses.replace(scenario, world=world))
+    assert [(s.ns, s.id) for s in specs] == [('obstacle', k) for k in range(6)]
+    wall = specs[0]
+    assert wall.type == Marker.CUBE and wall.scale == pytest.approx((0.05, 1.35, 2.2))
+    assert wall.position == pytest.approx([1.5, 0.825, 1.1])
+    assert specs[4].type == Marker.SPHERE and specs[4].scale == pytest.approx((0.4,) * 3)
+    q = specs[5].orientation  # (x, y, z, w) of 30 deg about z
+    assert q == pytest.approx([0.0, 0.0, math.sin(math.radians(15)), math.cos(math.radians(15))])
+    trees = obstacle_specs(scenario_io.load('forest'))
+    assert all(t.type == Marker.CYLINDER and t.scale == pytest.approx((0.16, 0.16, 3.0))
+               for t in trees)
+    assert obstacle_specs(scenario_io.load('twin_lift')) == []  # no world: nothing drawn

@@ -276,8 +276,8 @@ def _printed_paths(out: str) -> list[Path]:
 
 
 ALL_FIGURES = {'trajectories_3d', 'top_view', 'cable_constraints', 'cable_tensions',
-               'formation_errors', 'attitude', 'thrust', 'rotor_speeds', 'payload_position',
-               'leader_tracking'}
+               'formation_errors', 'attitude', 'thrust', 'rotor_speeds', 'thrust_margins',
+               'payload_position', 'leader_tracking'}
 
 
 def test_plot_writes_every_figure(bags, capsys):
@@ -383,3 +383,31 @@ def test_plot_draws_the_ropes_of_an_elastic_run_only(bags, tmp_path, capsys):
     written = _printed_paths(capsys.readouterr().out)
     assert {p.stem for p in written} == ALL_FIGURES | {'rope_stretch'}
     _pngs_ok(written)
+
+
+def test_plot_draws_the_clearance_of_a_run_with_a_world(tmp_path, capsys):
+    """A run whose summary gives clearances (a `world:` section) gets clearance.png, the
+    obstacles drawn in the views; the twin-lift's bag skips it, saying why. The series is the
+    tick's measure at given states: beside window's wall, checked by hand."""
+    from multilift_sim.statistics.clearance import clearance_series
+    from multilift_sim.scenario import load
+    world = tmp_path / 'world'
+    make_bag(world, 2, scenario='window')
+    summary = json.loads((world / 'summary.json').read_text())
+    summary['sim'].update(clearance={}, least_clearance=None, contact=None)
+    (world / 'summary.json').write_text(json.dumps(summary))
+    assert plot_main([str(world), '--out', str(tmp_path / 'figs')]) == 0
+    written = _printed_paths(capsys.readouterr().out)
+    assert {p.stem for p in written} == ALL_FIGURES | {'clearance'}
+    _pngs_ok(written)
+    make_bag(tmp_path / 'twin', 2, scenario='twin_lift')
+    assert plot_main([str(tmp_path / 'twin'), '--out', str(tmp_path / 'twin_figs')]) == 0
+    assert 'skipped clearance: no clearances' in capsys.readouterr().err
+    # uav1 at (1, 0, 1.5), 0.475 m before the wall's face and 0.15 m off the window's left
+    # edge (wall_left): sqrt(0.475^2 + 0.15^2) less its radius 0.07; uav2 0.5 m behind it
+    scenario = load('window')
+    level = np.tile([1.0, 0.0, 0.0, 0.0], (2, 1, 1))
+    series = clearance_series(scenario, np.array([[[1.0, 0.0, 1.5]], [[0.5, 0.0, 1.5]]]),
+                              level, np.array([[0.75, 0.0, 1.067]]))
+    assert series[0, 0] == pytest.approx(math.hypot(0.475, 0.15) - 0.07, abs=1e-12)
+    assert series[0, 3] == pytest.approx(0.5 - 0.14, abs=1e-12)  # UAV - UAV

@@ -21,6 +21,7 @@ from multilift_sim.drives import drive_table, spline_drive
 from multilift_sim.formation_params import StateLayout, constant_arrays
 from multilift_sim.physics import prescribed
 from multilift_sim.physics.formation_dae import integrate_period
+from multilift_sim.physics.layout import FORMATION_PRESCRIBED, FORMATION_SCALARS
 from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_TIME, WRENCH_COLUMNS,
                                           DRIVE_EULER)
 from multilift_sim.simulation import FormationSimulator
@@ -142,8 +143,8 @@ def test_a_positions_only_file_is_splined_through_its_rows_with_its_motion(tmp_p
     times = np.arange(0.0, 10.05, 0.05)
     w = 1.5
     drive = spline_drive('f', times, np.stack([np.sin(w * times), 0 * times, 0 * times], 1))
-    formation = np.concatenate([np.zeros(19), drive_table([drive])])
-    formation[17] = 1.0
+    formation = np.concatenate([np.zeros(FORMATION_SCALARS), drive_table([drive])])
+    formation[FORMATION_PRESCRIBED] = 1.0
     evaluate = kernels.runnable(prescribed.drive_axis)
     for t in (0.0, 0.025, 3.3, 10.0):
         value, rate, acceleration = evaluate(formation, drive_of(formation), 0, t)
@@ -165,8 +166,8 @@ def test_velocities_and_accelerations_are_the_files_and_continuous():
     for given in (accelerations, None):
         drive = spline_drive('f', times, positions, velocities, given,
                              euler=rng.normal(size=(8, 3)) * 0.1)
-        formation = np.concatenate([np.zeros(19), drive_table([drive])])
-        formation[17] = 1.0
+        formation = np.concatenate([np.zeros(FORMATION_SCALARS), drive_table([drive])])
+        formation[FORMATION_PRESCRIBED] = 1.0
         evaluate = prescribed.drive_axis.py_func
         for k, t in enumerate(times):
             for axis in range(3):

@@ -84,6 +84,8 @@ def test_every_figure_of_the_report_is_committed_and_modest(report_lines):
     assert numbers == ['2.12'] + [f'4.{k}' for k in range(1, 18)]
     beyond = re.findall(r'\(figures/(swing_feedback_[a-z_]+\.png)\)', text)  # issue 20
     assert beyond == ['swing_feedback_single_lift.png', 'swing_feedback_twin_lift.png']
-    assert len(links) == len(numbers) + len(beyond)
+    shared = re.findall(r'\(figures/(load_sharing\.png)\)', text)  # issue 35
+    assert shared == ['load_sharing.png']
+    assert len(links) == len(numbers) + len(beyond) + len(shared)
     sizes = [(REPORT.parent / link).stat().st_size for link in links]
     assert sum(sizes) < 8e6

@@ -155,7 +155,7 @@ def test_a_reeled_run_compiled_equals_its_uncompiled_source(monkeypatch):
             data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
             data['uavs'][0]['winch'] = WINCH
             data.update(events=events, **cable)
-            data['simulation'].update(duration=1.2, substeps=2)
+            data['simulation'].update(duration=1.2, substeps=4)   # checked at min_length
             s = scenario_io.loads(yaml.safe_dump(data))
         monkeypatch.setenv('MULTILIFT_KERNEL', 'auto')
         compiled = run_headless(s).simulator.state
@@ -166,3 +166,31 @@ def test_a_reeled_run_compiled_equals_its_uncompiled_source(monkeypatch):
         stretch = np.linalg.norm(layout.payload_position(compiled)
                                  - layout.uav_positions(compiled)[0])
         assert stretch > s.uavs[0].cable_length + 0.2    # paid out 0.24 m (a 0.8 s ramp)
+
+
+def test_a_winched_bag_carries_the_lengths_and_plots_them(tmp_path):
+    """The headless bag's /uav1/cable_length is the reel's length at every tick, which
+    `multilift plot` draws (cable_lengths.png) and the rope figure is skipped for."""
+    from multilift_tools.bagdata import load_run
+    from multilift_tools.figures import plot_main
+    from multilift_tools.headless_bag import record_headless
+    s = _single_lift([{'time': 0.5, 'type': 'winch_rate', 'uav': 1, 'rate': 0.3}], 3.0)
+    record_headless(s, tmp_path / 'bag')
+    t, lengths = load_run(tmp_path / 'bag').cable_lengths(1)
+    reel, _ = _reels(s)
+    np.testing.assert_array_equal(lengths, reel)          # every tick's, t = 0 to t_max
+    assert lengths[0] == 2.5 and lengths[-1] > 2.5 + 0.5 and t[-1] == pytest.approx(3.0)
+    assert plot_main([str(tmp_path / 'bag'), '--out', str(tmp_path / 'plots')]) == 0
+    assert (tmp_path / 'plots' / 'cable_lengths.png').stat().st_size > 0
+
+
+def test_an_elastic_rope_s_stepping_is_checked_at_the_winch_s_shortest_length():
+    """EA / l grows as the winch hauls in: a rope stepped well enough at its length is refused
+    when its winch may reel it to a fifth of it (omega h times sqrt 5), naming the sub-steps."""
+    data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
+    data.update(cable_model='elastic', cable={'axial_stiffness': 2e4})
+    data['simulation']['substeps'] = 4                            # omega h = 0.25
+    scenario_io.loads(yaml.safe_dump(data))                       # flies without a winch
+    data['uavs'][0]['winch'] = dict(WINCH, min_length=0.5)        # 5x stiffer: omega h 0.56
+    with pytest.raises(scenario_io.ScenarioError, match='set simulation.substeps >= '):
+        scenario_io.loads(yaml.safe_dump(data))

@@ -44,7 +44,7 @@ class HeadlessRun:
         'follower2': ...} (the same keys and definitions the nodes leave)."""
         sim = dict(self.simulator.stats.as_dict(), wall_time=self.wall_time, error=self.error,
                    scenario=self.scenario.name, events=self.simulator.events_summary(),
-                   seeds=run_seeds(self.scenario))
+                   seeds=run_seeds(self.scenario), **self.simulator.clearance_summary())
         return {'sim': sim, **{r.name: r.summary() for r in self.runtimes}}
 
 

@@ -46,6 +46,8 @@ class MultirotorParams:
     # the UAV's quadratic drag in the wind, -c_d |v - w| (v - w) (not in the seed, whose UAVs
     # meet no air)
     drag_coefficient: float = 0.0        # c_d [N s^2/m^2]
+    # the sphere about r_i that the clearance checks keep clear (physics.clearance; issue 34)
+    radius: float = 0.0                  # [m]
 
     def __post_init__(self) -> None:
         rotor_count(self.frame_type)  # ValueError naming the valid frame types

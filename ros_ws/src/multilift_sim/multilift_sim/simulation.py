@@ -30,6 +30,8 @@ from multilift_sim.schedules import event_records
 from multilift_sim.statistics import RunStatistics
 from multilift_sim.statistics.layout import (CHECK_G, CHECK_NON_FINITE, CHECK_QUATERNION,
                                              QUATERNION_NORM_TOLERANCE)
+from multilift_sim.physics.layout import STATUS_CONTACT
+from multilift_sim.statistics.clearance import clearance_figures, contact_message
 from multilift_sim.tick_arrays import (STOP_CHECKS, PhysicsArrays, PhysicsMemory,
                                        physics_fields, stacked)
 
@@ -290,9 +292,17 @@ class FormationSimulator:
         """The events that have happened, as the run's summary names them."""
         return event_records(self.arrays.events[0, :int(self.memory.next_event[0])])
 
+    def clearance_summary(self) -> dict:
+        """The clearances so far (`statistics.clearance.clearance_figures`; {} without a
+        `world:` section)."""
+        return clearance_figures(self.scenario, self.memory.clearance[0], self.memory.contact[0])
+
     def _raise_if_stopped(self) -> None:
-        """SimulationStopped naming why, where Algorithm 1's check stopped the run."""
+        """SimulationStopped naming why, where Algorithm 1's check or a contact stopped the
+        run."""
         status = int(self.memory.status[0])
+        if status == STATUS_CONTACT:
+            raise SimulationStopped(contact_message(self.scenario, self.memory.contact[0]))
         if status in STOP_CHECKS:
             raise SimulationStopped(stop_message(
                 STOP_CHECKS[status], int(self.memory.worst_cable[0]),

@@ -17,10 +17,12 @@ import numpy as np
 
 from multilift_sim.cables import CABLE_MODELS
 from multilift_sim.formulations import Formulation, make_formulation
-from multilift_sim.physics.layout import (REEL_COLUMNS, REEL_LENGTH, STATUS_QUATERNION,
+from multilift_sim.physics.layout import (CLEARANCE_COLUMNS, CLEARANCE_KINDS, CLEARANCE_VALUE,
+                                          REEL_COLUMNS, REEL_LENGTH, STATUS_QUATERNION,
                                           STATUS_NOT_FINITE,
                                           STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
 from multilift_sim.scenario import Scenario
+from multilift_sim.scenario.world import world_arrays
 from multilift_sim.schedules import event_array, wind_series
 from multilift_sim.estimators.arrays import estimator_arrays
 from multilift_sim.sensors.arrays import sensor_arrays
@@ -59,6 +61,10 @@ class PhysicsArrays(NamedTuple):
     tolerances: np.ndarray        # (B, 2): |g| [m^2], |g_dot| [m^2/s]
     swing_every: np.ndarray       # (B,) int: the payload swing sampled every this many ticks
     reach: np.ndarray             # (B, n) [m]: each cable's reach for the swing's equilibrium
+    # the world the clearances are measured against (`world:`; physics.clearance)
+    world: np.ndarray             # (B, WORLD_COLUMNS): checked, ground, payload radius, record
+    obstacles: np.ndarray         # (B, k, OBSTACLE_COLUMNS): the obstacles (k = 0: none)
+    uav_radii: np.ndarray         # (B, n) [m]: each UAV's sphere (vehicle.radius)
 
 
 class PhysicsMemory(NamedTuple):
@@ -84,6 +90,8 @@ class PhysicsMemory(NamedTuple):
     run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
     reel: np.ndarray              # (B, n, REEL_COLUMNS): each cable's length [m], its reel's
     #                               rate [m/s] and command [m/s] (physics.winch)
+    clearance: np.ndarray         # (B, CLEARANCE_KINDS, CLEARANCE_COLUMNS): least of each kind
+    contact: np.ndarray           # (B, CLEARANCE_COLUMNS): the first contact (KIND -1: none)
 
 
 def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tuple[dict, dict]:
@@ -115,7 +123,10 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         # (cables that stretch are no constraints: Algorithm 1's check of g does not apply)
         tolerances=(np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance])
                     if cables.KEEPS_LENGTH else np.full(2, math.inf)),
-        swing_every=swing_sampling(n), reach=cable_reach(scenario))
+        swing_every=swing_sampling(n), reach=cable_reach(scenario),
+        **dict(zip(('world', 'obstacles', 'uav_radii'), world_arrays(scenario))))
+    clearance = np.zeros((CLEARANCE_KINDS, CLEARANCE_COLUMNS))
+    clearance[:, CLEARANCE_VALUE] = math.inf  # none measured yet
     memory = dict(
         state=state, taut=np.ones(n, dtype=bool), rotors=np.full(rotors, math.nan),
         effectiveness=np.ones(rotors), released=np.zeros(n, dtype=bool), next_event=0,
@@ -123,7 +134,8 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         held_saturated=np.zeros(rotors, dtype=bool), tick=0, status=STATUS_RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n), gust=np.zeros(3),
         sensor_memory=sensors.memory, estimator_memory=estimator.memory,
-        run=RunStatistics(n).run, reel=reel_memory(scenario))
+        run=RunStatistics(n).run, reel=reel_memory(scenario),
+        clearance=clearance, contact=np.full(CLEARANCE_COLUMNS, -1.0))
     return arrays, memory
 
 

@@ -41,6 +41,7 @@ STATISTIC_UNITS: dict[str, str] = {
     # |g_vc| rows of the followers: m for a linear geometry's rows, m^2 for a distance row
     'formation_error_max': 'm or m^2',
     'formation_error_mean': 'm or m^2',
+    'least_clearance': 'm',           # of every kind (`world:`, physics.clearance); none: None
 }
 
 TABLE_UNITS: dict[str, str] = {
@@ -53,7 +54,7 @@ VEHICLE_UNITS: dict[str, str] = {
     'mass': 'kg', 'inertia': 'kg m^2', 'inertia_source': NO_UNIT, 'frame_type': NO_UNIT,
     'arm_length': 'm', 'thrust_coefficient': 'N s^2/rad^2', 'moment_coefficient': 'N m s^2/rad^2',
     'rotor_speed_min': 'rad/s', 'rotor_speed_max': 'rad/s', 'motor_time_constant': 's',
-    'motor_rate_limit': 'rad/s^2', 'drag_coefficient': 'N s^2/m^2',
+    'motor_rate_limit': 'rad/s^2', 'drag_coefficient': 'N s^2/m^2', 'radius': 'm',
 }
 
 # an elastic rope's keys (`cable:` and `uavs[i].cable:`, multilift_sim.cables.elastic)
@@ -89,7 +90,12 @@ SCENARIO_UNITS: dict[str, str] = {
     'payload.alpha_deg': 'deg', 'payload.beta_deg': 'deg', 'payload.swing_deg': 'deg',
     'payload.shape': NO_UNIT, 'payload.size': 'm', 'payload.inertia': 'kg m^2',
     'payload.attach_points': 'm', 'payload.initial_position': 'm',
-    'payload.initial_velocity': 'm/s',
+    'payload.initial_velocity': 'm/s', 'payload.radius': 'm',
+    'world.ground': 'm', 'world.on_contact': NO_UNIT, 'world.obstacles': NO_UNIT,
+    'world.obstacles[].type': NO_UNIT, 'world.obstacles[].name': NO_UNIT,
+    'world.obstacles[].center': 'm', 'world.obstacles[].size': 'm',
+    'world.obstacles[].radius': 'm', 'world.obstacles[].height': 'm',
+    'world.obstacles[].yaw': 'rad',
     'gusts[].center': 'm', 'gusts[].direction': NO_UNIT, 'gusts[].gradient_distance': 'm',
     'gusts[].reference_speed': 'm/s',
     'wind.velocity': 'm/s',  # a wind model's keys: its UNITS (multilift_sim.wind)

@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 
 from multilift_sim.kinematics import euler_from_quaternion
-from multilift_sim.topics import (ATTITUDE_SETPOINT, EVENTS, FORMATION_ERROR, FORMATION_STATE,
+from multilift_sim.topics import (ATTITUDE_SETPOINT, CABLE_LENGTH, EVENTS, FORMATION_ERROR,
+                                  FORMATION_STATE,
                                   ODOM, PAYLOAD_GUST, PAYLOAD_ODOM, REFERENCE_TOPIC, ROTOR_CMD,
                                   uav_topic)
 from multilift_tools.bagfields import EXTRACT, RunDataError, wanted_type
@@ -138,6 +139,10 @@ class Run:
         """(n, T, 3) UAV positions, world [m], on the time base `t`."""
         return self._uav_field('position')
 
+    def uav_orientations(self) -> np.ndarray:
+        """(n, T, 4) the UAVs' odometry quaternions (x, y, z, w), body FLU -> world."""
+        return self._uav_field('orientation')
+
     def uav_euler(self) -> np.ndarray:
         """(n, T, 3) ZYX Euler angles (roll, pitch, yaw) [rad] from the odometry quaternions."""
         return euler_from_quaternion(self._uav_field('orientation'))
@@ -179,6 +184,12 @@ class Run:
     def taut(self) -> np.ndarray:
         """(T, n) bool: which cables are taut (always all with cable_model: rigid)."""
         return self.topic(FORMATION_STATE)['taut'].astype(bool)
+
+    def cable_lengths(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """((T,) times [s], (T,) lengths [m]) of UAV i's (from 1) cable, reeled by its winch
+        (/uav{i}/cable_length, a run with winches; its log times, simulated)."""
+        series = self.topic(uav_topic(i, CABLE_LENGTH))
+        return series.t, series['data']
 
     def g(self) -> np.ndarray:
         """(T, n) cable constraints g_i = |r_p - r_i|^2 - l_i^2 [m^2]."""
@@ -308,11 +319,12 @@ def load_run(bag_dir: str | Path) -> Run:
             connections = [c for c in reader.connections if wanted_type(c.topic) == c.msgtype]
             # (an empty list would mean every connection to rosbags)
             messages = reader.messages(connections=connections) if connections else ()
-            for connection, _, raw in messages:
+            for connection, log_ns, raw in messages:
                 msg = reader.deserialize(raw, connection.msgtype)
-                stamp = msg.header.stamp
-                stamps.setdefault(connection.topic, []).append(
-                    stamp.sec + 1e-9 * stamp.nanosec)
+                header = getattr(msg, 'header', None)  # none: its log time (simulated time in
+                stamps.setdefault(connection.topic, []).append(  # our bags, recording.LogTime)
+                    log_ns * 1e-9 if header is None else
+                    header.stamp.sec + 1e-9 * header.stamp.nanosec)
                 rows.setdefault(connection.topic, []).append(EXTRACT[connection.msgtype](msg))
     except AnyReaderError as exc:
         raise RunDataError(f'cannot read bag {path}: {exc}') from None

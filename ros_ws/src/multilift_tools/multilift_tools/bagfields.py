@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-from multilift_sim.topics import (ATTITUDE_SETPOINT_TYPE, FORMATION_ERROR_TYPE,
+from multilift_sim.topics import (ATTITUDE_SETPOINT_TYPE, FLOAT64_TYPE, FORMATION_ERROR_TYPE,
                                   FORMATION_EVENT_TYPE, FORMATION_STATE_TYPE, ODOMETRY_TYPE,
                                   ROTOR_COMMAND_TYPE, TRACKING_REFERENCE_TYPE,
                                   VECTOR3_STAMPED_TYPE, topic_type)
@@ -59,6 +59,10 @@ def _vector3_stamped(msg: Any) -> dict[str, Any]:
     return {'vector': _vec(msg.vector)}
 
 
+def _float64(msg: Any) -> dict[str, Any]:
+    return {'data': float(msg.data)}
+
+
 def _formation_event(msg: Any) -> dict[str, Any]:
     return {'type': str(msg.type), 'uav': int(msg.uav), 'description': str(msg.description)}
 
@@ -68,6 +72,7 @@ EXTRACT: dict[str, Callable[[Any], dict[str, Any]]] = {
     ROTOR_COMMAND_TYPE: _rotor_command, ATTITUDE_SETPOINT_TYPE: _attitude_setpoint,
     TRACKING_REFERENCE_TYPE: _reference, FORMATION_ERROR_TYPE: _formation_error,
     VECTOR3_STAMPED_TYPE: _vector3_stamped, FORMATION_EVENT_TYPE: _formation_event,
+    FLOAT64_TYPE: _float64,
 }
 
 

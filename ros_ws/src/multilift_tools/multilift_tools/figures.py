@@ -27,8 +27,10 @@ from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, WORLD, Context,
                                         mark_events, parse_and_load, plot_context, plt,
                                         save_figure, shade_flags, uav_color, uav_label,
                                         uav_width)
-from multilift_tools.plots.ropes import fig_rope_stretch, lacks_ropes
-from multilift_tools.plots.rotors import fig_rotor_speeds, fig_thrust
+from multilift_tools.plots.obstacles import fig_clearance, lacks_world
+from multilift_tools.plots.ropes import (fig_cable_lengths, fig_rope_stretch, lacks_ropes,
+                                         lacks_winches)
+from multilift_tools.plots.rotors import fig_rotor_speeds, fig_thrust, fig_thrust_margins
 from multilift_tools.plots.scene import released_cables
 from multilift_tools.plots.views import fig_top_view, fig_trajectories_3d
 
@@ -234,10 +236,13 @@ FIGURES: tuple[FigureSpec, ...] = (
     FigureSpec('cable_constraints', fig_cable_constraints, _topics(FORMATION_STATE)),
     FigureSpec('cable_tensions', fig_tensions, _topics(FORMATION_STATE)),
     FigureSpec('rope_stretch', fig_rope_stretch, lacks_ropes),
+    FigureSpec('cable_lengths', fig_cable_lengths, lacks_winches),
+    FigureSpec('clearance', fig_clearance, lacks_world),
     FigureSpec('formation_errors', fig_formation_errors, _lacks_followers),
     FigureSpec('attitude', fig_attitude, _topics()),
     FigureSpec('thrust', fig_thrust, _topics(uav_topic(1, ATTITUDE_SETPOINT))),
     FigureSpec('rotor_speeds', fig_rotor_speeds, _topics(uav_topic(1, ROTOR_CMD))),
+    FigureSpec('thrust_margins', fig_thrust_margins, _topics(uav_topic(1, ROTOR_CMD))),
     FigureSpec('payload_position', fig_payload_position, _topics(PAYLOAD_ODOM)),
     FigureSpec('payload_attitude', fig_payload_attitude, _lacks_payload_attitude),
     FigureSpec('leader_tracking', fig_leader_tracking, _topics(REFERENCE_TOPIC)),

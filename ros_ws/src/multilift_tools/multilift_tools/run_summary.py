@@ -92,6 +92,10 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
             lines.append(f'  rope {i + 1}           max stretch {stretch:.3g} '
                          f'{unit_of("max_stretch")}, peak '
                          f'tension {peak:.2f} {unit_of("peak_tension")} (at the control ticks)')
+        for i in scenario.winches if 'longest_cable' in sim else ():  # a winch's reeled range
+            shortest, longest = sim['shortest_cable'][i - 1], sim['longest_cable'][i - 1]
+            lines.append(f'  cable {i} (winch)  length {shortest:.3f} .. {longest:.3f} '
+                         f'{unit_of("longest_cable")} (at the control ticks)')
         if sim.get('compressed_time'):
             lines.append(f'  warning: a cable pushed for {sim["compressed_time"]:.2f} '
                          f'{unit_of("compressed_time")} (least tension {sim["min_tension"]:.2f} '
@@ -118,6 +122,7 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
         if scenario.gusts:
             lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} '
                          f'{unit_of("max_gust_speed")}')
+        lines.extend(clearance_lines(sim))
         if sim.get('seeds'):
             lines.append('  seeds            ' + ', '.join(
                 f'{what} {seed}' for what, seed in sim['seeds'].items()))
@@ -178,4 +183,32 @@ def fault_lines(scenario, events: list[dict], t_end: float | None) -> list[str]:
             if live and mixer_row[MIXER_COLLECTIVE] <= 0.0:
                 lines.append(f'  uav{uav} rotor {r + 1}    pinned at its minimum speed by the '
                              f'reallocation from {start:g} s ({end - start:.2f} s)')
+    return lines
+
+
+# how the summary words each kind of clearance (statistics.clearance.KIND_NAMES)
+CLEARANCE_WORDS = {'uav_world': 'UAV - world', 'cable_world': 'cable - world',
+                   'payload_world': 'payload - world', 'uav_uav': 'UAV - UAV',
+                   'uav_cable': 'UAV - cable', 'cable_cable': 'cable - cable'}
+
+
+def clearance_lines(sim: dict) -> list[str]:
+    """The least clearance of each kind, when and between what, and a recorded contact (a run
+    with a `world:` section; docs/obstacles.md)."""
+    if 'clearance' not in sim:
+        return []
+    lines = []
+    for kind in CLEARANCE_WORDS:  # in one order whether read from summary.json or not
+        if kind not in sim['clearance']:
+            continue
+        figure = sim['clearance'][kind]
+        first, second = figure['between']
+        lines.append(f'  clearance {CLEARANCE_WORDS[kind]:<16} least {figure["value"]:.3f} '
+                     f'{unit_of("least_clearance")} at t = {figure["time"]:.2f} s '
+                     f'({first} to {second})')
+    contact = sim.get('contact')
+    if contact:
+        first, second = contact['between']
+        lines.append(f'  contact          {first} touched {second} at t = {contact["time"]:.3f} '
+                     f's (clearance {contact["value"]:.3g} m; recorded, flown on)')
     return lines

@@ -50,7 +50,7 @@ import numpy as np
 from multilift_control import laws
 from multilift_control.cascade import CascadeController, ControlOutput, FormationStates
 from multilift_control.controllers import compiled
-from multilift_control.controllers.followers import (cable_forces, thrust_margin,
+from multilift_control.controllers.followers import (cable_forces, heading, thrust_margin,
                                                      virtual_constraints)
 from multilift_control.controllers.leaders import cascade, constant_rotor_speed
 from multilift_control.laws.layout import REFERENCE_SIZE
@@ -63,7 +63,7 @@ from multilift_sim.start import formation_start, start_lengths
 LEADER_REQUIRED = ('NAME', 'KEYS', 'TRACKS_MISSION', 'arrays', 'answer')
 FOLLOWER_REQUIRED = ('NAME', 'KEYS', 'arrays', 'shared', 'answer')
 SHIPPED_LEADERS = (cascade, constant_rotor_speed)
-SHIPPED_FOLLOWERS = (virtual_constraints, thrust_margin, cable_forces)
+SHIPPED_FOLLOWERS = (virtual_constraints, thrust_margin, cable_forces, heading)
 for _part in SHIPPED_LEADERS:
     LEADER_CONTROLLERS.setdefault(_part.NAME, _part)
 for _part in SHIPPED_FOLLOWERS:

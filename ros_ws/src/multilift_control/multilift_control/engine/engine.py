@@ -12,7 +12,9 @@ from multilift_control.engine.arrays import (FINISHED, RUNNING, FormationArrays,
 from multilift_control.laws.layout import REFERENCE_SIZE, UAV_STATE_SIZE
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario
+from multilift_sim.physics.layout import STATUS_CONTACT
 from multilift_sim.simulation import stop_message
+from multilift_sim.statistics.clearance import clearance_figures, contact_message
 from multilift_sim.schedules import event_records, run_seeds
 from multilift_sim.tick_arrays import STOP_CHECKS
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
@@ -194,6 +196,8 @@ class Engine:
 
     def stop_reason(self, b: int) -> str | None:
         """Why formation b stopped, in the simulator's words (None while it has not)."""
+        if int(self.memory.status[b]) == STATUS_CONTACT:
+            return contact_message(self.scenarios[b], self.memory.contact[b])
         check = STOP_CHECKS.get(int(self.memory.status[b]))
         if check is None:
             return None
@@ -215,7 +219,9 @@ class Engine:
             sim['wall_time'] = wall_time
         happened = event_records(self.arrays.events[b, :self.memory.next_event[b]])
         out = {'sim': dict(sim, error=self.stop_reason(b), scenario=self.scenarios[b].name,
-                           events=happened, seeds=run_seeds(self.scenarios[b]))}
+                           events=happened, seeds=run_seeds(self.scenarios[b]),
+                           **clearance_figures(self.scenarios[b], self.memory.clearance[b],
+                                               self.memory.contact[b]))}
         if not self.scenarios[b].controlled:  # every UAV prescribed: no controller to report
             return out
         out['leader'] = leader.as_dict()

@@ -131,6 +131,10 @@ REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]
 REORGANIZE_UAV_SIZE = 3
 REORGANIZE_GRADIENT = 0.0  # thrust_margin: laws.reorganize.reorganize
 REORGANIZE_ALLOCATE = 1.0  # cable_forces: laws.reorganize.allocate
+# a follower whose offsets turn with the leader's heading (`formation.reorganize: heading`):
+# its constants after the FOLLOWER_* slots
+HEADING_LEADER_START_YAW = FOLLOWER_SIZE      # the leader's yaw at the start [rad]
+HEADING_SIZE = FOLLOWER_SIZE + 1
 # its memory after the FOLLOWER_* slots
 REORGANIZE_ACCELERATION = FOLLOWER_MEMORY_SIZE  # (3) the formation's filtered a [m/s^2]
 REORGANIZE_SHIFT = FOLLOWER_MEMORY_SIZE + 3     # (m) the rows' targets moved by [m]

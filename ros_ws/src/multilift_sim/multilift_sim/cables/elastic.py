@@ -41,12 +41,15 @@ def parse_uav_cable(u: Any, length: float, base: dict[str, Any]) -> tuple[float,
 
 def check(scenario: Any) -> str | None:
     """A point payload on cables from the UAVs' centres, the ropes stepped at omega h <=
-    ELASTIC_OMEGA_H (`rope_stepping`)."""
+    ELASTIC_OMEGA_H (`rope_stepping`) at their stiffest: a winch's rope reeled in to its
+    min_length is EA / min_length stiff (its damping scaled alike, physics.winch)."""
     if scenario.payload.type != 'point' or any(any(u.attach_point) for u in scenario.uavs):
         return ('cable_model: elastic is for a point payload on cables from the UAVs\' '
                 'centres')
     uavs, sim = scenario.uavs, scenario.simulation
-    return rope_stepping([u.cable_stiffness for u in uavs], [u.cable_damping for u in uavs],
+    shortest = [u.cable_length / u.winch.min_length if u.winch else 1.0 for u in uavs]
+    return rope_stepping([u.cable_stiffness * k for u, k in zip(uavs, shortest)],
+                         [u.cable_damping * k for u, k in zip(uavs, shortest)],
                          [u.vehicle.mass for u in uavs], scenario.payload.mass,
                          sim.physics_rate, sim.substeps)
 

@@ -241,3 +241,40 @@ STATUS_NOT_FINITE = 2       # stopped: the state became non-finite (Algorithm 1)
 STATUS_OFF_CONSTRAINT = 3   # stopped: a taut cable's |g| left constraint_tolerance (Algorithm 1)
 STATUS_OFF_RATE = 4         # stopped: a taut cable's |g_dot| left constraint_rate_tolerance
 STATUS_QUATERNION = 5       # stopped: a body's attitude quaternion lost its unit norm
+STATUS_CONTACT = 6          # stopped: a body touched another or the world (clearance <= 0;
+#                             world.on_contact: stop, physics.clearance)
+
+# -- an obstacle of `world.obstacles` (one row of (k, OBSTACLE_COLUMNS); its type a registered
+# part, multilift_sim.obstacles.OBSTACLE_TYPES, whose compiled `distance` reads the row) -------
+OBSTACLE_TYPE = 0           # its type's index in OBSTACLE_TYPES
+OBSTACLE_CENTER = 1         # its centre [m], world (3 slots)
+OBSTACLE_HALF = 4           # half its extent along its own axes [m] (box: size / 2; cylinder:
+#                             radius, radius, height / 2; sphere: radius, radius, radius) (3)
+OBSTACLE_COS_YAW = 7        # cos and sin of its yaw about world z (its x axis from world x)
+OBSTACLE_SIN_YAW = 8
+OBSTACLE_BOUND = 9          # the radius of a sphere about its centre that holds it [m]
+OBSTACLE_COLUMNS = 10
+
+# -- the world's scalars (one row of WORLD_COLUMNS per formation; physics.clearance) ------------
+WORLD_CHECKED = 0           # 1: clearances measured (a `world:` section or vehicle.radius); 0: none
+WORLD_GROUND = 1            # the ground's height [m], world z (NaN: no ground)
+WORLD_PAYLOAD_RADIUS = 2    # the payload's radius [m] about r_p (a rigid body's bounding sphere)
+WORLD_RECORD_CONTACT = 3    # 1: world.on_contact: record (fly on); 0: stop
+WORLD_COLUMNS = 4
+
+# -- the least clearance of each kind (one row of CLEARANCE_COLUMNS per kind in the memory's
+# `clearance`, (CLEARANCE_KINDS, CLEARANCE_COLUMNS); the first contact in `contact`) -----------
+CLEARANCE_UAV_WORLD = 0     # a UAV's sphere to an obstacle or the ground
+CLEARANCE_CABLE_WORLD = 1   # a cable's segment to an obstacle or the ground
+CLEARANCE_PAYLOAD_WORLD = 2  # the payload's sphere to an obstacle or the ground
+CLEARANCE_UAV_UAV = 3       # two UAVs' spheres
+CLEARANCE_UAV_CABLE = 4     # a UAV's sphere to another UAV's cable
+CLEARANCE_CABLE_CABLE = 5   # two cables that do not meet at the payload (a rigid body's)
+CLEARANCE_KINDS = 6
+CLEARANCE_VALUE = 0         # the least clearance [m] (+inf: none measured)
+CLEARANCE_TIME = 1          # when [s]
+CLEARANCE_FIRST = 2         # between what: a UAV or cable (from 0), or 0 the payload
+CLEARANCE_SECOND = 3        # and what: an obstacle (from 0), OBSTACLE_GROUND, or a UAV / cable
+CLEARANCE_KIND = 4          # (the `contact` row only) its kind, -1: no contact yet
+CLEARANCE_COLUMNS = 5
+OBSTACLE_GROUND = -1        # CLEARANCE_SECOND of the ground

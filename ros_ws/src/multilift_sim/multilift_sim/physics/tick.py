@@ -19,13 +19,14 @@ from multilift_sim.physics.allocation import rotor_wrenches
 from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.attitude import quaternion_norm_error
+from multilift_sim.physics.clearance import measure as measure_clearance
 from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_ELASTIC,
                                           FORMATION_PRESCRIBED, FORMATION_TIME, FORMATION_WIND,
-                                          FORMATION_WINCH, REEL_LENGTH,
+                                          FORMATION_WINCH, REEL_LENGTH, STATUS_CONTACT,
                                           STATUS_FINISHED, STATUS_QUATERNION,
                                           STATUS_NOT_FINITE, STATUS_OFF_CONSTRAINT,
                                           STATUS_OFF_RATE, STATUS_RUNNING,
-                                          WRENCH_COLUMNS)
+                                          WORLD_CHECKED, WORLD_RECORD_CONTACT, WRENCH_COLUMNS)
 from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
                                                uav_attitude_slot)
 from multilift_sim.physics.measurement import measured_states
@@ -132,6 +133,21 @@ def check(a, m, b):
 
 
 @jit
+def clearance_check(a, m, b):
+    """The clearances of formation b's current state (`physics.clearance.measure`) where its
+    world is checked (WORLD_CHECKED: a `world:` section or vehicle.radius; else nothing, not
+    even a call's cost): the least of each kind and the first contact into its memory; a
+    contact stops it as STATUS_CONTACT unless world.on_contact is record."""
+    if a.world[b, WORLD_CHECKED] == 0.0 or m.status[b] != STATUS_RUNNING:
+        return
+    touched = measure_clearance(a.world[b], a.obstacles[b], a.uav_radii[b], a.uavs[b],
+                                m.state[b], m.tick[b] * a.period_ns[b] * 1e-9, m.clearance[b],
+                                m.contact[b])
+    if touched and a.world[b, WORLD_RECORD_CONTACT] == 0.0:
+        m.status[b] = STATUS_CONTACT
+
+
+@jit
 def advance(a, m, b, speeds, saturated, tension):
     """Formation b under rotor `speeds` (n, rotors) [rad/s] (`saturated`: which are at a
     limit; a smaller UAV's padded with zeros) commanded over the control period (a silent
@@ -186,6 +202,7 @@ def advance(a, m, b, speeds, saturated, tension):
     m.next_event[b] = apply_events(a.events[b], m.next_event[b], m.tick[b], m.effectiveness[b],
                                    m.taut[b], m.released[b], m.silent_until[b], m.reel[b])
     check(a, m, b)
+    clearance_check(a, m, b)
     if m.status[b] == STATUS_RUNNING and m.tick[b] >= a.tick_count[b]:
         m.status[b] = STATUS_FINISHED
 
@@ -202,6 +219,7 @@ def start(a, m, which):
                                        m.effectiveness[b], m.taut[b], m.released[b],
                                        m.silent_until[b], m.reel[b])
         check(a, m, b)
+        clearance_check(a, m, b)
         if m.status[b] == STATUS_RUNNING and m.tick[b] >= a.tick_count[b]:
             m.status[b] = STATUS_FINISHED
 

@@ -292,7 +292,7 @@ class SimNode(Node):
         stats = self.sim.stats.as_dict()
         stats.update(wall_time=wall, error=error, scenario=self.scenario.name,
                      events=self.sim.events_summary(),
-                     seeds=run_seeds(self.scenario))
+                     seeds=run_seeds(self.scenario), **self.sim.clearance_summary())
         write_summary(self.summary_dir, 'sim', stats)
 
 

@@ -94,6 +94,27 @@ class PayloadConfig:
     # where it starts, world [m] and [m/s] (issue 34; None: hanging at rest under the UAVs)
     initial_position: tuple[float, float, float] | None = None
     initial_velocity: tuple[float, float, float] | None = None
+    radius: float = 0.0              # its sphere about r_p for the clearances [m] (point payload)
+
+
+@dataclass(frozen=True)
+class ObstacleConfig:
+    """One of `world.obstacles` (issue 34 item 5): its type a name of
+    multilift_sim.obstacles.OBSTACLE_TYPES."""
+    name: str                        # how the summary names it (default obstacle<k + 1>)
+    type: str
+    center: tuple[float, float, float]  # [m], world
+    half: tuple[float, float, float]  # half its extent along its own axes [m] (its type's)
+    yaw: float                       # about world z [rad]
+    bound: float                     # the radius of a sphere about its centre that holds it [m]
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """The `world:` section: what the formation must keep clear of (physics.clearance)."""
+    obstacles: tuple[ObstacleConfig, ...] = ()
+    ground: float | None = None      # the ground's height [m], world z; None: no ground
+    on_contact: str = 'stop'         # 'stop' (exit 1 naming it) or 'record' (fly on)
 
 
 @dataclass(frozen=True)
@@ -230,6 +251,7 @@ class Scenario:
     sensor_suite: tuple[SensorConfig, ...] = ()
     estimator: EstimatorConfig | None = None  # None: no estimator (`estimator: none`)
     parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
+    world: WorldConfig | None = None  # obstacles, ground (`world:`); None: no clearance checks
 
     @property
     def n_uavs(self) -> int:

@@ -32,6 +32,7 @@ from multilift_sim.scenario.prescribed import (check_prescribed, finite_vector, 
                                                scenario_folder)
 from multilift_sim.scenario.reading import Section
 from multilift_sim.scenario.sensor_sections import estimator_section, sensor_suite, sensors_section
+from multilift_sim.scenario.world import check_start, read_world
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
                                             preset_values, vehicle_params)
 
@@ -139,7 +140,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
                             swing=math.radians(p.number('swing_deg', 0.0, lambda a: abs(a) < 90,
                                                         'must be within (-90, 90) degrees')),
                             initial_position=finite_vector(p, 'initial_position'),
-                            initial_velocity=finite_vector(p, 'initial_velocity'))
+                            initial_velocity=finite_vector(p, 'initial_velocity'),
+                            radius=p.non_negative('radius', 0.0))
     swing = math.degrees(payload.swing)
     payload = payload_type.parse(p, payload, len(uavs))
     p.done()
@@ -202,6 +204,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
 
     from multilift_sim.missions import read_mission  # its parts import scenario's names
     mission = read_mission(top, uavs[0].position)
+    world = read_world(top)
     top.done()
 
     scenario = Scenario(name=name, description=description, source=where, simulation=sim,
@@ -210,7 +213,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, cable=rope, events=events, wind=tuple(wind),
                         wind_models=tuple(wind_models), sensors=sensors,
-                        sensor_suite=suite, estimator=estimator, parts=parts)
+                        sensor_suite=suite, estimator=estimator, parts=parts, world=world)
     _check_feasible(scenario)
     check_limits(scenario)
     check_prescribed(scenario)  # the files cover the run, the payload's start fits the cables
@@ -241,6 +244,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
     refused = cables.check(scenario) or winch.check(scenario)
     if refused:
         raise ScenarioError(f'{where}: {refused}')
+    check_start(scenario)  # no body starts touching the world or another (world:)
     return scenario
 
 

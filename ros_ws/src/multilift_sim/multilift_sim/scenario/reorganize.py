@@ -4,8 +4,9 @@ multilift_control's follower `thrust_margin`, `laws.reorganize`), read and check
 - `formation.reorganize`: `none` (the seed's fixed geometry, the default), `thrust_margin`
   (the followers' horizontal offsets move online so that the UAVs' thrust margins stay even,
   or above the floor) or `cable_forces` (they move where the cables carry the shares that give
-  every UAV the same share of its largest thrust: three UAVs); needs a linear or V formation
-  of two UAVs or more;
+  every UAV the same share of its largest thrust: three UAVs) or `heading` (they turn about
+  the leader with its heading: its yaw from its start, as a mission's yaw turns it; issue 34,
+  the `window` scenario); needs a linear or V formation of two UAVs or more;
 - `formation.min_spacing` [m] (default 1.0): the least horizontal distance between two UAVs;
   a point payload's cables meet at the payload, so their spacing grows with the UAVs';
 - `formation.max_spread` [m] (default: none): the largest horizontal distance between two UAVs;
@@ -22,7 +23,8 @@ from typing import Any
 from multilift_sim.scenario.config import ScenarioError
 from multilift_sim.scenario.reading import Section
 
-REORGANIZE = ('none', 'thrust_margin', 'cable_forces')  # each a follower of that name
+REORGANIZE = ('none', 'thrust_margin', 'cable_forces', 'heading')  # each a follower of that name
+SPACED = ('thrust_margin', 'cable_forces')  # those held to min_spacing and max_spread
 
 
 def parse(f: Section, n: int, geometry: str) -> dict[str, Any]:
@@ -62,7 +64,7 @@ def control_of(c: Section, formation, control):
 
 def check_start(source: str, formation, uavs) -> None:
     """The formation's start places (uavs (n, 3) [m]) within its spacing and spread limits."""
-    if formation is None or formation.reorganize == 'none':
+    if formation is None or formation.reorganize not in SPACED:
         return
     n = len(uavs)
     for i in range(n):

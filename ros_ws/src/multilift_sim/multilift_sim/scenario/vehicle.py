@@ -12,7 +12,7 @@ from multilift_sim.scenario.reading import Section
 
 VEHICLE_KEYS = ('mass', 'inertia', 'frame_type', 'arm_length', 'thrust_coefficient',
                 'moment_coefficient', 'rotor_speed_min', 'rotor_speed_max',
-                'motor_time_constant', 'motor_rate_limit', 'drag_coefficient')
+                'motor_time_constant', 'motor_rate_limit', 'drag_coefficient', 'radius')
 
 
 def preset_values(sec: Section) -> dict[str, Any] | None:
@@ -53,10 +53,12 @@ def vehicle_params(sec: Section, base: dict[str, Any] | None) -> MultirotorParam
     rate = rate_default if rate is None else sec.positive('motor_rate_limit')
     drag = sec.non_negative('drag_coefficient',  # in the wind (issue 21); the seed's: none
                             0.0 if base is None else base['drag_coefficient'])
+    radius = sec.non_negative('radius', 0.0 if base is None else base.get('radius', 0.0))
     return MultirotorParams(mass=mass, inertia=inertia, frame_type=frame_type,
                             arm_length=arm_length, thrust_coefficient=k_t,
                             moment_coefficient=k_d, rotor_speed_min=w_min, rotor_speed_max=w_max,
-                            motor_time_constant=tau, motor_rate_limit=rate, drag_coefficient=drag)
+                            motor_time_constant=tau, motor_rate_limit=rate, drag_coefficient=drag,
+                            radius=radius)
 
 
 SEED_INERTIA = (0.957, 0.486, 0.355)  # seed Table 4.1 / 4.2 [kg m^2]

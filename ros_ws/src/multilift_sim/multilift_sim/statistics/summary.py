@@ -37,4 +37,5 @@ def summary_row(summary: dict) -> dict:
                                 if followers else None),
         'formation_error_mean': (sum(f['mean_formation_error_norm'] for f in followers)
                                  / len(followers) if followers else None),
+        'least_clearance': sim.get('least_clearance'),
     }

@@ -19,7 +19,10 @@ markers (world frame, z up, metres):
   `scenario.mission` (start, then the end of each segment);
 - ns `gust_zone`, id k (from 0), CYLINDER: where gust k blows, radius H (its gradient distance)
   about its centre, spanning the heights the payload can reach (height does not matter to a
-  gust, seed Eq. 2.55), translucent.
+  gust, seed Eq. 2.55), translucent;
+- ns `obstacle`, id k (from 0): `world.obstacles[k]` as its type draws it (`outline`: a CUBE,
+  CYLINDER or SPHERE of its full size at its centre, turned by its yaw), translucent
+  (docs/obstacles.md).
 
 Cable colour: tension T [N] against the static share of the payload weight per cable,
 T_ref = m_p g / n: blue at T <= 0+ (slack), green at T_ref, red at 2 T_ref and above; a negative
@@ -42,6 +45,7 @@ CABLE_SEGMENTS = 8  # a cable is drawn as this many segments: end to end (taut) 
 PATH_WIDTH = 0.05  # [m] line width of the mission path
 GUST_ALPHA = 0.15  # opacity of a gust zone
 GUST_MARGIN = 1.0  # [m] a gust zone reaches this far above and below the payload's heights
+OBSTACLE_ALPHA = 0.6  # opacity of an obstacle
 
 # visualization_msgs/Marker types and action used here
 ARROW, CUBE, SPHERE, CYLINDER, LINE_STRIP, LINE_LIST = 0, 1, 2, 3, 4, 5
@@ -53,6 +57,7 @@ _PAYLOAD = (0.35, 0.35, 0.35)
 _PATH = (0.1, 0.7, 0.2)
 _GUST = (0.55, 0.8, 1.0)
 _COMPRESSION = (0.9, 0.1, 0.9)
+_OBSTACLE = (0.55, 0.45, 0.35)  # brown-grey
 
 
 def tension_color(tension: float, reference: float) -> tuple[float, float, float]:
@@ -143,6 +148,24 @@ def _static_specs(scenario: Scenario) -> list[MarkerSpec]:
             'gust_zone', k, CYLINDER,
             position=[float(gust.center[0]), float(gust.center[1]), float(0.5 * (bottom + top))],
             scale=(diameter, diameter, float(top - bottom)), color=_rgba(_GUST, GUST_ALPHA)))
+    return specs + obstacle_specs(scenario)
+
+
+def obstacle_specs(scenario: Scenario) -> list[MarkerSpec]:
+    """The `world.obstacles` as markers, ns `obstacle`, id k: each its type's `outline` (none
+    without a `world:` section)."""
+    if scenario.world is None:
+        return []
+    from multilift_sim.obstacles import OBSTACLE_TYPES
+    types = {'cube': CUBE, 'cylinder': CYLINDER, 'sphere': SPHERE}
+    specs = []
+    for k, obstacle in enumerate(scenario.world.obstacles):
+        shape, size = OBSTACLE_TYPES[obstacle.type].outline(obstacle.half)
+        half_yaw = 0.5 * obstacle.yaw
+        specs.append(MarkerSpec(
+            'obstacle', k, types[shape], position=[float(c) for c in obstacle.center],
+            orientation=[0.0, 0.0, math.sin(half_yaw), math.cos(half_yaw)],
+            scale=tuple(float(s) for s in size), color=_rgba(_OBSTACLE, OBSTACLE_ALPHA)))
     return specs
 
 

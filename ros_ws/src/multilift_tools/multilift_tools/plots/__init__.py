@@ -4,7 +4,8 @@
                 cable ends (a rigid body's attach points), which cables were released, a rigid
                 body's outline (its box's corners, its cylinder's axis and rims)
     views       the 3-D trajectories and the top view, drawn from the scene
-    ropes       elastic ropes' stretch and tension (cable_model: elastic)
+    ropes       elastic ropes' stretch and tension (cable_model: elastic), winches' reeled
+                lengths (uavs[i].winch)
     rotors      collective thrust and rotor speeds (each rotor its colour and dash; the clipped
                 strips at the limit they hit)
 """

@@ -1,4 +1,5 @@
-"""The UAVs' actuation: `fig_thrust` (collective thrust, asked and delivered) and
+"""The UAVs' actuation: `fig_thrust` (collective thrust, asked and delivered),
+`fig_thrust_margins` (the share of each UAV's largest thrust left) and
 `fig_rotor_speeds` (each rotor's speed [rad/s] after saturation, the bands beyond the limits
 grey, and where a rotor was clipped: a strip at the top for the upper limit, at the bottom for
 the lower one). Each rotor has its own colour and dash, so six (a hexarotor) stay apart where
@@ -122,6 +123,29 @@ def _label_ends(ax: Axes, t: np.ndarray, omega: np.ndarray) -> None:
         ax.annotate(f'{"rotors" if len(group) > 1 else "rotor"} {names}',
                     (t[-1], final[group[0] - 1]), textcoords='offset points', xytext=(-2, 4),
                     ha='right', fontsize='small', color='0.15')
+
+
+def fig_thrust_margins(ctx: Context) -> Figure:
+    """Each UAV's thrust margin 1 - u_T / u_T,max [%] of its commanded rotor speeds (issue
+    35: the share of its largest thrust left; every rotor counted fully effective, where the
+    summary's least margin counts a fault's), its least marked."""
+    run = ctx.run
+    fig, ax = plt.subplots(figsize=(9, 4.8), layout='constrained')
+    for i in range(1, run.n_uavs + 1):
+        vehicle = vehicle_of(ctx, i)
+        if vehicle is None or not run.has(uav_topic(i, ROTOR_CMD)):
+            continue
+        margin = 100.0 * (1.0 - vehicle.collective_thrust(run.rotor_speeds(i))
+                          / vehicle.max_thrust)
+        ax.plot(run.rotor_time(i), margin, color=uav_color(i), lw=uav_width(i),
+                label=f'{uav_label(i)}: least {margin.min():.1f} %')
+    ax.axhline(0.0, color='tab:red', lw=1.0, ls='-.',
+               label='no thrust left (every rotor at ω_max)')
+    ax.set_ylabel('thrust margin $1 - u_T / u_{T,max}$ [%]')
+    ax.set_title(f'{run.label}: the share of each UAV\'s largest thrust left', fontsize='medium')
+    legend(ax, loc='best', ncols=2)
+    finish_time_axes([ax])
+    return fig
 
 
 def fig_rotor_speeds(ctx: Context) -> Figure:

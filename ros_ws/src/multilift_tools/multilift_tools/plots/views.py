@@ -1,5 +1,6 @@
 """The formation seen in space: `fig_trajectories_3d` (paths, the cables and the payload at the
-start and the end) and `fig_top_view` (x-y paths, five snapshots, the gust regions). Cables end
+start and the end) and `fig_top_view` (x-y paths, five snapshots, the gust regions), with the
+world's obstacles (`obstacles`). Cables end
 at their attach points, a released cable is drawn only while it holds the payload, and a rigid
 payload is drawn as its body (`scene`). World frame, z up [m].
 """
@@ -12,6 +13,8 @@ import numpy as np
 from multilift_sim.topics import REFERENCE_TOPIC
 from multilift_tools.plot_style import (PAYLOAD_COLOR, WORLD, Context, equal_3d, legend, plt,
                                         uav_color, uav_label)
+from multilift_tools.plots.obstacles import (draw_obstacles_3d, draw_obstacles_top,
+                                             obstacle_points)
 from multilift_tools.plots.scene import Scene, formation_scene
 
 if TYPE_CHECKING:
@@ -60,7 +63,8 @@ def fig_trajectories_3d(ctx: Context) -> Figure:
     if scene.released:
         ax.plot([], [], color='none', label=_released_note(scene))
     bodies = [scene.corners(0), scene.corners(len(scene.t) - 1)]
-    equal_3d(ax, np.concatenate([r.reshape(-1, 3), rp, *bodies]))
+    draw_obstacles_3d(ax, ctx.scenario)
+    equal_3d(ax, np.concatenate([r.reshape(-1, 3), rp, *bodies, obstacle_points(ctx.scenario)]))
     ax.set_xlabel('x [m]', labelpad=LABEL_PAD)
     ax.set_ylabel('y [m]', labelpad=LABEL_PAD)
     ax.set_zlabel('z [m]', labelpad=LABEL_PAD)
@@ -112,6 +116,7 @@ def fig_top_view(ctx: Context) -> Figure:
     r, rp = scene.uavs, scene.payload
     fig, ax = plt.subplots(figsize=(8, 7), layout='constrained')
     _gust_regions(ax, ctx.scenario)
+    draw_obstacles_top(ax, ctx.scenario)
     if run.has(REFERENCE_TOPIC):
         ax.plot(*run.reference_position()[:, :2].T, color='0.5', ls='--', lw=1.0,
                 label='leader reference')

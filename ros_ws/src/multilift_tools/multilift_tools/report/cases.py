@@ -25,7 +25,7 @@ from multilift_tools.report.seed import MULTI, SWING, TWIN
 from multilift_tools.report.single_lift import single_lift_table
 
 CASES = ('twin_lift', 'multi_lift', 'multi_lift_still_air', 'single_lift_table',
-         'single_lift_swing', 'modal', 'swing_feedback')
+         'single_lift_swing', 'modal', 'swing_feedback', 'load_sharing')
 
 
 class _ProgressFile:
@@ -136,6 +136,19 @@ def _swing_feedback_case(study_dir: Path, figure_dir: Path, progress: _ProgressF
             'periods': periods}
 
 
+def _load_sharing_case(study_dir: Path, figure_dir: Path, progress: _ProgressFile) -> dict:
+    """Beyond the seed (issue 35): `multilift study load_sharing` written to `study_dir`, its
+    figure copied to `figure_dir` as load_sharing.png."""
+    from multilift_tools.load_study import load_sharing_study
+
+    progress(0, 1)
+    study = load_sharing_study(study_dir)
+    figure_dir.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(study['files']['figure'], figure_dir / 'load_sharing.png')
+    progress(1, 1)
+    return {'table': study['table'], 'rows': study['rows']}
+
+
 def run_case(case: str, work: str, figures: str) -> dict:
     """Run one case of CASES in this process; `work` holds bags and progress files. Returns
     what the report needs (picklable), with 'wall_time' [s]."""
@@ -152,6 +165,8 @@ def run_case(case: str, work: str, figures: str) -> dict:
         result = _modal_case(figure_dir, progress)
     elif case == 'swing_feedback':
         result = _swing_feedback_case(work_dir / 'swing_feedback', figure_dir, progress)
+    elif case == 'load_sharing':
+        result = _load_sharing_case(work_dir / 'load_sharing', figure_dir, progress)
     else:
         raise ValueError(f'unknown case {case!r}')
     result['wall_time'] = time.monotonic() - start

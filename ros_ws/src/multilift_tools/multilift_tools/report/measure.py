@@ -204,4 +204,5 @@ def measure(results: dict[str, dict], work: Path, runs: dict[str, Any],
             'multi_modal': ModalNumbers.from_case(results['modal'][MULTI]),
             'gust_effect': gust_effect(runs[MULTI], results['multi_lift_still_air'],
                                        multi.gusts),
-            'swing_feedback': results['swing_feedback']}
+            'swing_feedback': results['swing_feedback'],
+            'load_sharing': results['load_sharing']}

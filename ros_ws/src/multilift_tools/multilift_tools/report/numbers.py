@@ -258,6 +258,8 @@ class Report:
     gust_effect: tuple[float, ...]     # the V's payload moved by each gust [m]
     # beyond the seed: `multilift study swing_feedback` (table, rows, figures), issue 20
     swing_feedback: dict
+    # beyond the seed: `multilift study load_sharing` (table, rows), issue 35
+    load_sharing: dict
     files: dict[str, str]              # seed figure number -> PNG name
     comparison: tuple[str, ...]        # compare.comparison_numbers lines
     wall: dict[str, float]             # wall time per case and 'total' [s]

@@ -30,7 +30,8 @@ def _short(name: str, cables: str | None = None) -> scenario.Scenario:
 
 
 def _every_kind() -> scenario.Scenario:
-    """multi_lift with every kind of event (docs/events.md) and sensors (docs/sensors.md)."""
+    """multi_lift with every kind of event (docs/events.md), sensors (docs/sensors.md) and the
+    estimator (docs/estimation.md)."""
     data = yaml.safe_load(scenario.resolve('multi_lift').read_text())
     data['simulation']['duration'] = 0.05
     data['events'] = [
@@ -39,6 +40,7 @@ def _every_kind() -> scenario.Scenario:
         {'time': 0.02, 'type': 'controller_silence', 'uav': 1, 'duration': 0.01},
         {'time': 0.03, 'type': 'cable_release', 'uav': 3}]
     data['sensors'] = {'position_noise': 0.01, 'latency_ticks': 1}
+    data['imu'], data['mocap'], data['estimator'] = {}, {'preset': 'mocap_indoor'}, 'ekf'
     return scenario.loads(yaml.safe_dump(data))
 
 

@@ -28,9 +28,9 @@ from typing import Any, Callable
 # the subpackages of numba kernels, in any multilift_* package (physics and statistics here,
 # the laws and the engine's tick above): numba compiles a kernel together with the kernels it
 # calls from other files, but checks a cached kernel against its own file only
-KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine', 'events', 'sensors', 'obstacles',
-                  'controllers',
-                  'controllers/leaders', 'controllers/followers')
+KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine', 'events', 'sensors',
+                  'estimators', 'obstacles', 'controllers', 'controllers/leaders',
+                  'controllers/followers')
 CACHE_ROOT = (Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache')
               / 'multilift' / 'numba')
 

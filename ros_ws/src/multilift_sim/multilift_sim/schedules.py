@@ -55,11 +55,13 @@ def wind_series(scenario: Scenario) -> np.ndarray:
 
 
 def run_seeds(scenario: Scenario) -> dict[str, int]:
-    """The seeds a run's random draws come from, by what they draw (`sensors`, a wind model's),
-    as its summary records them: none where it draws nothing."""
+    """The seeds a run's random draws come from, by what they draw (`sensors`, `imu`, `mocap`,
+    a wind model's), as its summary records them: none where it draws nothing."""
     seeds = {}
     if scenario.sensors is not None:
         seeds['sensors'] = scenario.sensors.seed
+    for config in scenario.sensor_suite:  # `imu:`, `mocap:`: each its own stream
+        seeds[config.model] = config.seed
     for name, config in scenario.wind_models:
         if hasattr(WIND_MODELS[name], 'seed'):
             seeds[name] = WIND_MODELS[name].seed(config)

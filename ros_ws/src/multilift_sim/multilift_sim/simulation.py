@@ -22,6 +22,7 @@ from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_COLUMNS,
                                           ODOMETRY_BODY_VELOCITY, ODOMETRY_COLUMNS,
                                           ODOMETRY_QUATERNION, ODOMETRY_ROTATION, REEL_COMMAND,
                                           REEL_LENGTH)
+from multilift_sim.estimators.published import ESTIMATE_COLUMNS
 from multilift_sim.physics.measurement import odometry_states
 from multilift_sim.physics.rigid_payload import payload_rotation
 from multilift_sim.scenario import Scenario
@@ -66,6 +67,9 @@ class Snapshot:
     payload_attitude: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     # every cable's length [m] (n,): reeled by a winch (physics.winch), else its own
     cable_lengths: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # every UAV's estimate as /uav{i}/estimate carries it (n, ESTIMATE_COLUMNS:
+    # estimators.published), None without an estimator
+    estimate: np.ndarray | None = None
 
 
 def stop_message(status: int, cable: int, value: float, t: float, sim, n_uavs: int) -> str:
@@ -223,7 +227,9 @@ class FormationSimulator:
         attitude = payload_attitude(state, n) if self.model.layout.rigid_payload else None
         return Snapshot(self.t_ns, uavs, layout.payload_position(state).copy(),
                         layout.payload_velocity(state).copy(), odometry, measured, attitude,
-                        self.memory.reel[0, :, REEL_LENGTH].copy())
+                        self.memory.reel[0, :, REEL_LENGTH].copy(),
+                        self.memory.estimator_memory[0, 0, :, :ESTIMATE_COLUMNS].copy()
+                        if self.memory.estimator_memory.shape[1] else None)
 
     # ------------------------------------------------------------------------- the cables
     def cable_state(self, rotor_speeds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray,

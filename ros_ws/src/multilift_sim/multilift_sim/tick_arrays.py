@@ -24,6 +24,7 @@ from multilift_sim.physics.layout import (CLEARANCE_COLUMNS, CLEARANCE_KINDS, CL
 from multilift_sim.scenario import Scenario
 from multilift_sim.scenario.world import world_arrays
 from multilift_sim.schedules import event_array, wind_series
+from multilift_sim.estimators.arrays import estimator_arrays
 from multilift_sim.sensors.arrays import sensor_arrays
 from multilift_sim.start import cable_reach, initial_state, swing_sampling
 from multilift_sim.statistics import RunStatistics
@@ -49,6 +50,9 @@ class PhysicsArrays(NamedTuple):
     sensor_models: np.ndarray     # (B, K) int: each sensor's model (index in SENSOR_MODELS)
     sensor_constants: np.ndarray  # (B, K, C): each one's constants row (its model's slots)
     sensor_draws: np.ndarray      # (B, K, n, S, D): every sample's draws, by UAV
+    # the estimator of every UAV (`estimator:`; E = 1, 0: none; estimators.arrays)
+    estimator_models: np.ndarray  # (B, E) int: its index in ESTIMATORS
+    estimator_constants: np.ndarray  # (B, E, C): its constants row
     # time and Algorithm 1's tolerances
     physics_dt: np.ndarray        # (B,) [s]
     physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
@@ -82,6 +86,7 @@ class PhysicsMemory(NamedTuple):
     g_dot: np.ndarray             # (B, n): g_dot at the current tick [m^2/s]
     gust: np.ndarray              # (B, 3): the air velocity at the payload [m/s], world
     sensor_memory: np.ndarray     # (B, K, n, M): each sensor's memory of each UAV
+    estimator_memory: np.ndarray  # (B, E, n, M): the estimator's memory of each UAV
     run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
     reel: np.ndarray              # (B, n, REEL_COLUMNS): each cable's length [m], its reel's
     #                               rate [m/s] and command [m/s] (physics.winch)
@@ -101,6 +106,7 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
                                  scenario.cable_model)
     uavs, gusts, formation, allocation, actuators = model.physics_constants()
     sensors = sensor_arrays(scenario)
+    estimator = estimator_arrays(scenario)
     state = initial_state(scenario)
     rotors = allocation.shape[::2]  # (n, the largest rotor count)
     arrays = dict(
@@ -110,7 +116,8 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         slack=cables.SLACKENS, events=event_array(scenario),
         wind_series=wind_series(scenario), state_size=state.size,
         sensor_models=sensors.models, sensor_constants=sensors.constants,
-        sensor_draws=sensors.draws,
+        sensor_draws=sensors.draws, estimator_models=estimator.models,
+        estimator_constants=estimator.constants,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         # (cables that stretch are no constraints: Algorithm 1's check of g does not apply)
@@ -126,7 +133,8 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         silent_until=np.zeros(n, dtype=np.int64), held=np.full(rotors, math.nan),
         held_saturated=np.zeros(rotors, dtype=bool), tick=0, status=STATUS_RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n), gust=np.zeros(3),
-        sensor_memory=sensors.memory, run=RunStatistics(n).run, reel=reel_memory(scenario),
+        sensor_memory=sensors.memory, estimator_memory=estimator.memory,
+        run=RunStatistics(n).run, reel=reel_memory(scenario),
         clearance=clearance, contact=np.full(CLEARANCE_COLUMNS, -1.0))
     return arrays, memory
 

@@ -43,6 +43,7 @@ PATH = '/formation/path'                # a live path for the leader (run --live
 # leaves of the per-UAV topics /uav{i}/{leaf}
 ODOM = 'odom'                           # UAV i's state (every UAV)
 MEASURED_ODOM = 'measured_odom'         # what UAV i's controllers receive (with `sensors:`)
+ESTIMATE = 'estimate'                   # UAV i's estimate with its covariance (an estimator)
 ROTOR_CMD = 'rotor_cmd'                 # UAV i's rotor speeds (every UAV)
 ATTITUDE_SETPOINT = 'attitude_setpoint'  # UAV i's outer-loop output (every UAV)
 REFERENCE = 'reference'                 # the mission reference (the leader only)
@@ -50,7 +51,8 @@ FORMATION_ERROR = 'formation_error'     # follower i's rows of g_vc (followers o
 CABLE_LENGTH = 'cable_length'           # UAV i's cable length [m] (a UAV with a winch)
 WINCH_CMD = 'winch_cmd'                 # a live reel rate for UAV i's winch [m/s] (run --live)
 
-UAV_TYPES = {ODOM: ODOMETRY_TYPE, MEASURED_ODOM: ODOMETRY_TYPE, ROTOR_CMD: ROTOR_COMMAND_TYPE,
+UAV_TYPES = {ODOM: ODOMETRY_TYPE, MEASURED_ODOM: ODOMETRY_TYPE, ESTIMATE: ODOMETRY_TYPE,
+             ROTOR_CMD: ROTOR_COMMAND_TYPE,
              ATTITUDE_SETPOINT: ATTITUDE_SETPOINT_TYPE, REFERENCE: TRACKING_REFERENCE_TYPE,
              FORMATION_ERROR: FORMATION_ERROR_TYPE, CABLE_LENGTH: FLOAT64_TYPE,
              WINCH_CMD: FLOAT64_TYPE}
@@ -104,7 +106,7 @@ def topic_type(topic: str) -> str | None:
 
 def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
                sensors: bool = False, wind: bool = False, commands: bool = True,
-               live: bool = False, winches: Sequence[int] = ()
+               live: bool = False, winches: Sequence[int] = (), estimates: bool = False
                ) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
@@ -113,7 +115,8 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
     /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind; without
     `commands` (every UAV prescribed) not even the rotor commands; with `live` (`run --live`),
     /formation/goal and /formation/path; for each UAV of `winches` (from 1: those with a
-    winch) /uav{i}/cable_length, and with `live` /uav{i}/winch_cmd."""
+    winch) /uav{i}/cable_length, and with `live` /uav{i}/winch_cmd; with `estimates` (an
+    estimator, docs/estimation.md) every /uav{i}/estimate."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
         list(WIND_TYPES.items()) if wind else []) + (list(LIVE_TYPES.items()) if live else [])
     if controllers:
@@ -124,6 +127,8 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
                                 else (ODOM, ROTOR_CMD) if commands else (ODOM,))]
         if sensors:
             topics.append((uav_topic(i, MEASURED_ODOM), ODOMETRY_TYPE))
+        if estimates:
+            topics.append((uav_topic(i, ESTIMATE), ODOMETRY_TYPE))
         if i > 1 and controllers:
             topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
         if i in winches:
@@ -135,11 +140,13 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
 def scenario_topics(scenario, controllers: bool = True, live: bool = False
                     ) -> list[tuple[str, str]]:
     """`run_topics` of a scenario (multilift_sim.scenario.Scenario): its n, and the topics its
-    `events:`, `sensors:`, wind and winches add (and a live run's, `live`); none of the controllers'
-    when every UAV's motion is prescribed (`uavs[i].trajectory`: no controller runs)."""
+    `events:`, `sensors:`, estimator, wind and winches add (and a live run's, `live`); none of
+    the controllers' when every UAV's motion is prescribed (`uavs[i].trajectory`: no
+    controller runs)."""
     return run_topics(scenario.n_uavs, controllers and scenario.controlled,
-                      bool(scenario.events), scenario.sensors is not None, scenario.has_wind,
-                      commands=scenario.controlled, live=live, winches=scenario.winches)
+                      bool(scenario.events), scenario.measures, scenario.has_wind,
+                      commands=scenario.controlled, live=live, winches=scenario.winches,
+                      estimates=scenario.estimator is not None)
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

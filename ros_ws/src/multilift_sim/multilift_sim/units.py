@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import re
 
-from multilift_sim.sensors import key_units
+from multilift_sim.estimators import ESTIMATORS
+from multilift_sim.sensors import COMMON_KEYS, SENSOR_MODELS, key_units
 from multilift_sim.wind import WIND_MODELS
 
 NO_UNIT = ''
@@ -141,6 +142,14 @@ def unit_of(name: str) -> str:
     section, _, sensor_key = key.partition('.')
     if section == 'sensors' and sensor_key in key_units():  # the registered models' keys
         return key_units()[sensor_key]
+    own = ({**COMMON_KEYS, **SENSOR_MODELS[section].UNITS} if section in SENSOR_MODELS
+           else {})  # a sensor of its own section (`imu:`, `mocap:`)
+    if sensor_key in own:
+        return own[sensor_key]
+    if key in ('estimator', 'estimator.model'):
+        return NO_UNIT
+    if section == 'estimator' and any(sensor_key in e.UNITS for e in ESTIMATORS.values()):
+        return next(e.UNITS[sensor_key] for e in ESTIMATORS.values() if sensor_key in e.UNITS)
     if key.endswith('[]') and key[:-2] in UNITS:    # one component of a vector key
         return UNITS[key[:-2]]
     model = _WIND_KEY.match(key)

@@ -36,6 +36,7 @@ from multilift_sim.tick_arrays import PhysicsArrays, PhysicsMemory
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Snapshot, TickCables,
                                       payload_attitude)
+from multilift_sim.estimators.published import ESTIMATE_COLUMNS
 from multilift_sim.wire.tick_messages import (SimulatorMessages, measured_odometry, payload_motion,
                                               state_rows)
 from multilift_sim.topics import MARKER_DECIMATION, scenario_topics
@@ -80,7 +81,7 @@ class EngineBag:
         self._counts = None if min(counts) == rotors else counts
         self._real = np.concatenate([i * rotors + np.arange(c) for i, c in enumerate(counts)])
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
-        self._sensors = scenario.sensors is not None  # /uav{i}/measured_odom
+        self._sensors = scenario.measures  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
         # /formation/wind by tick (physics.tick.period_winds), where the air moves everywhere
         self._wind = None
@@ -99,6 +100,8 @@ class EngineBag:
         snapshots, odometry = state_rows(states, n, received)
         measured = measured_odometry(received).tolist() if self._sensors \
             else [None] * count
+        estimates = record.estimate[:count, 0].tolist() if record.estimate.shape[3] \
+            else [None] * count  # /uav{i}/estimate (an estimator)
         winds = self._wind[first:first + count].tolist() if self._wind is not None \
             else [None] * count
         speeds = record.speeds[:count, 0]
@@ -148,7 +151,7 @@ class EngineBag:
             messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
                                           odometry[k], payload_position[k],
                                           payload_velocity[k], gusts[k], measured[k],
-                                          winds[k], poses[k], lengths[k])
+                                          winds[k], poses[k], lengths[k], estimates[k])
             messages += self._events_at(tick, t_ns)
             for i in range(n if self._commands else 0):
                 if not self._controllers:
@@ -175,13 +178,16 @@ class EngineBag:
         payload_position = layout.payload_position(state).tolist()
         measured = measured_odometry(engine.measured()[:1])[0].tolist() if self._sensors \
             else None
+        estimates = memory.estimator_memory[0, 0, :, :ESTIMATE_COLUMNS].tolist() \
+            if memory.estimator_memory.shape[1] else None  # after measured(): this tick's
         velocity, pose = payload_motion(payload_attitude(state, n) if self._rigid else None,
                                         layout.payload_velocity(state))
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
                                              velocity, memory.gust[0].tolist(), measured,
                                              None if self._wind is None
                                              else self._wind[tick].tolist(), pose,
-                                             memory.reel[0, :, REEL_LENGTH].tolist())
+                                             memory.reel[0, :, REEL_LENGTH].tolist(),
+                                             estimates)
                     + self._events_at(tick, t_ns), t_ns)
         # the tension under the commands held since the tick before, as the simulator node's
         # last tick solves it (physics.tick.tension_at, on the physics' arrays of the engine's)

@@ -23,6 +23,7 @@ from multilift_control.controllers import (FOLLOWER_CONTROLLERS, LEADER_CONTROLL
 from multilift_control.faults import fault_mixers, mixer_uavs, target_schedule
 from multilift_control.laws.layout import MIXER_SIZE, REFERENCE_SIZE, ROW_SIZE, UAV_STATE_SIZE
 from multilift_control.runtime import ThrustBook
+from multilift_sim.estimators.published import ESTIMATE_COLUMNS
 from multilift_sim.physics.layout import (STATUS_FINISHED, STATUS_NOT_FINITE,
                                           STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
 from multilift_sim.scenario import Scenario
@@ -109,6 +110,9 @@ class TickRecord(NamedTuple):
     taut: np.ndarray              # (ticks, B, n) bool, at the tick's start
     gust: np.ndarray              # (ticks, B, 3): the air velocity at the payload [m/s], world
     cable_length: np.ndarray      # (ticks, B, n) [m]: each cable's, reeled by a winch or not
+    # (ticks, B, n, ESTIMATE_COLUMNS) each UAV's estimate as /uav{i}/estimate carries it
+    # (estimators.published); (ticks, B, n, 0) without an estimator
+    estimate: np.ndarray
 
 
 def _padded(rows: np.ndarray, rotors: int) -> np.ndarray:
@@ -239,4 +243,6 @@ def empty_record(arrays: FormationArrays, ticks: int) -> TickRecord:
         rates=np.full((ticks, batch, n, rows), math.nan),
         tension=np.empty((ticks, batch, n)), g=np.empty((ticks, batch, n)),
         g_dot=np.empty((ticks, batch, n)), taut=np.empty((ticks, batch, n), dtype=bool),
-        gust=np.empty((ticks, batch, 3)), cable_length=np.empty((ticks, batch, n)))
+        gust=np.empty((ticks, batch, 3)), cable_length=np.empty((ticks, batch, n)),
+        estimate=np.empty((ticks, batch, n, ESTIMATE_COLUMNS if
+                           arrays.estimator_models.shape[1] else 0)))

@@ -20,6 +20,7 @@ from multilift_control.laws.follower import lift_vectors
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
+from multilift_sim.estimators.published import ESTIMATE_COLUMNS
 from multilift_sim.physics import tick as physics
 from multilift_sim.physics.layout import REEL_LENGTH
 from multilift_sim.physics.measurement import payload_position, payload_velocity
@@ -252,5 +253,7 @@ def run_ticks(a, m, ticks, record):
                 record.errors[k, b] = errors
                 record.rates[k, b] = rates
                 record.tension[k, b] = tension
+                if record.estimate.shape[3]:  # every UAV's estimate as published
+                    record.estimate[k, b] = m.estimator_memory[b, 0, :, :ESTIMATE_COLUMNS]
             flown[b] += 1
     return flown

@@ -1,9 +1,10 @@
 """A rigid body's attitude in the state: its block (layout BODY_*: the unit quaternion q =
 (w, x, y, z), body -> world, and the body rates omega [rad/s]) for every UAV and a rigid
 payload alike (issue 31, item 6). The rotation of a quaternion, the kinematics q_dot =
-q (x) (0, omega) / 2, a small turn and the renormalisation after an RK4 step: the one place
-of these equations for the compiled functions (the Euler angles the controllers read are
-computed from q once, `measurement.quaternion_euler`). Slots are `physics.layout`'s.
+q (x) (0, omega) / 2, a small turn and the renormalisation after an RK4 step, the product of
+quaternions, Exp and Log of a rotation vector (the IMU's, the motion capture's and the EKF's):
+the one place of these equations for the compiled functions (the Euler angles the controllers
+read are computed from q once, `measurement.quaternion_euler`). Slots are `physics.layout`'s.
 """
 import math
 
@@ -11,6 +12,8 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import BODY_QUATERNION
+
+SMALL_ANGLE = 1e-12  # [rad] below which Exp and Log take their first-order forms
 
 
 @jit
@@ -81,3 +84,53 @@ def quaternion_norm_error(x, base):
     for k in range(4):
         norm += x[base + BODY_QUATERNION + k] * x[base + BODY_QUATERNION + k]
     return abs(math.sqrt(norm) - 1.0)
+
+
+@jit
+def quaternion_product(a0, a1, a2, a3, b0, b1, b2, b3):
+    """The Hamilton product a (x) b of quaternions (w, x, y, z), as 4 floats."""
+    return (a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+            a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0)
+
+
+@jit
+def rotation_quaternion(t0, t1, t2):
+    """Exp(t): the unit quaternion (w, x, y, z) of the rotation vector t [rad]."""
+    angle = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    if angle < SMALL_ANGLE:
+        return 1.0, 0.5 * t0, 0.5 * t1, 0.5 * t2
+    s = math.sin(0.5 * angle) / angle
+    return math.cos(0.5 * angle), s * t0, s * t1, s * t2
+
+
+@jit
+def quaternion_rotation_vector(w, x, y, z):
+    """Log(q): the rotation vector [rad] (3 floats, angle in [0, pi]) of the unit quaternion
+    (w, x, y, z) (q and -q the same rotation)."""
+    if w < 0.0:
+        w, x, y, z = -w, -x, -y, -z
+    s = math.sqrt(x * x + y * y + z * z)
+    if s < SMALL_ANGLE:
+        return 2.0 * x, 2.0 * y, 2.0 * z
+    scale = 2.0 * math.atan2(s, w) / s
+    return scale * x, scale * y, scale * z
+
+
+@jit
+def turn(q, base, t0, t1, t2):
+    """The unit quaternion at q[base:base + 4] turned by the body-frame rotation vector t [rad]:
+    q -> q (x) Exp(t), back to unit length."""
+    e0, e1, e2, e3 = rotation_quaternion(t0, t1, t2)
+    r0, r1, r2, r3 = quaternion_product(q[base], q[base + 1], q[base + 2], q[base + 3],
+                                        e0, e1, e2, e3)
+    norm = math.sqrt(r0 * r0 + r1 * r1 + r2 * r2 + r3 * r3)
+    q[base], q[base + 1], q[base + 2], q[base + 3] = r0 / norm, r1 / norm, r2 / norm, r3 / norm
+
+
+@jit
+def attitude_difference(q, base, z0, z1, z2, z3):
+    """Log(q^-1 (x) z) [rad] (3 floats): the body-frame rotation from the quaternion at
+    q[base:] to z (w, x, y, z), the attitude error a measurement z of it shows."""
+    r0, r1, r2, r3 = quaternion_product(q[base], -q[base + 1], -q[base + 2], -q[base + 3],
+                                        z0, z1, z2, z3)
+    return quaternion_rotation_vector(r0, r1, r2, r3)

@@ -31,6 +31,7 @@ from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rate
                                                uav_attitude_slot)
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.prescribed import prescribe_state
+from multilift_sim.estimators.estimation import estimated_states
 from multilift_sim.physics.winch import reel_end, reel_period
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
@@ -227,12 +228,16 @@ def start(a, m, which):
 def measure(a, m, b, states):
     """What formation b's controllers receive of its UAVs at its current tick, into states
     (n, MEASURED_COLUMNS): the measured states (seed Eq. 2.7), with `sensors:` as its sensor
-    models deliver them (`sensors.sensing.sensed_states`; the same result however often it is
+    models deliver them (`sensors.sensing.sensed_states`), with `estimator:` as it estimates
+    them (`estimators.estimation.estimated_states`; the same result however often it is
     called at one tick)."""
     measured_states(m.state[b], states.shape[0], states)
     if a.sensor_models.shape[1]:
         sensed_states(a.sensor_models[b], a.sensor_constants[b], a.sensor_draws[b],
                       m.sensor_memory[b], m.tick[b], states)
+    if a.estimator_models.shape[1]:  # the estimate from the sensors (estimators.estimation)
+        estimated_states(a.estimator_models[b], a.estimator_constants[b], m.sensor_memory[b],
+                         m.estimator_memory[b], m.tick[b], states)
 
 
 @jit

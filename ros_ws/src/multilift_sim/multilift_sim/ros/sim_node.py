@@ -39,7 +39,8 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       recorder_hears, recorder_missing, run_node, wait_until,
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
-from multilift_sim.topics import (CABLE_LENGTH, CLOCK, EVENTS, FORMATION_SNAPSHOT, FORMATION_STATE,
+from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
+                                  FORMATION_STATE,
                                   MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
                                   PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, WINCH_CMD, parse_external,
                                   state_topics, uav_topic)
@@ -102,7 +103,10 @@ class SimNode(Node):
         # /uav{i}/measured_odom, what the controllers receive, where it has `sensors:`
         self.measured_pubs = [self.create_publisher(Odometry, uav_topic(i + 1, MEASURED_ODOM),
                                                     PUBLISHER_QOS)
-                              for i in range(n)] if scenario.sensors is not None else []
+                              for i in range(n)] if scenario.measures else []
+        # /uav{i}/estimate, each UAV's estimate with its covariance, with an estimator
+        estimates = [self.create_publisher(Odometry, uav_topic(i + 1, ESTIMATE), PUBLISHER_QOS)
+                     for i in range(n)] if scenario.estimator is not None else []
         # /uav{i}/cable_length of each UAV with a winch
         lengths = [self.create_publisher(Float64, uav_topic(i, CABLE_LENGTH), PUBLISHER_QOS)
                    for i in scenario.winches]
@@ -111,7 +115,7 @@ class SimNode(Node):
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
             self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events, *winds,
-            *self.measured_pubs, *lengths,
+            *self.measured_pubs, *estimates, *lengths,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)
@@ -187,7 +191,7 @@ class SimNode(Node):
         """Whether a node publishing `command_topic` subscribes to one of the simulator's state
         topics. The graph lists a node's subscriptions once our participant discovered them,
         which is when our writers match them."""
-        wanted = set(state_topics(self.sim.n, self.scenario.sensors is not None))
+        wanted = set(state_topics(self.sim.n, self.scenario.measures))
         for info in self.get_publishers_info_by_topic(command_topic):
             if not info.node_namespace.startswith('/'):
                 continue  # the writer is known, its node not yet (_NODE_NAMESPACE_UNKNOWN_)
@@ -203,7 +207,7 @@ class SimNode(Node):
     def _state_topics_text(self, index: int) -> str:
         """The state topics in words for UAV `index`: its own odometry first."""
         own = uav_topic(index, ODOM)
-        others = [t for t in state_topics(self.sim.n, self.scenario.sensors is not None)
+        others = [t for t in state_topics(self.sim.n, self.scenario.measures)
                   if t != own]
         return ', '.join([own] + others)
 

@@ -220,6 +220,14 @@ class SensorConfig:
 
 
 @dataclass(frozen=True)
+class EstimatorConfig:
+    """The estimator of every UAV (`estimator:`, docs/estimation.md): a part of
+    multilift_sim.estimators.ESTIMATORS with its keys."""
+    model: str                       # its name in ESTIMATORS (`estimator.model`)
+    settings: Any                    # its own keys, as its `parse` read them
+
+
+@dataclass(frozen=True)
 class Scenario:
     name: str
     description: str
@@ -239,6 +247,9 @@ class Scenario:
     # the wind models `wind:` names: (name, its config) (multilift_sim.wind.WIND_MODELS)
     wind_models: tuple[tuple[str, Any], ...] = ()
     sensors: SensorConfig | None = None  # None: the controllers read the exact state
+    # the sensors of their own sections (`imu:`, `mocap:`), in the registry's order
+    sensor_suite: tuple[SensorConfig, ...] = ()
+    estimator: EstimatorConfig | None = None  # None: no estimator (`estimator: none`)
     parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
     world: WorldConfig | None = None  # obstacles, ground (`world:`); None: no clearance checks
 
@@ -250,6 +261,12 @@ class Scenario:
     def prescribed(self) -> tuple[int, ...]:
         """The UAVs (from 0) whose motion is prescribed (`uavs[i].trajectory`)."""
         return tuple(i for i, u in enumerate(self.uavs) if u.trajectory is not None)
+
+    @property
+    def measures(self) -> bool:
+        """Whether the controllers receive something other than the state (`sensors:` or an
+        estimator): every /uav{i}/measured_odom carries what they received."""
+        return self.sensors is not None or self.estimator is not None
 
     @property
     def winches(self) -> tuple[int, ...]:

@@ -16,12 +16,11 @@ from multilift_sim.cables import CABLE_MODELS, winch
 from multilift_sim.formulations import FORMULATIONS, unsupported
 from multilift_sim.payloads import PAYLOAD_TYPES
 from multilift_sim.events import EVENT_KINDS
-from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
 from multilift_sim.scenario.config import (FORMATION_GEOMETRIES,
                                            INPUT_SHAPERS,
                                            ControlConfig, EventConfig, FormationConfig,
                                            PayloadConfig,
-                                           Scenario, ScenarioError, SensorConfig,
+                                           Scenario, ScenarioError,
                                            SimulationConfig, UavConfig,
                                            flies_a_period, one_period_rule)
 from multilift_sim.scenario.controllers import (DEFAULT_FOLLOWER, follower_controllers,
@@ -32,6 +31,7 @@ from multilift_sim.scenario.part_files import scenario_parts
 from multilift_sim.scenario.prescribed import (check_prescribed, finite_vector, read_trajectory,
                                                scenario_folder)
 from multilift_sim.scenario.reading import Section
+from multilift_sim.scenario.sensor_sections import estimator_section, sensor_suite, sensors_section
 from multilift_sim.scenario.world import check_start, read_world
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
                                             preset_values, vehicle_params)
@@ -178,7 +178,9 @@ def scenario_of(data: Any, where: str) -> Scenario:
             wind_models.append((model_name, model.parse(d)))
             d.done()
     w.done()
-    sensors = _sensors(top.section('sensors'), sim) if top.has('sensors') else None
+    sensors = sensors_section(top.section('sensors'), sim) if top.has('sensors') else None
+    suite = sensor_suite(top, sim)
+    estimator = estimator_section(top, suite)
 
     c = top.section('control')
     mode = c.text('mode', choices=tuple(leader_controllers()))
@@ -210,8 +212,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
                         mission=mission,
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, cable=rope, events=events, wind=tuple(wind),
-                        wind_models=tuple(wind_models), sensors=sensors, parts=parts,
-                        world=world)
+                        wind_models=tuple(wind_models), sensors=sensors,
+                        sensor_suite=suite, estimator=estimator, parts=parts, world=world)
     _check_feasible(scenario)
     check_limits(scenario)
     check_prescribed(scenario)  # the files cover the run, the payload's start fits the cables
@@ -287,24 +289,6 @@ def _payload_feedback(c: Section, mode: str) -> dict[str, float]:
                             f'{mode!r}')
     feedback.done()
     return {**gains, 'input_shaping': shaping}
-
-
-def _sensors(d: Section, sim: SimulationConfig) -> SensorConfig:
-    """The `sensors:` section, validated: its model (default DEFAULT_MODEL, one of the
-    registry's), the rate (default the control rate, which it must divide) and the seed, which
-    every model has, then the model's own keys (its `parse`), nothing else."""
-    model = d.text('model', DEFAULT_MODEL, choices=tuple(SENSOR_MODELS))
-    control_rate = sim.control_rate
-    rate = d.number('rate', control_rate, lambda v: 0 < v <= control_rate,
-                    f'must be > 0 and <= simulation.control_rate ({control_rate:g})')
-    ratio = control_rate / rate
-    if abs(ratio - round(ratio)) > 1e-9:
-        raise d.fail('rate', rate, f'must divide simulation.control_rate ({control_rate:g}) '
-                     'into a whole number of ticks')
-    config = SensorConfig(model=model, rate=rate, seed=d.count('seed', 0),
-                          settings=SENSOR_MODELS[model].parse(d))
-    d.done()
-    return config
 
 
 def _events(top: Section, uavs: list[UavConfig], duration: float) -> tuple[EventConfig, ...]:

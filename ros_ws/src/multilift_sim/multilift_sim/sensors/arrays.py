@@ -38,17 +38,32 @@ def _padded(rows: list[np.ndarray], empty: tuple[int, ...]) -> np.ndarray:
     return out
 
 
+def sensor_configs(scenario) -> tuple:
+    """The run's sensors in the order the tick runs them: `sensors:` (what the controllers
+    receive), then the sensors of their own sections (`imu:`, `mocap:`: `sensor_suite`)."""
+    return (() if scenario.sensors is None else (scenario.sensors,)) + scenario.sensor_suite
+
+
+def sensor_rng(scenario, config) -> np.random.Generator:
+    """The stream of a sensor's draws: numpy.random.default_rng of its `seed` for `sensors:`;
+    of (seed, its model's index) for a sensor of its own section, so that two with one seed
+    draw apart."""
+    if config is scenario.sensors:
+        return np.random.default_rng(config.seed)
+    return np.random.default_rng((config.seed, model_index(config.model)))
+
+
 def sensor_arrays(scenario) -> SensorArrays:
-    """The scenario's `sensors:` as arrays: its draws from numpy.random.default_rng of the
-    section's `seed`, the model's `draws` in its fixed order."""
-    configs = () if scenario.sensors is None else (scenario.sensors,)
+    """The scenario's sensors (`sensor_configs`) as arrays: each one's draws from its stream
+    (`sensor_rng`), the model's `draws` in its fixed order."""
+    configs = sensor_configs(scenario)
     sim, n = scenario.simulation, scenario.n_uavs
     constants, draws, memory = [], [], []
     for config in configs:
         model = SENSOR_MODELS[config.model]
         every = config.every(sim.control_rate)
         samples = sensor_samples(sim.tick_count, every)
-        rng = np.random.default_rng(config.seed)
+        rng = sensor_rng(scenario, config)
         constants.append(np.asarray(model.constants(config.settings, every), dtype=float))
         draws.append(np.asarray(model.draws(config.settings, n, samples,
                                             every / sim.control_rate, rng), dtype=float))

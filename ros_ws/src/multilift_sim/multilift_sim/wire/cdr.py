@@ -42,16 +42,19 @@ class Float64:
 
 
 class Odometry:
-    """nav_msgs/Odometry with zero covariances, frame `frame`, child `child`."""
+    """nav_msgs/Odometry with zero covariances, frame `frame`, child `child`; with `covariance`
+    its covariances given (`pack_row`'s 85 numbers in the message's order: an estimate,
+    estimators.published)."""
 
-    def __init__(self, child: str, frame: str = WORLD_FRAME) -> None:
+    def __init__(self, child: str, frame: str = WORLD_FRAME, covariance: bool = False) -> None:
         layout, self._frame = header_layout(frame)
         child_data = layout.string(child)
         self._frame += (len(child_data) + 1, child_data)
+        covariances = layout.primitive if covariance else layout.zeros
         layout.primitive('d', 7)    # pose: position, orientation
-        layout.zeros('d', 36)       # pose covariance
+        covariances('d', 36)        # pose covariance
         layout.primitive('d', 6)    # twist: linear, angular
-        layout.zeros('d', 36)       # twist covariance
+        covariances('d', 36)        # twist covariance
         self.layout, self._struct = layout, layout.compile()
 
     def pack(self, t_ns: int, position: Sequence[float], orientation: Sequence[float],
@@ -61,7 +64,7 @@ class Odometry:
                                  *orientation, *linear, *angular)
 
     def pack_row(self, t_ns: int, row: Sequence[float]) -> bytes:
-        """From the 13 numbers of `pack`'s four tuples in a row."""
+        """From the 13 numbers of `pack`'s four tuples in a row (with `covariance`, 85)."""
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, *row)
 
 

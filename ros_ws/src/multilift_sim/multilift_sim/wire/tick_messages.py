@@ -25,7 +25,7 @@ from multilift_sim.physics.measurement import odometry_rows, odometry_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.wire.scene import FormationScene
 from multilift_sim.simulation import Snapshot
-from multilift_sim.topics import (CABLE_LENGTH, CLOCK, EVENTS, FORMATION_SNAPSHOT,
+from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
                                   FORMATION_STATE, MARKERS, MEASURED_ODOM, PAYLOAD_GUST,
                                   PAYLOAD_ODOM, TF, ODOM, WIND, uav_topic)
 
@@ -50,7 +50,10 @@ class SimulatorMessages:
                           for i in range(1, n + 1)]
         # what the controllers receive, UAV by UAV, where the scenario has `sensors:`
         self._measured = [(uav_topic(i, MEASURED_ODOM), cdr.Odometry(uav_frame(i)))
-                          for i in range(1, n + 1)] if scenario.sensors is not None else []
+                          for i in range(1, n + 1)] if scenario.measures else []
+        # each UAV's estimate with its covariance (/uav{i}/estimate), with an estimator
+        self._estimates = [(uav_topic(i, ESTIMATE), cdr.Odometry(uav_frame(i), covariance=True))
+                           for i in range(1, n + 1)] if scenario.estimator is not None else []
         # each winch's cable length (/uav{i}/cable_length), where UAVs carry winches
         self._lengths = [(i - 1, uav_topic(i, CABLE_LENGTH), cdr.Float64())
                          for i in scenario.winches]
@@ -91,7 +94,8 @@ class SimulatorMessages:
             None if snapshot is None else len(snapshot[-1]), uavs,
             snap.payload_position.tolist(), payload_velocity, vec3(gust),
             measured, None if wind is None else vec3(wind), payload_pose,
-            snap.cable_lengths.tolist())
+            snap.cable_lengths.tolist(),
+            snap.estimate.tolist() if self._estimates else None)
 
     def state_of(self, t_ns: int, snapshot: list[float] | None, previous: int | None,
                  uavs: Sequence[Sequence[float]], payload_position: Sequence[float],
@@ -99,7 +103,8 @@ class SimulatorMessages:
                  measured: Sequence[Sequence[float]] | None = None,
                  wind: Sequence[float] | None = None,
                  payload_pose: tuple[Sequence[float], Sequence[float]] | None = None,
-                 cable_lengths: Sequence[float] = ()) -> list[Message]:
+                 cable_lengths: Sequence[float] = (),
+                 estimates: Sequence[Sequence[float]] | None = None) -> list[Message]:
         """`state` from plain numbers (the one packing of both): `snapshot` the
         FormationSnapshot's numbers in a row (`cdr.FormationSnapshot.pack_row`; None at the
         last tick) with `previous` rotor speeds at its end, per UAV its odometry's 13 numbers
@@ -108,7 +113,8 @@ class SimulatorMessages:
         position and velocity, the gust and (where the air moves everywhere) the wind, world
         [m, m/s]; a rigid payload's `payload_pose` (its orientation (x, y, z, w) and body rates
         [rad/s]; its velocity then in its own frame, as nav_msgs/Odometry's twist is), and
-        every cable's length [m] (/uav{i}/cable_length of the UAVs with a winch)."""
+        every cable's length [m] (/uav{i}/cable_length of the UAVs with a winch), and with an
+        estimator every UAV's estimate (estimators.published's 85 numbers, /uav{i}/estimate)."""
         orientation, spin = (IDENTITY, _ZERO) if payload_pose is None else payload_pose
         out = [(CLOCK, self._clock.pack(t_ns))]
         if snapshot is not None:
@@ -117,6 +123,9 @@ class SimulatorMessages:
             out.append((topic, packer.pack_row(t_ns, uav)))
         if measured is not None:
             for uav, (topic, packer) in zip(measured, self._measured):
+                out.append((topic, packer.pack_row(t_ns, uav)))
+        if estimates is not None:
+            for uav, (topic, packer) in zip(estimates, self._estimates):
                 out.append((topic, packer.pack_row(t_ns, uav)))
         for i, topic, packer in self._lengths:
             out.append((topic, packer.pack(cable_lengths[i])))

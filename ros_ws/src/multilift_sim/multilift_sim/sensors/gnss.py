@@ -1,0 +1,131 @@
+"""`gnss`: a GNSS receiver on every UAV (issue 33 item 1; docs/estimation.md): its position [m]
+and velocity [m/s] (world) at its own rate, `latency` late, with white noise and dropouts.
+
+Sample s, taken at tick s * every, carries p + (sigma_h w_x, sigma_h w_y, sigma_v w_z) and
+v + sigma_v' w', w standard normal, and arrives `latency` [s] later (to the nearest control
+tick) unless lost (probability `dropout`). The first sample (tick 0) arrives at once. Errors
+drawn before the run (`draws`). A real receiver's error wanders slowly (multipath, the
+atmosphere); white noise is the datasheets' figure, not that correlation: not modelled.
+
+Preset `gnss_outdoor` (docs/estimation.md cites each value): a u-blox M8 receiver (MAX-M8Q):
+10 Hz, 2.5 m CEP horizontal (sigma = CEP / 1.1774 = 2.12 m per axis), vertical assumed twice
+that, velocity 0.05 m/s, 110 ms latency (PX4 EKF2's default EKF2_GPS_DELAY), none lost.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from multilift_sim.kernels import jit
+from multilift_sim.physics.layout import MEASURED_POSITION, MEASURED_VELOCITY
+from multilift_sim.sensors.outputs import ARRIVED, OUTPUT, TAKEN
+
+NAME = 'gnss'
+UNITS = {'horizontal_position_noise': 'm', 'vertical_position_noise': 'm',
+         'velocity_noise': 'm/s', 'latency': 's', 'dropout': '', 'preset': ''}
+CEP_SIGMA = 1.1774  # CEP / sigma of a circular normal distribution (sqrt(2 ln 2))
+PRESETS = {'gnss_outdoor': {'rate': 10.0, 'latency': 0.11,
+                            'horizontal_position_noise': 2.5 / CEP_SIGMA,
+                            'vertical_position_noise': 2.0 * 2.5 / CEP_SIGMA,
+                            'velocity_noise': 0.05, 'dropout': 0.0}}
+
+# -- its output (after outputs.OUTPUT) ---------------------------------------------------------
+OUTPUT_POSITION = 0         # p [m], world (3)
+OUTPUT_VELOCITY = 3         # v [m/s], world (3)
+OUTPUT_COLUMNS = 6
+# -- its constants row -------------------------------------------------------------------------
+EVERY = 0                   # control ticks between two samples
+LATENCY = 1                 # control ticks from a sample to its arrival
+CONSTANT_COLUMNS = 2
+# -- a sample's draws --------------------------------------------------------------------------
+DRAW_ERROR = 0              # its position and velocity errors [m, m/s] (6)
+DRAW_DELIVERED = 6          # 1.0: it arrives, 0.0: lost
+DRAW_COLUMNS = 7
+# -- one UAV's memory (after outputs.OUTPUT's block) ------------------------------------------
+LAST_TICK = OUTPUT + OUTPUT_COLUMNS  # the tick measured last (-1: none)
+DELAY_LINE = LAST_TICK + 1  # the true (p, v) of the last latency + 1 ticks, by tick %
+#                             (latency + 1) (rows of OUTPUT_COLUMNS)
+
+
+@dataclass(frozen=True)
+class GnssSettings:
+    horizontal_position_noise: float  # [m], standard deviation per horizontal axis
+    vertical_position_noise: float    # [m]
+    velocity_noise: float             # [m/s], per axis
+    latency: float                    # [s]
+    dropout: float                    # probability a sample is lost, in [0, 1)
+    latency_ticks: int = 0            # the latency in control ticks (`with_simulation`)
+
+
+def preset_values(d) -> dict:
+    """The key values of the section's `preset` (none: {})."""
+    return PRESETS.get(d.text('preset', 'none', choices=('none', *PRESETS)), {})
+
+
+def parse(d) -> GnssSettings:
+    """Its keys from `d` (the `gnss:` section), defaults its `preset`'s (else 0)."""
+    preset = preset_values(d)
+    return GnssSettings(
+        **{key: d.non_negative(key, preset.get(key, 0.0)) for key in (
+            'horizontal_position_noise', 'vertical_position_noise', 'velocity_noise',
+            'latency')},
+        dropout=d.number('dropout', preset.get('dropout', 0.0), lambda v: 0 <= v < 1,
+                         'must be within [0, 1)'))
+
+
+def with_simulation(settings: GnssSettings, simulation, every: int) -> GnssSettings:
+    """The settings with the latency in control ticks (the nearest)."""
+    return replace(settings, latency_ticks=int(round(settings.latency * simulation.control_rate)))
+
+
+def constants(settings: GnssSettings, every: int) -> np.ndarray:
+    row = np.zeros(CONSTANT_COLUMNS)
+    row[EVERY], row[LATENCY] = every, settings.latency_ticks
+    return row
+
+
+def memory(settings: GnssSettings) -> np.ndarray:
+    row = np.zeros(DELAY_LINE + (settings.latency_ticks + 1) * OUTPUT_COLUMNS)
+    row[ARRIVED] = row[TAKEN] = row[LAST_TICK] = -1.0
+    return row
+
+
+def draws(settings: GnssSettings, n_uavs: int, samples: int, dt: float,
+          rng: np.random.Generator) -> np.ndarray:
+    """Every sample's draws (n_uavs, samples, DRAW_COLUMNS) in a fixed order from `rng`
+    (position and velocity noise, dropouts)."""
+    sigma = np.array([settings.horizontal_position_noise] * 2
+                     + [settings.vertical_position_noise] + [settings.velocity_noise] * 3)
+    rows = np.empty((n_uavs, samples, DRAW_COLUMNS))
+    rows[:, :, DRAW_ERROR:DRAW_ERROR + 6] = rng.standard_normal((n_uavs, samples, 6)) * sigma
+    rows[:, :, DRAW_DELIVERED] = rng.random((n_uavs, samples)) >= settings.dropout
+    return rows
+
+
+@jit
+def measure(constants, draws, memory, tick, truth, received):
+    """At control tick `tick`: the true position and velocity from `truth` into the delay
+    line; the sample taken `latency` ticks ago, if one was and is not lost, into the output
+    with its errors (ARRIVED this tick, TAKEN its tick); received left alone. A second call
+    at one tick changes nothing."""
+    if memory[LAST_TICK] == tick:
+        return
+    memory[LAST_TICK] = tick
+    every = int(constants[EVERY])
+    slots = int(constants[LATENCY]) + 1
+    line = DELAY_LINE + (tick % slots) * OUTPUT_COLUMNS
+    for j in range(3):
+        memory[line + OUTPUT_POSITION + j] = truth[MEASURED_POSITION + j]
+        memory[line + OUTPUT_VELOCITY + j] = truth[MEASURED_VELOCITY + j]
+    taken = 0 if tick == 0 else tick - slots + 1
+    if taken < 0 or taken % every != 0 or (taken == 0 and tick > 0):  # tick 0's: at once
+        return
+    sample = taken // every
+    if sample >= draws.shape[0] or (draws[sample, DRAW_DELIVERED] == 0.0 and tick > 0):
+        return
+    source = DELAY_LINE + (taken % slots) * OUTPUT_COLUMNS
+    for j in range(OUTPUT_COLUMNS):
+        memory[OUTPUT + j] = memory[source + j] + draws[sample, DRAW_ERROR + j]
+    memory[ARRIVED] = tick
+    memory[TAKEN] = taken

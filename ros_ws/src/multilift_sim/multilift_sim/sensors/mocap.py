@@ -1,0 +1,146 @@
+"""`mocap`: motion capture (issue 33 item 1; docs/estimation.md): every UAV's position [m]
+(world) and attitude (the quaternion body -> world) at its own rate, `latency` late, with white
+noise and dropouts, as a Vicon or OptiTrack system streams a rigid body's pose.
+
+Sample s, taken at tick s * every, carries position p + sigma_p w_p and attitude q (x)
+Exp(sigma_theta w_theta) (a body-frame rotation of sigma_theta [rad] per axis), w
+standard normal; it arrives `latency` [s] later (rounded to the nearest control tick) unless
+lost (probability `dropout`, each sample independently). The first sample (tick 0) arrives
+at once: the estimator starts from it. Errors drawn before the run (`draws`).
+
+Preset `mocap_indoor` (docs/estimation.md cites each value): 100 Hz, 7 ms latency (a
+Qualisys system measured end to end at ETH Zurich: 6-7 ms), 1 mm of position noise (a Vicon
+system's dynamic error below 2 mm: Merriaux et al., Sensors 17(7) 1591, 2017), 5 mrad of
+attitude noise (1 mm across a 0.2 m marker base) and 1 % of samples lost (assumed).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from multilift_sim.kernels import jit
+from multilift_sim.physics.attitude import rotation_quaternion, quaternion_product
+from multilift_sim.physics.layout import MEASURED_EULER, MEASURED_POSITION
+from multilift_sim.physics.measurement import euler_quaternion
+from multilift_sim.sensors.outputs import ARRIVED, OUTPUT, TAKEN
+
+NAME = 'mocap'
+UNITS = {'position_noise': 'm', 'attitude_noise': 'rad', 'latency': 's', 'dropout': '',
+         'preset': ''}
+PRESETS = {'mocap_indoor': {'rate': 100.0, 'latency': 0.007, 'position_noise': 0.001,
+                            'attitude_noise': 0.005, 'dropout': 0.01}}
+
+# -- its output (after outputs.OUTPUT) ---------------------------------------------------------
+OUTPUT_POSITION = 0         # p [m], world (3)
+OUTPUT_QUATERNION = 3       # q (w, x, y, z), body -> world (4)
+OUTPUT_COLUMNS = 7
+# -- its constants row -------------------------------------------------------------------------
+EVERY = 0                   # control ticks between two samples
+LATENCY = 1                 # control ticks from a sample to its arrival
+CONSTANT_COLUMNS = 2
+# -- a sample's draws --------------------------------------------------------------------------
+DRAW_POSITION = 0           # its position error [m] (3)
+DRAW_ATTITUDE = 3           # its attitude error [rad], body rotation vector (3)
+DRAW_DELIVERED = 6          # 1.0: it arrives, 0.0: lost
+DRAW_COLUMNS = 7
+# -- one UAV's memory (after outputs.OUTPUT's block) ------------------------------------------
+LAST_TICK = OUTPUT + OUTPUT_COLUMNS  # the tick measured last (-1: none)
+DELAY_LINE = LAST_TICK + 1  # the true poses (p, q) of the last latency + 1 ticks, by tick %
+#                             (latency + 1) (rows of OUTPUT_COLUMNS)
+
+
+@dataclass(frozen=True)
+class MocapSettings:
+    """Its keys."""
+    position_noise: float            # [m], standard deviation per axis
+    attitude_noise: float            # [rad], standard deviation per body axis
+    latency: float                   # [s] from a sample to its arrival
+    dropout: float                   # probability a sample is lost, in [0, 1)
+    latency_ticks: int = 0           # the latency in control ticks (`with_simulation`)
+
+
+def preset_values(d) -> dict:
+    """The key values of the section's `preset` (none: {})."""
+    return PRESETS.get(d.text('preset', 'none', choices=('none', *PRESETS)), {})
+
+
+def parse(d) -> MocapSettings:
+    """Its keys from `d` (the `mocap:` section), defaults its `preset`'s (else 0)."""
+    preset = preset_values(d)
+    return MocapSettings(
+        position_noise=d.non_negative('position_noise', preset.get('position_noise', 0.0)),
+        attitude_noise=d.non_negative('attitude_noise', preset.get('attitude_noise', 0.0)),
+        latency=d.non_negative('latency', preset.get('latency', 0.0)),
+        dropout=d.number('dropout', preset.get('dropout', 0.0), lambda v: 0 <= v < 1,
+                         'must be within [0, 1)'))
+
+
+def with_simulation(settings: MocapSettings, simulation, every: int) -> MocapSettings:
+    """The settings with the latency in control ticks (the nearest)."""
+    return MocapSettings(**{**settings.__dict__, 'latency_ticks': int(round(
+        settings.latency * simulation.control_rate))})
+
+
+def constants(settings: MocapSettings, every: int) -> np.ndarray:
+    row = np.zeros(CONSTANT_COLUMNS)
+    row[EVERY], row[LATENCY] = every, settings.latency_ticks
+    return row
+
+
+def memory(settings: MocapSettings) -> np.ndarray:
+    row = np.zeros(DELAY_LINE + (settings.latency_ticks + 1) * OUTPUT_COLUMNS)
+    row[ARRIVED] = row[TAKEN] = row[LAST_TICK] = -1.0
+    return row
+
+
+def draws(settings: MocapSettings, n_uavs: int, samples: int, dt: float,
+          rng: np.random.Generator) -> np.ndarray:
+    """Every sample's draws (n_uavs, samples, DRAW_COLUMNS) in a fixed order from `rng`
+    (position noise, attitude noise, dropouts)."""
+    rows = np.empty((n_uavs, samples, DRAW_COLUMNS))
+    rows[:, :, DRAW_POSITION:DRAW_POSITION + 3] = (
+        rng.standard_normal((n_uavs, samples, 3)) * settings.position_noise)
+    rows[:, :, DRAW_ATTITUDE:DRAW_ATTITUDE + 3] = (
+        rng.standard_normal((n_uavs, samples, 3)) * settings.attitude_noise)
+    rows[:, :, DRAW_DELIVERED] = rng.random((n_uavs, samples)) >= settings.dropout
+    return rows
+
+
+@jit
+def measure(constants, draws, memory, tick, truth, received):
+    """At control tick `tick`: the true pose from `truth` (MEASURED_COLUMNS,) into the delay
+    line; the sample taken `latency` ticks ago, if one was and is not lost, into the output
+    with its errors (ARRIVED this tick, TAKEN its tick); received left alone. A second call
+    at one tick changes nothing."""
+    if memory[LAST_TICK] == tick:
+        return
+    memory[LAST_TICK] = tick
+    every = int(constants[EVERY])
+    slots = int(constants[LATENCY]) + 1
+    line = DELAY_LINE + (tick % slots) * OUTPUT_COLUMNS
+    for j in range(3):
+        memory[line + OUTPUT_POSITION + j] = truth[MEASURED_POSITION + j]
+    x, y, z, w = euler_quaternion(truth[MEASURED_EULER], truth[MEASURED_EULER + 1],
+                                  truth[MEASURED_EULER + 2])
+    q = line + OUTPUT_QUATERNION
+    memory[q], memory[q + 1], memory[q + 2], memory[q + 3] = w, x, y, z
+    taken = 0 if tick == 0 else tick - slots + 1
+    if taken < 0 or taken % every != 0 or (taken == 0 and tick > 0):  # tick 0's: at once
+        return
+    sample = taken // every
+    if sample >= draws.shape[0] or (draws[sample, DRAW_DELIVERED] == 0.0 and tick > 0):
+        return
+    source = DELAY_LINE + (taken % slots) * OUTPUT_COLUMNS
+    for j in range(3):
+        memory[OUTPUT + OUTPUT_POSITION + j] = (memory[source + OUTPUT_POSITION + j]
+                                                + draws[sample, DRAW_POSITION + j])
+    e0, e1, e2, e3 = rotation_quaternion(draws[sample, DRAW_ATTITUDE],
+                                         draws[sample, DRAW_ATTITUDE + 1],
+                                         draws[sample, DRAW_ATTITUDE + 2])
+    s = source + OUTPUT_QUATERNION
+    o = OUTPUT + OUTPUT_QUATERNION
+    memory[o], memory[o + 1], memory[o + 2], memory[o + 3] = quaternion_product(
+        memory[s], memory[s + 1], memory[s + 2], memory[s + 3], e0, e1, e2, e3)
+    memory[ARRIVED] = tick
+    memory[TAKEN] = taken

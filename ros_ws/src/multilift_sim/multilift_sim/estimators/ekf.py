@@ -77,6 +77,7 @@ HISTORY = DELAYED_COVARIANCE + ERROR_SIZE * ERROR_SIZE  # the ring of IMU sample
 #                                             (L + 1): each its tick (-1: none), f (3), w (3)
 SAMPLE = 7                  # a ring entry's length
 UPDATE_DOF = 6              # the NIS's degrees of freedom: position and attitude
+COVARIANCE_SIDE = 6         # nav_msgs/Odometry's covariances: 6 x 6, row by row
 
 
 @dataclass(frozen=True)
@@ -248,9 +249,10 @@ def publish(constants, x, covariance, memory):
                 total = 0.0
                 for k in range(ERROR_SIZE):
                     total += product[r, k] * jacobian[c, k]
-                memory[start + 6 * r + c] = total
+                memory[start + COVARIANCE_SIDE * r + c] = total
     for j in range(3):
-        memory[ESTIMATE_TWIST_COVARIANCE + 6 * (3 + j) + 3 + j] += constants[RATE_VARIANCE]
+        memory[ESTIMATE_TWIST_COVARIANCE + COVARIANCE_SIDE * (3 + j) + 3 + j] += \
+            constants[RATE_VARIANCE]
 
 
 @jit

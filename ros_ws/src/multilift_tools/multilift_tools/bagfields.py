@@ -23,9 +23,11 @@ def _vec(v: Any) -> list[float]:
 def _odometry(msg: Any) -> dict[str, list[float]]:
     pose, twist = msg.pose.pose, msg.twist.twist
     q = pose.orientation
+    covariance = msg.pose.covariance   # 6 x 6, row by row: its diagonal's variances
     return {'position': _vec(pose.position),
             'orientation': [float(q.x), float(q.y), float(q.z), float(q.w)],
-            'linear': _vec(twist.linear), 'angular': _vec(twist.angular)}
+            'linear': _vec(twist.linear), 'angular': _vec(twist.angular),
+            'pose_variance': [float(covariance[7 * k]) for k in range(6)]}
 
 
 def _formation_state(msg: Any) -> dict[str, Any]:

@@ -30,6 +30,7 @@ from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, WORLD, Context,
 from multilift_tools.plots.obstacles import fig_clearance, lacks_world
 from multilift_tools.plots.ropes import (fig_cable_lengths, fig_rope_stretch, lacks_ropes,
                                          lacks_winches)
+from multilift_tools.plots.estimation import fig_estimation, lacks_estimates
 from multilift_tools.plots.rotors import fig_rotor_speeds, fig_thrust, fig_thrust_margins
 from multilift_tools.plots.scene import released_cables
 from multilift_tools.plots.views import fig_top_view, fig_trajectories_3d
@@ -243,6 +244,7 @@ FIGURES: tuple[FigureSpec, ...] = (
     FigureSpec('thrust', fig_thrust, _topics(uav_topic(1, ATTITUDE_SETPOINT))),
     FigureSpec('rotor_speeds', fig_rotor_speeds, _topics(uav_topic(1, ROTOR_CMD))),
     FigureSpec('thrust_margins', fig_thrust_margins, _topics(uav_topic(1, ROTOR_CMD))),
+    FigureSpec('estimation', fig_estimation, lacks_estimates),
     FigureSpec('payload_position', fig_payload_position, _topics(PAYLOAD_ODOM)),
     FigureSpec('payload_attitude', fig_payload_attitude, _lacks_payload_attitude),
     FigureSpec('leader_tracking', fig_leader_tracking, _topics(REFERENCE_TOPIC)),

@@ -6,6 +6,8 @@
     views       the 3-D trajectories and the top view, drawn from the scene
     ropes       elastic ropes' stretch and tension (cable_model: elastic), winches' reeled
                 lengths (uavs[i].winch)
+    estimation  each UAV's estimated position against the truth in its 3-sigma band (an
+                estimator, docs/estimation.md)
     rotors      collective thrust and rotor speeds (each rotor its colour and dash; the clipped
                 strips at the limit they hit)
 """

@@ -203,3 +203,30 @@ def test_the_foxglove_layout_plots_each_winch_s_length_only_where_there_are_winc
                                                    '/uav2/cable_length.data']
     assert {p['timestampMethod'] for p in plot['paths']} == {'receiveTime'}   # no header
     assert 'Plot!winches' not in layout(scenario_io.load('twin_lift'))['configById']
+
+
+def test_a_rigid_beam_is_lowered_on_its_reeled_cables():
+    """beam_lift's two winches pay out 0.2 m/s for 10 s in a hover: each cable 2 m longer
+    (the ramps cancel), the beam (a rigid body, its cables at its ends) lowered with them, the
+    reeled constraint |d_i|^2 = l_i(t)^2 held within 1e-3 m^2."""
+    data = yaml.safe_load((SCENARIOS / 'beam_lift.yaml').read_text())
+    for uav in data['uavs']:
+        uav['winch'] = dict(WINCH, min_length=2.0, max_length=15.0)
+    data['simulation']['duration'] = 30.0
+    data['mission']['segments'] = [{'velocity': [0.0, 0.0, 0.0], 'until': 30.0}]
+    data['events'] = [{'time': t, 'type': 'winch_rate', 'uav': i, 'rate': rate}
+                      for t, rate in ((5.0, 0.2), (15.0, 0.0)) for i in (1, 2)]
+    s = scenario_io.loads(yaml.safe_dump(data))
+    start = FormationSimulator(s).state.copy()
+    run = fly(s)
+    sim = run.summary()['sim']
+    length = s.uavs[0].cable_length
+    assert sim['longest_cable'] == pytest.approx([length + 2.0] * 2, abs=1e-9)
+    assert sim['max_abs_constraint'] < 1e-3
+    layout = StateLayout(2)
+
+    def below(x):
+        return layout.uav_positions(x)[:, 2].mean() - layout.payload_position(x)[2]
+    # 2 m for vertical cables; a cable leaning h off its end drops sqrt(l_1^2 - h^2) -
+    # sqrt(l_0^2 - h^2), more (beam_lift's UAVs stand outside its ends: 2.07 m)
+    assert 2.0 <= below(run.engine.state[0]) - below(start) < 2.2

@@ -6,6 +6,9 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+import numpy as np
+
+from multilift_sim.estimators.published import COVARIANCE_SIDE
 from multilift_sim.topics import (ATTITUDE_SETPOINT_TYPE, FLOAT64_TYPE, FORMATION_ERROR_TYPE,
                                   FORMATION_EVENT_TYPE, FORMATION_STATE_TYPE, ODOMETRY_TYPE,
                                   ROTOR_COMMAND_TYPE, TRACKING_REFERENCE_TYPE,
@@ -23,11 +26,12 @@ def _vec(v: Any) -> list[float]:
 def _odometry(msg: Any) -> dict[str, list[float]]:
     pose, twist = msg.pose.pose, msg.twist.twist
     q = pose.orientation
-    covariance = msg.pose.covariance   # 6 x 6, row by row: its diagonal's variances
+    variances = np.asarray(msg.pose.covariance, dtype=float).reshape(
+        COVARIANCE_SIDE, COVARIANCE_SIDE).diagonal()
     return {'position': _vec(pose.position),
             'orientation': [float(q.x), float(q.y), float(q.z), float(q.w)],
             'linear': _vec(twist.linear), 'angular': _vec(twist.angular),
-            'pose_variance': [float(covariance[7 * k]) for k in range(6)]}
+            'pose_variance': variances.tolist()}   # the 6 x 6 pose covariance's diagonal
 
 
 def _formation_state(msg: Any) -> dict[str, Any]:

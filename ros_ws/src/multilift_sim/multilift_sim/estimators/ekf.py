@@ -36,7 +36,7 @@ from multilift_sim.estimators.error_state import (
     NOMINAL_SIZE, NOMINAL_VELOCITY, fuse, inject, propagate)
 from multilift_sim.kernels import jit
 from multilift_sim.estimators.published import (
-    ESTIMATE_ANGULAR, ESTIMATE_COLUMNS, ESTIMATE_LINEAR, ESTIMATE_ORIENTATION,
+    COVARIANCE_SIDE, ESTIMATE_ANGULAR, ESTIMATE_COLUMNS, ESTIMATE_LINEAR, ESTIMATE_ORIENTATION,
     ESTIMATE_POSE_COVARIANCE, ESTIMATE_POSITION, ESTIMATE_TWIST_COVARIANCE)
 from multilift_sim.physics.attitude import attitude_difference, quaternion_rotation
 from multilift_sim.physics.layout import (MEASURED_BODY_RATES, MEASURED_EULER,
@@ -77,7 +77,6 @@ HISTORY = DELAYED_COVARIANCE + ERROR_SIZE * ERROR_SIZE  # the ring of IMU sample
 #                                             (L + 1): each its tick (-1: none), f (3), w (3)
 SAMPLE = 7                  # a ring entry's length
 UPDATE_DOF = 6              # the NIS's degrees of freedom: position and attitude
-COVARIANCE_SIDE = 6         # nav_msgs/Odometry's covariances: 6 x 6, row by row
 
 
 @dataclass(frozen=True)

@@ -9,3 +9,4 @@ ESTIMATE_LINEAR = 43            # velocity [m/s], body FLU (3)
 ESTIMATE_ANGULAR = 46           # body rates [rad/s], body FLU (3)
 ESTIMATE_TWIST_COVARIANCE = 49  # (linear, angular), body, row by row (36)
 ESTIMATE_COLUMNS = 85
+COVARIANCE_SIDE = 6             # each covariance: 6 x 6, row by row (nav_msgs/Odometry's)

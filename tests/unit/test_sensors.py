@@ -280,7 +280,8 @@ def test_sensors_of_a_formation_run_in_order_each_from_the_truth():
         memory = memory0.copy()
         for k in range(ticks):
             states = exact[k].copy()
-            function(models, constants, _padded(draws, (n, 0, 0)), memory, k, states)
+            function(models, constants, _padded(draws, (n, 0, 0)), memory, k, exact[k].copy(),
+                     states)
             # the second sensor's: the true state now with its noise (not 2 ticks late)
             np.testing.assert_array_equal(states, exact[k] + draws[1][:, k, :MEASURED_COLUMNS])
             # the first one's, held in its memory: the state 2 ticks ago (tick 0's before)

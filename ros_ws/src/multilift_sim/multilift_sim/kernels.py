@@ -29,8 +29,8 @@ from typing import Any, Callable
 # the laws and the engine's tick above): numba compiles a kernel together with the kernels it
 # calls from other files, but checks a cached kernel against its own file only
 KERNEL_FOLDERS = ('physics', 'statistics', 'laws', 'engine', 'events', 'sensors',
-                  'estimators', 'obstacles', 'controllers', 'controllers/leaders',
-                  'controllers/followers')
+                  'estimators', 'payload_estimators', 'obstacles', 'controllers',
+                  'controllers/leaders', 'controllers/followers')
 CACHE_ROOT = (Path(os.environ.get('XDG_CACHE_HOME') or Path.home() / '.cache')
               / 'multilift' / 'numba')
 

@@ -25,6 +25,7 @@ from multilift_sim.scenario import Scenario
 from multilift_sim.scenario.world import world_arrays
 from multilift_sim.schedules import event_array, wind_series
 from multilift_sim.estimators.arrays import estimator_arrays
+from multilift_sim.payload_estimators.arrays import payload_estimator_arrays
 from multilift_sim.sensors.arrays import sensor_arrays
 from multilift_sim.start import cable_reach, initial_state, swing_sampling
 from multilift_sim.statistics import RunStatistics
@@ -53,6 +54,9 @@ class PhysicsArrays(NamedTuple):
     # the estimator of every UAV (`estimator:`; E = 1, 0: none; estimators.arrays)
     estimator_models: np.ndarray  # (B, E) int: its index in ESTIMATORS
     estimator_constants: np.ndarray  # (B, E, C): its constants row
+    # the payload's estimator (`payload_estimator:`; P = 1, 0: none; payload_estimators.arrays)
+    payload_estimator_models: np.ndarray  # (B, P) int: its index in PAYLOAD_ESTIMATORS
+    payload_estimator_constants: np.ndarray  # (B, P, C): its constants row
     # time and Algorithm 1's tolerances
     physics_dt: np.ndarray        # (B,) [s]
     physics_steps: np.ndarray     # (B,) int: RK4 steps per control period
@@ -87,6 +91,9 @@ class PhysicsMemory(NamedTuple):
     gust: np.ndarray              # (B, 3): the air velocity at the payload [m/s], world
     sensor_memory: np.ndarray     # (B, K, n, M): each sensor's memory of each UAV
     estimator_memory: np.ndarray  # (B, E, n, M): the estimator's memory of each UAV
+    payload_estimator_memory: np.ndarray  # (B, P, M): the payload estimator's memory
+    cable_tension: np.ndarray     # (B, n): each cable's tension T_i [N] at the last tick flown
+    #                               (advance's; NaN before the first): what a load cell reads
     run: np.ndarray               # (B, run_size(n)): the run's figures (statistics RUN_*)
     reel: np.ndarray              # (B, n, REEL_COLUMNS): each cable's length [m], its reel's
     #                               rate [m/s] and command [m/s] (physics.winch)
@@ -107,6 +114,7 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
     uavs, gusts, formation, allocation, actuators = model.physics_constants()
     sensors = sensor_arrays(scenario)
     estimator = estimator_arrays(scenario)
+    payload_estimator = payload_estimator_arrays(scenario)
     state = initial_state(scenario)
     rotors = allocation.shape[::2]  # (n, the largest rotor count)
     arrays = dict(
@@ -118,6 +126,8 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         sensor_models=sensors.models, sensor_constants=sensors.constants,
         sensor_draws=sensors.draws, estimator_models=estimator.models,
         estimator_constants=estimator.constants,
+        payload_estimator_models=payload_estimator.models,
+        payload_estimator_constants=payload_estimator.constants,
         physics_dt=1.0 / sim.physics_rate, physics_steps=sim.physics_steps_per_tick,
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         # (cables that stretch are no constraints: Algorithm 1's check of g does not apply)
@@ -134,6 +144,7 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         held_saturated=np.zeros(rotors, dtype=bool), tick=0, status=STATUS_RUNNING,
         worst_cable=0, worst_value=0.0, g=np.zeros(n), g_dot=np.zeros(n), gust=np.zeros(3),
         sensor_memory=sensors.memory, estimator_memory=estimator.memory,
+        payload_estimator_memory=payload_estimator.memory, cable_tension=np.full(n, math.nan),
         run=RunStatistics(n).run, reel=reel_memory(scenario),
         clearance=clearance, contact=np.full(CLEARANCE_COLUMNS, -1.0))
     return arrays, memory

@@ -15,6 +15,7 @@ from __future__ import annotations
 import re
 
 from multilift_sim.estimators import ESTIMATORS
+from multilift_sim.payload_estimators import PAYLOAD_ESTIMATORS
 from multilift_sim.sensors import COMMON_KEYS, SENSOR_MODELS, key_units
 from multilift_sim.wind import WIND_MODELS
 
@@ -150,6 +151,12 @@ def unit_of(name: str) -> str:
         return NO_UNIT
     if section == 'estimator' and any(sensor_key in e.UNITS for e in ESTIMATORS.values()):
         return next(e.UNITS[sensor_key] for e in ESTIMATORS.values() if sensor_key in e.UNITS)
+    if key in ('payload_estimator', 'payload_estimator.model'):
+        return NO_UNIT
+    if section == 'payload_estimator' and any(sensor_key in e.UNITS
+                                              for e in PAYLOAD_ESTIMATORS.values()):
+        return next(e.UNITS[sensor_key] for e in PAYLOAD_ESTIMATORS.values()
+                    if sensor_key in e.UNITS)
     if key.endswith('[]') and key[:-2] in UNITS:    # one component of a vector key
         return UNITS[key[:-2]]
     model = _WIND_KEY.match(key)

@@ -20,7 +20,8 @@ from multilift_control.laws.follower import lift_vectors
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
-from multilift_sim.estimators.published import ESTIMATE_COLUMNS
+from multilift_sim.estimators.published import (ESTIMATE_COLUMNS, ESTIMATE_LINEAR,
+                                                ESTIMATE_POSITION)
 from multilift_sim.physics import tick as physics
 from multilift_sim.physics.layout import REEL_LENGTH
 from multilift_sim.physics.measurement import payload_position, payload_velocity
@@ -61,11 +62,18 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
             speeds[i, k] = 0.0
             saturated[i, k] = False
     count = a.rotor_counts[b, 0]
+    if m.payload_estimator_memory.shape[1]:  # the payload's estimate (payload_estimator:)
+        estimate = m.payload_estimator_memory[b, 0]
+        payload_at = estimate[ESTIMATE_POSITION:ESTIMATE_POSITION + 3]
+        payload_moving = estimate[ESTIMATE_LINEAR:ESTIMATE_LINEAR + 3]  # world (point payload)
+    else:
+        payload_at, payload_moving = payload_position(m.state[b], n), payload_velocity(
+            m.state[b], n)
     thrust[0] = leader_answer(
         a.leader_law[b], a.leader[b], m.leader_memory[b], a.cascade[b, 0],
         m.mixers[b, 0, :count], a.mission[b], a.segments[b], a.mission_steps[b], t, states,
-        payload_position(m.state[b], n), payload_velocity(m.state[b], n), speeds[0, :count],
-        saturated[0, :count], setpoints[0], reference)
+        payload_at, payload_moving, speeds[0, :count], saturated[0, :count], setpoints[0],
+        reference)
     if not math.isnan(reference[REFERENCE_POSITION]):
         tracking_add(m.tracking[b], reference[REFERENCE_POSITION:REFERENCE_POSITION + 3],
                      states[0, UAV_POSITION:UAV_POSITION + 3])

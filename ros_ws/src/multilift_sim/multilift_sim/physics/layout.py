@@ -226,6 +226,12 @@ MEASURED_VELOCITY = 3       # r_i_dot [m/s], world (3)
 MEASURED_EULER = 6          # eta_i = (roll, pitch, yaw) [rad] of its quaternion (3)
 MEASURED_BODY_RATES = 9     # omega_i [rad/s], body FLU (3)
 MEASURED_COLUMNS = 12
+# -- what a sensor model reads of its UAV (`sensors.sensing.sensed_states`): its measured state
+# (the MEASURED_* slots), then its cable's, one row of (n, SENSED_COLUMNS) ----------------------
+SENSED_CABLE_DIRECTION = 12  # the cable's unit direction from its attach point on the UAV to
+#                              the payload, world (3)
+SENSED_CABLE_TENSION = 15   # its tension T_i [N] at the last tick flown (NaN before the first)
+SENSED_COLUMNS = 16
 
 # -- a UAV's odometry: its measured state (the MEASURED_* slots), then the rest of what its
 # messages carry (/formation/snapshot, /uav{i}/odom, /tf), one row of (n, ODOMETRY_COLUMNS) ---

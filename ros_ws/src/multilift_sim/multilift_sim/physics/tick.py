@@ -20,7 +20,7 @@ from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.attitude import quaternion_norm_error
 from multilift_sim.physics.clearance import measure as measure_clearance
-from multilift_sim.physics.layout import (CABLE_COLUMNS, FORMATION_ELASTIC,
+from multilift_sim.physics.layout import (CABLE_COLUMNS, MEASURED_COLUMNS, SENSED_COLUMNS, FORMATION_ELASTIC,
                                           FORMATION_PRESCRIBED, FORMATION_TIME, FORMATION_WIND,
                                           FORMATION_WINCH, REEL_LENGTH, STATUS_CONTACT,
                                           STATUS_FINISHED, STATUS_QUATERNION,
@@ -32,6 +32,8 @@ from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rate
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.prescribed import prescribe_state
 from multilift_sim.estimators.estimation import estimated_states
+from multilift_sim.payload_estimators.estimation import estimated_payload
+from multilift_sim.physics.cable_sensing import cable_truths
 from multilift_sim.physics.winch import reel_end, reel_period
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
@@ -181,6 +183,7 @@ def advance(a, m, b, speeds, saturated, tension):
         a.physics_dt[b], a.physics_steps[b])
     for i in range(n):  # l_i at the tick (a reeled cable's now)
         tension[i] = 2.0 * m.reel[b, i, REEL_LENGTH] * multipliers[i]
+        m.cable_tension[b, i] = tension[i]
     run_add_tensions(m.run[b], tension)
     run_add_compression(m.run[b], tension, period)
     if formation[FORMATION_ELASTIC] != 0.0:  # each rope's stretch and tension at the tick
@@ -228,16 +231,25 @@ def start(a, m, which):
 def measure(a, m, b, states):
     """What formation b's controllers receive of its UAVs at its current tick, into states
     (n, MEASURED_COLUMNS): the measured states (seed Eq. 2.7), with `sensors:` as its sensor
-    models deliver them (`sensors.sensing.sensed_states`), with `estimator:` as it estimates
-    them (`estimators.estimation.estimated_states`; the same result however often it is
-    called at one tick)."""
+    models deliver them from the truth (the measured states and the cables', `physics.
+    cable_sensing.cable_truths`; `sensors.sensing.sensed_states`), with `estimator:` as it
+    estimates them (`estimators.estimation.estimated_states`), then with `payload_estimator:`
+    the payload's estimate into its memory (`payload_estimators.estimation
+    .estimated_payload`); the same result however often it is called at one tick."""
     measured_states(m.state[b], states.shape[0], states)
     if a.sensor_models.shape[1]:
+        truth = np.empty((states.shape[0], SENSED_COLUMNS))
+        truth[:, :MEASURED_COLUMNS] = states[:, :MEASURED_COLUMNS]
+        cable_truths(m.state[b], a.uavs[b], m.cable_tension[b], truth)
         sensed_states(a.sensor_models[b], a.sensor_constants[b], a.sensor_draws[b],
-                      m.sensor_memory[b], m.tick[b], states)
+                      m.sensor_memory[b], m.tick[b], truth, states)
     if a.estimator_models.shape[1]:  # the estimate from the sensors (estimators.estimation)
         estimated_states(a.estimator_models[b], a.estimator_constants[b], m.sensor_memory[b],
                          m.estimator_memory[b], m.tick[b], states)
+    if a.payload_estimator_models.shape[1]:
+        estimated_payload(a.payload_estimator_models[b], a.payload_estimator_constants[b],
+                          m.sensor_memory[b], m.estimator_memory[b],
+                          m.payload_estimator_memory[b], m.tick[b])
 
 
 @jit

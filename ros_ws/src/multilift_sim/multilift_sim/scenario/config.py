@@ -250,6 +250,9 @@ class Scenario:
     # the sensors of their own sections (`imu:`, `mocap:`), in the registry's order
     sensor_suite: tuple[SensorConfig, ...] = ()
     estimator: EstimatorConfig | None = None  # None: no estimator (`estimator: none`)
+    # the payload's estimator (`payload_estimator:`, a part of multilift_sim.payload_estimators
+    # .PAYLOAD_ESTIMATORS); None: the controllers read the payload's state
+    payload_estimator: EstimatorConfig | None = None
     parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
     world: WorldConfig | None = None  # obstacles, ground (`world:`); None: no clearance checks
 

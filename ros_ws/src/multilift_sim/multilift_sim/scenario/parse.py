@@ -31,7 +31,9 @@ from multilift_sim.scenario.part_files import scenario_parts
 from multilift_sim.scenario.prescribed import (check_prescribed, finite_vector, read_trajectory,
                                                scenario_folder)
 from multilift_sim.scenario.reading import Section
-from multilift_sim.scenario.sensor_sections import estimator_section, sensor_suite, sensors_section
+from multilift_sim.scenario.sensor_sections import (check_payload_estimator, estimator_section,
+                                                    payload_estimator_section, sensor_suite,
+                                                    sensors_section)
 from multilift_sim.scenario.world import check_start, read_world
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
                                             preset_values, vehicle_params)
@@ -181,6 +183,7 @@ def scenario_of(data: Any, where: str) -> Scenario:
     sensors = sensors_section(top.section('sensors'), sim) if top.has('sensors') else None
     suite = sensor_suite(top, sim)
     estimator = estimator_section(top, suite)
+    payload_estimator = payload_estimator_section(top)
 
     c = top.section('control')
     mode = c.text('mode', choices=tuple(leader_controllers()))
@@ -213,7 +216,9 @@ def scenario_of(data: Any, where: str) -> Scenario:
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, cable=rope, events=events, wind=tuple(wind),
                         wind_models=tuple(wind_models), sensors=sensors,
-                        sensor_suite=suite, estimator=estimator, parts=parts, world=world)
+                        sensor_suite=suite, estimator=estimator,
+                        payload_estimator=payload_estimator, parts=parts, world=world)
+    check_payload_estimator(top, scenario)
     _check_feasible(scenario)
     check_limits(scenario)
     check_prescribed(scenario)  # the files cover the run, the payload's start fits the cables

@@ -1,9 +1,10 @@
 """The scenario's sensor sections, validated once: `sensors:` (what the controllers receive,
 docs/sensors.md), the sensors of their own sections named as their models (`imu:`, `mocap:`)
-and `estimator:` (docs/estimation.md)."""
+and `estimator:`, `payload_estimator:` (docs/estimation.md)."""
 from __future__ import annotations
 
 from multilift_sim.estimators import ESTIMATORS, NONE as NONE_ESTIMATOR
+from multilift_sim.payload_estimators import PAYLOAD_ESTIMATORS
 from multilift_sim.scenario.config import EstimatorConfig, SensorConfig, SimulationConfig
 from multilift_sim.scenario.reading import Section
 from multilift_sim.sensors import DEFAULT_MODEL, SENSOR_MODELS
@@ -55,17 +56,22 @@ def sensor_suite(top: Section, sim: SimulationConfig) -> tuple[SensorConfig, ...
     return tuple(suite)
 
 
+def _named_part(top: Section, key: str, registry) -> tuple[str, Section]:
+    """(its name, its section) of `key:` (a name, or a section with `model:` and its keys)
+    among `none` and the registry's."""
+    if isinstance(top.raw(key), str):
+        name = top.text(key, choices=(NONE_ESTIMATOR, *registry))
+        return name, Section({}, top.key(key), top.where)
+    d = top.section(key)
+    return d.text('model', choices=(NONE_ESTIMATOR, *registry)), d
+
+
 def estimator_section(top: Section, suite: tuple[SensorConfig, ...]) -> EstimatorConfig | None:
     """`estimator:` (a name, or a section with `model:` and its keys): None for `none` or no
     section; an estimator lacking a sensor it reads fails in one line."""
     if not top.has('estimator'):
         return None
-    if isinstance(top.raw('estimator'), str):
-        name = top.text('estimator', choices=(NONE_ESTIMATOR, *ESTIMATORS))
-        d = Section({}, top.key('estimator'), top.where)
-    else:
-        d = top.section('estimator')
-        name = d.text('model', choices=(NONE_ESTIMATOR, *ESTIMATORS))
+    name, d = _named_part(top, 'estimator', ESTIMATORS)
     if name == NONE_ESTIMATOR:
         d.done()
         return None
@@ -76,3 +82,26 @@ def estimator_section(top: Section, suite: tuple[SensorConfig, ...]) -> Estimato
     config = EstimatorConfig(model=name, settings=part.parse(d))
     d.done()
     return config
+
+
+def payload_estimator_section(top: Section) -> EstimatorConfig | None:
+    """`payload_estimator:` (a name, or a section with `model:` and its keys; issue 33 item 3):
+    None for `none` or no section. What it needs of the scenario: `check_payload_estimator`."""
+    if not top.has('payload_estimator'):
+        return None
+    name, d = _named_part(top, 'payload_estimator', PAYLOAD_ESTIMATORS)
+    config = None if name == NONE_ESTIMATOR else EstimatorConfig(
+        model=name, settings=PAYLOAD_ESTIMATORS[name].parse(d))
+    d.done()
+    return config
+
+
+def check_payload_estimator(top: Section, scenario) -> None:
+    """A payload estimator lacking what it reads of the scenario (its `needs`) fails in one
+    line."""
+    config = scenario.payload_estimator
+    if config is None:
+        return
+    missing = PAYLOAD_ESTIMATORS[config.model].needs(scenario)
+    if missing:
+        raise top.fail('payload_estimator', config.model, missing)

@@ -42,7 +42,7 @@ from __future__ import annotations
 from types import ModuleType
 
 from multilift_sim.registry import Registry
-from multilift_sim.sensors import gnss, imu, measured_state, mocap
+from multilift_sim.sensors import cable_sensor, gnss, imu, measured_state, mocap
 
 DEFAULT_MODEL = measured_state.NAME  # `sensors:` without `model:`
 COMMON_KEYS = {'model': '', 'rate': 'Hz', 'seed': ''}  # every model's, with their units
@@ -74,7 +74,7 @@ def _changed() -> None:
 
 SENSOR_MODELS = Registry('sensor model',
                          ('NAME', 'UNITS', 'parse', 'constants', 'memory', 'draws', 'measure'),
-                         (measured_state, imu, mocap, gnss), changed=_changed, check=_check)
+                         (measured_state, imu, mocap, gnss, cable_sensor), changed=_changed, check=_check)
 register, unregister, registered = (SENSOR_MODELS.register, SENSOR_MODELS.unregister,
                                     SENSOR_MODELS.registered)
 

@@ -16,14 +16,14 @@ measure_sensor = SENSORS.compiled()  # rebound when the registry changes (SENSOR
 
 
 @jit
-def sensed_states(models, constants, draws, memory, tick, states):
-    """Replace the MEASURED_* slots of every UAV's true measured state `states` (n, >=
-    MEASURED_COLUMNS) at control tick `tick` by what its controllers receive: each sensor k of
-    the formation in turn (models (K,) int: its model's index in SENSOR_MODELS; constants (K,
-    C), draws (K, n, samples, D), memory (K, n, M): its rows, padded to the widest), each
-    from the true state, writing over what the ones before it wrote."""
+def sensed_states(models, constants, draws, memory, tick, truth, states):
+    """Replace the MEASURED_* slots of every UAV's row of states (n, >= MEASURED_COLUMNS) at
+    control tick `tick` by what its controllers receive: each sensor k of the formation in
+    turn (models (K,) int: its model's index in SENSOR_MODELS; constants (K, C), draws (K, n,
+    samples, D), memory (K, n, M): its rows, padded to the widest), each from the truth (n,
+    SENSED_COLUMNS: each UAV's true measured state, then its cable's, physics.layout
+    SENSED_*), writing over what the ones before it wrote."""
     n = states.shape[0]
-    truth = states[:, :MEASURED_COLUMNS].copy()
     for k in range(models.shape[0]):
         for i in range(n):
             measure_sensor(models[k], constants[k], draws[k, i], memory[k, i], tick, truth[i],

@@ -44,6 +44,24 @@ class Progress:
             print()
 
 
+def estimation_lines(estimation: dict | None) -> list[str]:
+    """The estimators' errors against the truth over the run (issue 33 item 6): each UAV's
+    position and attitude rms and mean NEES (3 dof: 3 when consistent), the payload's
+    position and velocity rms and mean NEES; nothing without an estimator."""
+    if not estimation:
+        return []
+    lines = [f'  estimate uav{i + 1}    position rms {p * 1e3:.2f} mm (NEES {pn:.2f}), attitude '
+             f'rms {a * 1e3:.2f} mrad (NEES {an:.2f})'
+             for i, (p, pn, a, an) in enumerate(zip(
+                 estimation['position_rms'], estimation['position_nees'],
+                 estimation['attitude_rms'], estimation['attitude_nees']))]
+    if 'payload_position_rms' in estimation:
+        lines.append(f'  estimate payload position rms {estimation["payload_position_rms"]:.4f} '
+                     f'm (NEES {estimation["payload_nees"]:.2f}), velocity rms '
+                     f'{estimation["payload_velocity_rms"]:.4f} m/s')
+    return lines
+
+
 def read_summaries(summary_dir: Path, scenario) -> dict:
     """What each node of a run left in `summary_dir` (sim, leader, follower2, ...)."""
     data = {}
@@ -123,6 +141,7 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
             lines.append(f'  peak gust speed met by the payload  {sim["max_gust_speed"]:.2f} '
                          f'{unit_of("max_gust_speed")}')
         lines.extend(clearance_lines(sim))
+        lines.extend(estimation_lines(sim.get('estimation')))
         if sim.get('seeds'):
             lines.append('  seeds            ' + ', '.join(
                 f'{what} {seed}' for what, seed in sim['seeds'].items()))

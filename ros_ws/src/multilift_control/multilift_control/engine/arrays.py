@@ -113,6 +113,9 @@ class TickRecord(NamedTuple):
     # (ticks, B, n, ESTIMATE_COLUMNS) each UAV's estimate as /uav{i}/estimate carries it
     # (estimators.published); (ticks, B, n, 0) without an estimator
     estimate: np.ndarray
+    # (ticks, B, ESTIMATE_COLUMNS) the payload's estimate as /payload/estimate carries it
+    # (payload_estimator:; 0 columns without one)
+    payload_estimate: np.ndarray
 
 
 def _padded(rows: np.ndarray, rotors: int) -> np.ndarray:
@@ -245,4 +248,6 @@ def empty_record(arrays: FormationArrays, ticks: int) -> TickRecord:
         g_dot=np.empty((ticks, batch, n)), taut=np.empty((ticks, batch, n), dtype=bool),
         gust=np.empty((ticks, batch, 3)), cable_length=np.empty((ticks, batch, n)),
         estimate=np.empty((ticks, batch, n, ESTIMATE_COLUMNS if
-                           arrays.estimator_models.shape[1] else 0)))
+                           arrays.estimator_models.shape[1] else 0)),
+        payload_estimate=np.empty((ticks, batch, ESTIMATE_COLUMNS if
+                                   arrays.payload_estimator_models.shape[1] else 0)))

@@ -263,5 +263,8 @@ def run_ticks(a, m, ticks, record):
                 record.tension[k, b] = tension
                 if record.estimate.shape[3]:  # every UAV's estimate as published
                     record.estimate[k, b] = m.estimator_memory[b, 0, :, :ESTIMATE_COLUMNS]
+                if record.payload_estimate.shape[2]:  # the payload's, as published
+                    record.payload_estimate[k, b] = m.payload_estimator_memory[
+                        b, 0, :ESTIMATE_COLUMNS]
             flown[b] += 1
     return flown

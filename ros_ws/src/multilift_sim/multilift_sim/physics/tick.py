@@ -36,6 +36,7 @@ from multilift_sim.payload_estimators.estimation import estimated_payload
 from multilift_sim.physics.cable_sensing import cable_truths
 from multilift_sim.physics.winch import reel_end, reel_period
 from multilift_sim.sensors.sensing import sensed_states
+from multilift_sim.statistics.estimation import run_add_estimation
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
                                                    run_add_compression, run_add_gust_speed,
                                                    run_add_reel, run_add_ropes, run_add_slack,
@@ -166,6 +167,9 @@ def advance(a, m, b, speeds, saturated, tension):
         tension[:] = 0.0
         return
     period = a.period_ns[b] * 1e-9
+    if a.estimator_models.shape[1]:  # the estimates of this tick against its state
+        run_add_estimation(m.run[b], m.state[b], m.estimator_memory[b, 0],
+                           m.payload_estimator_memory[b].reshape(-1))
     held_commands(speeds, saturated, m.tick[b], m.silent_until[b], m.held[b],
                   m.held_saturated[b])
     run_add_commands(m.run[b], m.held[b], m.held_saturated[b], period)

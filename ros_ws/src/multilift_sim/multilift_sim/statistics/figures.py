@@ -18,7 +18,9 @@ from multilift_sim.statistics.layout import (
     FORMATION_MAX_ABS, FORMATION_NORM_SUM, FORMATION_SAMPLES, FORMATION_SIZE, PEAK_MAX,
     PEAK_SAMPLES, PEAK_SIZE, PEAK_SUM_SQ, RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
     RUN_LEAST_THRUST_MARGIN, RUN_LONGEST_CABLE, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED,
-    RUN_MAX_STRETCH, RUN_SHORTEST_CABLE,
+    RUN_MAX_STRETCH, RUN_SHORTEST_CABLE, RUN_ATTITUDE_ERROR_SQ, RUN_ATTITUDE_NEES,
+    RUN_ESTIMATION_SAMPLES, RUN_PAYLOAD_NEES, RUN_PAYLOAD_POSITION_SQ, RUN_PAYLOAD_VELOCITY_SQ,
+    RUN_POSITION_ERROR_SQ, RUN_POSITION_NEES,
     RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
     RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR,
     TRACKING_SIZE, run_size)
@@ -320,4 +322,26 @@ class RunStatistics:
                 'rms_payload_swing': self.swing.rms,
                 'swing_from': SWING_FROM,
                 'compressed_time': self.compressed_time, **self.rope_figures,
-                **self.reel_figures}
+                **self.reel_figures, **self.estimation_figures}
+
+    @property
+    def estimation_figures(self) -> dict:
+        """With an estimator (issue 33 item 6): {'estimation': {'position_rms': [m] and
+        'attitude_rms': [rad] per UAV, 'position_nees', 'attitude_nees': their mean NEES
+        (3 dof: 3 when consistent), and with a payload estimator 'payload_position_rms' [m],
+        'payload_velocity_rms' [m/s], 'payload_nees'}}, over every tick flown; {} without."""
+        samples = float(self.run[RUN_ESTIMATION_SAMPLES])
+        if samples == 0.0:
+            return {}
+        figures = {'position_rms': [math.sqrt(v / samples)
+                                    for v in self._per_uav(RUN_POSITION_ERROR_SQ)],
+                   'attitude_rms': [math.sqrt(v / samples)
+                                    for v in self._per_uav(RUN_ATTITUDE_ERROR_SQ)],
+                   'position_nees': [v / samples for v in self._per_uav(RUN_POSITION_NEES)],
+                   'attitude_nees': [v / samples for v in self._per_uav(RUN_ATTITUDE_NEES)]}
+        if self.run[RUN_PAYLOAD_NEES] != 0.0:
+            figures.update(
+                payload_position_rms=math.sqrt(self.run[RUN_PAYLOAD_POSITION_SQ] / samples),
+                payload_velocity_rms=math.sqrt(self.run[RUN_PAYLOAD_VELOCITY_SQ] / samples),
+                payload_nees=float(self.run[RUN_PAYLOAD_NEES]) / samples)
+        return {'estimation': figures}

@@ -27,7 +27,13 @@ RUN_SIMULATED_TIME = 4      # the time of the last state checked [s]
 RUN_MAX_GUST_SPEED = 5      # the peak gust speed met by the payload [m/s]
 RUN_SWING = 6               # a peak/rms block (PEAK_*): the payload swing [m], from SWING_FROM
 RUN_COMPRESSED_TIME = RUN_SWING + PEAK_SIZE  # time with a cable pushing (T_i < 0: rigid) [s]
-RUN_SCALARS = RUN_COMPRESSED_TIME + 1
+# the estimators' errors against the truth (statistics.estimation), at every tick flown with an
+# estimator (issue 33 item 6): how many, then the payload's sums (with payload_estimator:)
+RUN_ESTIMATION_SAMPLES = RUN_COMPRESSED_TIME + 1  # ticks with an estimate
+RUN_PAYLOAD_POSITION_SQ = RUN_ESTIMATION_SAMPLES + 1  # sum of |p_hat - p|^2 [m^2]
+RUN_PAYLOAD_VELOCITY_SQ = RUN_ESTIMATION_SAMPLES + 2  # sum of |v_hat - v|^2 [m^2/s^2]
+RUN_PAYLOAD_NEES = RUN_ESTIMATION_SAMPLES + 3  # sum of its position NEES (3 dof)
+RUN_SCALARS = RUN_ESTIMATION_SAMPLES + 4
 # the payload swing is measured from this time on [s]: before it, a released payload's first
 # swing (twin_lift's 15 deg release: 2.6 m) would be every run's maximum, the same whatever
 # the controllers do
@@ -45,7 +51,11 @@ RUN_PEAK_TENSION = 5        # its rope's largest tension T_i [N] (cable_model: e
 RUN_SHORTEST_CABLE = 6      # its cable's shortest length l_i [m] reeled by its winch (+inf:
 #                             none yet, and in every run without winches)
 RUN_LONGEST_CABLE = 7       # its cable's longest length [m] (-inf)
-RUN_UAV_COLUMNS = 8
+RUN_POSITION_ERROR_SQ = 8   # with an estimator: sum of |r_hat - r|^2 [m^2]
+RUN_ATTITUDE_ERROR_SQ = 9   # sum of |Log(q_hat^-1 q)|^2 [rad^2]
+RUN_POSITION_NEES = 10      # sum of its position NEES (3 dof)
+RUN_ATTITUDE_NEES = 11      # sum of its attitude NEES (3 dof)
+RUN_UAV_COLUMNS = 12
 
 
 def run_size(n_uavs: int) -> int:

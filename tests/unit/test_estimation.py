@@ -186,7 +186,8 @@ def test_the_engine_and_the_per_object_path_estimate_the_same_and_the_controller
     error = (record.measured[50:, 0, :, :3]
              - StateLayout(scenario.n_uavs).uav_positions(record.states[50:, 0]))
     assert 1e-5 < np.sqrt(np.mean(error ** 2)) < 2e-3  # [m]; motion capture's 1 mm noise
-    exact = Engine(_realistic(2.0, imu=None, mocap=None, estimator=None))
+    exact = Engine(_realistic(2.0, imu=None, mocap=None, estimator=None, cable_sensor=None,
+                                payload_estimator=None))
     exact.step(200)
     assert not np.array_equal(exact.state, engine.state)
 

@@ -58,9 +58,10 @@ CABLE_LENGTH = 8            # l_i [m], one per UAV (n)
 # -- the formation's memory: first its estimate as /payload/estimate carries it
 #    (estimators.published, ESTIMATE_COLUMNS), then
 LAST_TICK = ESTIMATE_COLUMNS  # the tick estimated last (-1: none)
-STATE = LAST_TICK + 1       # (p, v) [m, m/s], world (6)
-COVARIANCE = STATE + 6      # P (6, 6), row by row
-MEMORY_COLUMNS = COVARIANCE + 36
+STATE_SIZE = 6              # the filter's state: p (3), then v (3)
+STATE = LAST_TICK + 1       # (p, v) [m, m/s], world (STATE_SIZE)
+COVARIANCE = STATE + STATE_SIZE  # P (STATE_SIZE, STATE_SIZE), row by row
+MEMORY_COLUMNS = COVARIANCE + STATE_SIZE * STATE_SIZE
 
 
 @dataclass(frozen=True)
@@ -132,7 +133,7 @@ def predict(constants, cables, state, covariance):
     for j in range(3):
         state[j] += state[3 + j] * dt + 0.5 * accel[j] * dt * dt
         state[3 + j] += accel[j] * dt
-    transition = np.eye(6)
+    transition = np.eye(STATE_SIZE)
     for j in range(3):
         transition[j, 3 + j] = dt
     moved = transition @ covariance @ transition.T
@@ -150,14 +151,14 @@ def predict(constants, cables, state, covariance):
 def update(state, covariance, measured, noise, lag):
     """One payload position measurement `measured` (3,) [m] of p - lag v (lag [s]) with noise
     covariance `noise` (3, 3) fused into state (6,) and covariance (6, 6) (Joseph form)."""
-    h = np.zeros((3, 6))
+    h = np.zeros((3, STATE_SIZE))
     for j in range(3):
         h[j, j], h[j, 3 + j] = 1.0, -lag
     innovation = measured - h @ state
     s = h @ covariance @ h.T + noise
     gain = covariance @ h.T @ np.linalg.inv(s)
     state += gain @ innovation
-    keep = np.eye(6) - gain @ h
+    keep = np.eye(STATE_SIZE) - gain @ h
     joseph = keep @ covariance @ keep.T + gain @ noise @ gain.T
     covariance[:, :] = 0.5 * (joseph + joseph.T)
 
@@ -183,11 +184,11 @@ def cable_measurement(constants, cable, uav, length, measured, noise, up):
         measured[j] = (uav[ESTIMATE_POSITION + j] - lag * velocity[j]
                        + length * direction[j])
         up[j] = -direction[j]
-    pose = np.empty((6, 6))
-    for r in range(6):
-        for c in range(6):
+    pose = np.empty((COVARIANCE_SIDE, COVARIANCE_SIDE))
+    for r in range(COVARIANCE_SIDE):
+        for c in range(COVARIANCE_SIDE):
             pose[r, c] = uav[ESTIMATE_POSE_COVARIANCE + COVARIANCE_SIDE * r + c]
-    jacobian = np.zeros((3, 6))  # d(measured) / d(position, attitude error about world axes)
+    jacobian = np.zeros((3, COVARIANCE_SIDE))  # d(measured) / d(position, attitude error about world axes)
     for j in range(3):
         jacobian[j, j] = 1.0
     d = direction * length  # dz = dr + dtheta x (l d) = dr - [l d]x dtheta
@@ -232,8 +233,8 @@ def estimate(constants, sensors, estimates, memory, tick):
     memory[LAST_TICK] = tick
     cables = sensors[int(constants[CABLE_ROW])]
     n = cables.shape[0]
-    state = memory[STATE:STATE + 6]
-    covariance = memory[COVARIANCE:MEMORY_COLUMNS].copy().reshape((6, 6))
+    state = memory[STATE:STATE + STATE_SIZE]
+    covariance = memory[COVARIANCE:MEMORY_COLUMNS].copy().reshape((STATE_SIZE, STATE_SIZE))
     measured = np.empty((n, 3))
     noise = np.empty((n, 3, 3))
     lags = np.empty(n)
@@ -256,5 +257,5 @@ def estimate(constants, sensors, estimates, memory, tick):
         tension = forces[i, 3]
         if cables[i, ARRIVED] == tick and (tick == 0 or tension > 0.0):
             update(state, covariance, measured[i], noise[i], lags[i])
-    memory[COVARIANCE:MEMORY_COLUMNS] = covariance.reshape(36)
+    memory[COVARIANCE:MEMORY_COLUMNS] = covariance.reshape(STATE_SIZE * STATE_SIZE)
     publish(state, covariance, memory)

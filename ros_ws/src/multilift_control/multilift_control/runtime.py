@@ -24,6 +24,7 @@ from multilift_control.laws.follower import lift_vectors
 from multilift_control.laws.layout import UAV_BODY_RATES, UAV_EULER, UAV_POSITION, UAV_VELOCITY
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.mission import Reference
+from multilift_sim.estimators.published import payload_read
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
@@ -179,13 +180,15 @@ def answer_tick(runtimes: list[ControllerRuntime], t_ns: int,
 def uav_states(snapshot: Snapshot) -> FormationStates:
     """What the controllers measure of the formation at the snapshot's tick (its
     `measured` rows: the state, or with `sensors:` the sensors' measurement) and the payload's
-    position and velocity (the state's)."""
+    position and velocity (the state's; its estimate with a payload estimator)."""
     return FormationStates((UavState(row[UAV_POSITION:UAV_POSITION + 3],
                                      row[UAV_VELOCITY:UAV_VELOCITY + 3],
                                      row[UAV_EULER:UAV_EULER + 3],
                                      row[UAV_BODY_RATES:UAV_BODY_RATES + 3])
-                            for row in snapshot.measured), snapshot.payload_position,
-                           snapshot.payload_velocity)
+                            for row in snapshot.measured),
+                           *((snapshot.payload_position, snapshot.payload_velocity)
+                             if snapshot.payload_estimate is None
+                             else payload_read(snapshot.payload_estimate)))
 
 
 def prepare_node_laws(scenario: Scenario, index: int) -> None:

@@ -70,6 +70,9 @@ class Snapshot:
     # every UAV's estimate as /uav{i}/estimate carries it (n, ESTIMATE_COLUMNS:
     # estimators.published), None without an estimator
     estimate: np.ndarray | None = None
+    # the payload's estimate as /payload/estimate carries it (ESTIMATE_COLUMNS), None without
+    # a payload estimator: what the controllers then read of the payload
+    payload_estimate: np.ndarray | None = None
 
 
 def stop_message(status: int, cable: int, value: float, t: float, sim, n_uavs: int) -> str:
@@ -229,7 +232,9 @@ class FormationSimulator:
                         layout.payload_velocity(state).copy(), odometry, measured, attitude,
                         self.memory.reel[0, :, REEL_LENGTH].copy(),
                         self.memory.estimator_memory[0, 0, :, :ESTIMATE_COLUMNS].copy()
-                        if self.memory.estimator_memory.shape[1] else None)
+                        if self.memory.estimator_memory.shape[1] else None,
+                        self.memory.payload_estimator_memory[0, 0, :ESTIMATE_COLUMNS].copy()
+                        if self.memory.payload_estimator_memory.shape[1] else None)
 
     # ------------------------------------------------------------------------- the cables
     def cable_state(self, rotor_speeds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray,

@@ -30,6 +30,7 @@ FLOAT64_TYPE = 'std_msgs/msg/Float64'
 CLOCK = '/clock'                        # simulated time, the simulator only
 PAYLOAD_ODOM = '/payload/odom'          # payload position and velocity
 PAYLOAD_GUST = '/payload/gust'          # gust velocity at the payload [m/s], world
+PAYLOAD_ESTIMATE = '/payload/estimate'  # the payload's estimate with its covariance
 FORMATION_STATE = '/formation/state'    # per cable: tension, g_i, g_i_dot
 FORMATION_SNAPSHOT = '/formation/snapshot'  # what the controllers read, one message a tick
 MARKERS = '/visualization/markers'      # the formation drawn for RViz / Foxglove
@@ -60,6 +61,8 @@ RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
              PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
              MARKERS: MARKER_ARRAY_TYPE, TF: TF_TYPE}
+# the topic of a run with a payload estimator (run_topics(payload_estimate=True))
+PAYLOAD_ESTIMATE_TYPES = {PAYLOAD_ESTIMATE: ODOMETRY_TYPE}
 # the topic of a run whose scenario has `events:` (run_topics(events=True))
 EVENT_TYPES = {EVENTS: FORMATION_EVENT_TYPE}
 # the topic of a run whose air moves everywhere (run_topics(wind=True), Scenario.has_wind)
@@ -97,7 +100,7 @@ def parse_uav_topic(topic: str) -> tuple[int, str] | None:
 
 def topic_type(topic: str) -> str | None:
     """The type a multilift topic has (`pkg/msg/Type`), or None for a name not of a run."""
-    every = {**RUN_TYPES, **EVENT_TYPES, **WIND_TYPES, **LIVE_TYPES}
+    every = {**RUN_TYPES, **EVENT_TYPES, **WIND_TYPES, **LIVE_TYPES, **PAYLOAD_ESTIMATE_TYPES}
     if topic in every:
         return every[topic]
     parsed = parse_uav_topic(topic)
@@ -106,8 +109,8 @@ def topic_type(topic: str) -> str | None:
 
 def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
                sensors: bool = False, wind: bool = False, commands: bool = True,
-               live: bool = False, winches: Sequence[int] = (), estimates: bool = False
-               ) -> list[tuple[str, str]]:
+               live: bool = False, winches: Sequence[int] = (), estimates: bool = False,
+               payload_estimate: bool = False) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
     which has no reference, set-points or formation errors); with `events` (a scenario with
@@ -116,9 +119,11 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
     `commands` (every UAV prescribed) not even the rotor commands; with `live` (`run --live`),
     /formation/goal and /formation/path; for each UAV of `winches` (from 1: those with a
     winch) /uav{i}/cable_length, and with `live` /uav{i}/winch_cmd; with `estimates` (an
-    estimator, docs/estimation.md) every /uav{i}/estimate."""
+    estimator, docs/estimation.md) every /uav{i}/estimate; with `payload_estimate` (a payload
+    estimator) /payload/estimate."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
-        list(WIND_TYPES.items()) if wind else []) + (list(LIVE_TYPES.items()) if live else [])
+        list(WIND_TYPES.items()) if wind else []) + (list(LIVE_TYPES.items()) if live else []) + (
+        list(PAYLOAD_ESTIMATE_TYPES.items()) if payload_estimate else [])
     if controllers:
         topics.append((REFERENCE_TOPIC, TRACKING_REFERENCE_TYPE))
     for i in range(1, n_uavs + 1):
@@ -146,7 +151,8 @@ def scenario_topics(scenario, controllers: bool = True, live: bool = False
     return run_topics(scenario.n_uavs, controllers and scenario.controlled,
                       bool(scenario.events), scenario.measures, scenario.has_wind,
                       commands=scenario.controlled, live=live, winches=scenario.winches,
-                      estimates=scenario.estimator is not None)
+                      estimates=scenario.estimator is not None,
+                      payload_estimate=scenario.payload_estimator is not None)
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

@@ -97,7 +97,9 @@ class EngineBag:
         n, period, rows = self._n, self._period_ns, self._own_rows
         states = record.states[:count, 0]
         received = record.measured[:count, 0]  # what the controllers received
-        snapshots, odometry = state_rows(states, n, received)
+        payload_estimates = record.payload_estimate[:count, 0] \
+            if record.payload_estimate.shape[2] else None  # /payload/estimate
+        snapshots, odometry = state_rows(states, n, received, payload_estimates)
         measured = measured_odometry(received).tolist() if self._sensors \
             else [None] * count
         estimates = record.estimate[:count, 0].tolist() if record.estimate.shape[3] \
@@ -151,7 +153,9 @@ class EngineBag:
             messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
                                           odometry[k], payload_position[k],
                                           payload_velocity[k], gusts[k], measured[k],
-                                          winds[k], poses[k], lengths[k], estimates[k])
+                                          winds[k], poses[k], lengths[k], estimates[k],
+                                          None if payload_estimates is None
+                                          else payload_estimates[k].tolist())
             messages += self._events_at(tick, t_ns)
             for i in range(n if self._commands else 0):
                 if not self._controllers:
@@ -180,6 +184,8 @@ class EngineBag:
             else None
         estimates = memory.estimator_memory[0, 0, :, :ESTIMATE_COLUMNS].tolist() \
             if memory.estimator_memory.shape[1] else None  # after measured(): this tick's
+        payload_estimate = memory.payload_estimator_memory[0, 0, :ESTIMATE_COLUMNS].tolist() \
+            if memory.payload_estimator_memory.shape[1] else None
         velocity, pose = payload_motion(payload_attitude(state, n) if self._rigid else None,
                                         layout.payload_velocity(state))
         self._write(self._simulator.state_of(t_ns, None, None, odometry, payload_position,
@@ -187,7 +193,7 @@ class EngineBag:
                                              None if self._wind is None
                                              else self._wind[tick].tolist(), pose,
                                              memory.reel[0, :, REEL_LENGTH].tolist(),
-                                             estimates)
+                                             estimates, payload_estimate)
                     + self._events_at(tick, t_ns), t_ns)
         # the tension under the commands held since the tick before, as the simulator node's
         # last tick solves it (physics.tick.tension_at, on the physics' arrays of the engine's)

@@ -188,7 +188,8 @@ def cable_measurement(constants, cable, uav, length, measured, noise, up):
     for r in range(COVARIANCE_SIDE):
         for c in range(COVARIANCE_SIDE):
             pose[r, c] = uav[ESTIMATE_POSE_COVARIANCE + COVARIANCE_SIDE * r + c]
-    jacobian = np.zeros((3, COVARIANCE_SIDE))  # d(measured) / d(position, attitude error about world axes)
+    # d(measured) / d(position, attitude error about the world's axes)
+    jacobian = np.zeros((3, COVARIANCE_SIDE))
     for j in range(3):
         jacobian[j, j] = 1.0
     d = direction * length  # dz = dr + dtheta x (l d) = dr - [l d]x dtheta

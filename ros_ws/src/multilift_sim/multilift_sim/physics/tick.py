@@ -20,7 +20,8 @@ from multilift_sim.physics.events import apply_events, held_commands
 from multilift_sim.physics.formation_dae import air_velocity, residuals, solve
 from multilift_sim.physics.attitude import quaternion_norm_error
 from multilift_sim.physics.clearance import measure as measure_clearance
-from multilift_sim.physics.layout import (CABLE_COLUMNS, MEASURED_COLUMNS, SENSED_COLUMNS, FORMATION_ELASTIC,
+from multilift_sim.physics.layout import (CABLE_COLUMNS, MEASURED_COLUMNS, SENSED_COLUMNS,
+                                          FORMATION_ELASTIC,
                                           FORMATION_PRESCRIBED, FORMATION_TIME, FORMATION_WIND,
                                           FORMATION_WINCH, REEL_LENGTH, STATUS_CONTACT,
                                           STATUS_FINISHED, STATUS_QUATERNION,

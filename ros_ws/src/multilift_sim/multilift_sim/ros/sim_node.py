@@ -40,10 +40,9 @@ from multilift_sim.ros.common import (FIRST_ACK_TIMEOUT, PUBLISHER_QOS, STARTUP_
                                       write_summary)
 from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
-                                  FORMATION_STATE,
-                                  MARKER_DECIMATION, MARKERS, MEASURED_ODOM, ODOM, PAYLOAD_GUST,
-                                  PAYLOAD_ODOM, ROTOR_CMD, TF, WIND, WINCH_CMD, parse_external,
-                                  state_topics, uav_topic)
+                                  FORMATION_STATE, MARKER_DECIMATION, MARKERS, MEASURED_ODOM,
+                                  ODOM, PAYLOAD_ESTIMATE, PAYLOAD_GUST, PAYLOAD_ODOM, ROTOR_CMD,
+                                  TF, WIND, WINCH_CMD, parse_external, state_topics, uav_topic)
 from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, TickCables
 from multilift_sim.schedules import run_seeds
 from multilift_sim.wire.tick_messages import SimulatorMessages
@@ -107,6 +106,9 @@ class SimNode(Node):
         # /uav{i}/estimate, each UAV's estimate with its covariance, with an estimator
         estimates = [self.create_publisher(Odometry, uav_topic(i + 1, ESTIMATE), PUBLISHER_QOS)
                      for i in range(n)] if scenario.estimator is not None else []
+        # /payload/estimate, the payload's estimate with its covariance, with a payload estimator
+        payload_estimate = [self.create_publisher(Odometry, PAYLOAD_ESTIMATE, PUBLISHER_QOS)] \
+            if scenario.payload_estimator is not None else []
         # /uav{i}/cable_length of each UAV with a winch
         lengths = [self.create_publisher(Float64, uav_topic(i, CABLE_LENGTH), PUBLISHER_QOS)
                    for i in scenario.winches]
@@ -115,7 +117,7 @@ class SimNode(Node):
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
             self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events, *winds,
-            *self.measured_pubs, *estimates, *lengths,
+            *self.measured_pubs, *estimates, *payload_estimate, *lengths,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)

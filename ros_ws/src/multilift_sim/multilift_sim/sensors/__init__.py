@@ -24,7 +24,8 @@ module declares:
   `every` ticks to the end; `dt` [s] between two), as the turbulence is drawn: one seed, one
   series, in every path;
 - `measure(constants, draws, memory, tick, truth, received)`: compiled (`kernels.jit`), the one
-  signature of every model: at control tick `tick`, from UAV truth (MEASURED_COLUMNS,) its
+  signature of every model: at control tick `tick`, from UAV truth (SENSED_COLUMNS,: its
+  measured state, then its cable's direction and tension, physics.layout SENSED_*) its
   output into received (MEASURED_COLUMNS,): what the controllers read (left as it is, a model
   passes the state through); `draws` (samples, D) and `memory` (M,) that UAV's. It may be
   called more than once at a tick (a snapshot read twice) and must then give the same result.
@@ -74,7 +75,8 @@ def _changed() -> None:
 
 SENSOR_MODELS = Registry('sensor model',
                          ('NAME', 'UNITS', 'parse', 'constants', 'memory', 'draws', 'measure'),
-                         (measured_state, imu, mocap, gnss, cable_sensor), changed=_changed, check=_check)
+                         (measured_state, imu, mocap, gnss, cable_sensor), changed=_changed,
+                         check=_check)
 register, unregister, registered = (SENSOR_MODELS.register, SENSOR_MODELS.unregister,
                                     SENSOR_MODELS.registered)
 

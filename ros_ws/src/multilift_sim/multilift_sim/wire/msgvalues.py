@@ -10,6 +10,7 @@ from typing import Sequence
 
 import numpy as np
 
+from multilift_sim.estimators.published import payload_read
 from multilift_sim.events import kind_at
 from multilift_sim.kernels import uncompiled
 from multilift_sim.physics.measurement import euler_quaternion
@@ -76,13 +77,15 @@ def formation_snapshot(snapshot, previous_rotor_speeds: Sequence[np.ndarray] | N
     """The arrays of a multilift_msgs/FormationSnapshot from a simulation.Snapshot and the
     rotor speeds applied up to it (None at t = 0): (position, velocity, euler, body_rates)
     3 per UAV, what the controllers receive (its `measured` rows), payload position and
-    velocity, previous rotor speeds UAV by UAV (empty at t = 0)."""
+    velocity (its estimate with a payload estimator: what the controllers read), previous
+    rotor speeds UAV by UAV (empty at t = 0)."""
     measured = snapshot.measured  # what the controllers receive (multilift_sim.sensors)
     previous = (np.concatenate(previous_rotor_speeds).astype(float)
                 if previous_rotor_speeds is not None else np.empty(0))
+    payload = ((snapshot.payload_position, snapshot.payload_velocity)
+               if snapshot.payload_estimate is None else payload_read(snapshot.payload_estimate))
     return tuple(measured[:, block:block + 3].reshape(-1) for block in SNAPSHOT_BLOCKS) + (
-        np.asarray(snapshot.payload_position, dtype=float),
-        np.asarray(snapshot.payload_velocity, dtype=float), previous)
+        np.asarray(payload[0], dtype=float), np.asarray(payload[1], dtype=float), previous)
 
 
 FormationEventValues = tuple[str, int, int, float, float, str]

@@ -25,9 +25,10 @@ from multilift_sim.physics.measurement import odometry_rows, odometry_states
 from multilift_sim.scenario import Scenario
 from multilift_sim.wire.scene import FormationScene
 from multilift_sim.simulation import Snapshot
+from multilift_sim.estimators.published import payload_read
 from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
-                                  FORMATION_STATE, MARKERS, MEASURED_ODOM, PAYLOAD_GUST,
-                                  PAYLOAD_ODOM, TF, ODOM, WIND, uav_topic)
+                                  FORMATION_STATE, MARKERS, MEASURED_ODOM, PAYLOAD_ESTIMATE,
+                                  PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, WIND, uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
 _ZERO = (0.0, 0.0, 0.0)
@@ -58,6 +59,10 @@ class SimulatorMessages:
         self._lengths = [(i - 1, uav_topic(i, CABLE_LENGTH), cdr.Float64())
                          for i in scenario.winches]
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
+        # the payload's estimate with its covariance (/payload/estimate), with a payload
+        # estimator
+        self._payload_estimate = cdr.Odometry(PAYLOAD_FRAME, covariance=True) \
+            if scenario.payload_estimator is not None else None
         self._gust = cdr.Vector3Stamped()
         self._wind = cdr.Vector3Stamped() if scenario.has_wind else None  # /formation/wind
         # /tf: world -> each UAV, world -> payload, and a rigid payload's attach points
@@ -95,7 +100,8 @@ class SimulatorMessages:
             snap.payload_position.tolist(), payload_velocity, vec3(gust),
             measured, None if wind is None else vec3(wind), payload_pose,
             snap.cable_lengths.tolist(),
-            snap.estimate.tolist() if self._estimates else None)
+            snap.estimate.tolist() if self._estimates else None,
+            None if self._payload_estimate is None else snap.payload_estimate.tolist())
 
     def state_of(self, t_ns: int, snapshot: list[float] | None, previous: int | None,
                  uavs: Sequence[Sequence[float]], payload_position: Sequence[float],
@@ -104,7 +110,8 @@ class SimulatorMessages:
                  wind: Sequence[float] | None = None,
                  payload_pose: tuple[Sequence[float], Sequence[float]] | None = None,
                  cable_lengths: Sequence[float] = (),
-                 estimates: Sequence[Sequence[float]] | None = None) -> list[Message]:
+                 estimates: Sequence[Sequence[float]] | None = None,
+                 payload_estimate: Sequence[float] | None = None) -> list[Message]:
         """`state` from plain numbers (the one packing of both): `snapshot` the
         FormationSnapshot's numbers in a row (`cdr.FormationSnapshot.pack_row`; None at the
         last tick) with `previous` rotor speeds at its end, per UAV its odometry's 13 numbers
@@ -114,7 +121,8 @@ class SimulatorMessages:
         [m, m/s]; a rigid payload's `payload_pose` (its orientation (x, y, z, w) and body rates
         [rad/s]; its velocity then in its own frame, as nav_msgs/Odometry's twist is), and
         every cable's length [m] (/uav{i}/cable_length of the UAVs with a winch), and with an
-        estimator every UAV's estimate (estimators.published's 85 numbers, /uav{i}/estimate)."""
+        estimator every UAV's estimate (estimators.published's 85 numbers, /uav{i}/estimate),
+        with a payload estimator the payload's (the same numbers, /payload/estimate)."""
         orientation, spin = (IDENTITY, _ZERO) if payload_pose is None else payload_pose
         out = [(CLOCK, self._clock.pack(t_ns))]
         if snapshot is not None:
@@ -131,6 +139,9 @@ class SimulatorMessages:
             out.append((topic, packer.pack(cable_lengths[i])))
         out.append((PAYLOAD_ODOM, self._payload.pack(t_ns, payload_position, orientation,
                                                      payload_velocity, spin)))
+        if payload_estimate is not None:
+            out.append((PAYLOAD_ESTIMATE, self._payload_estimate.pack_row(t_ns,
+                                                                          payload_estimate)))
         out.append((PAYLOAD_GUST, self._gust.pack(t_ns, *gust)))
         if self._wind is not None:
             out.append((WIND, self._wind.pack(t_ns, *wind)))
@@ -174,21 +185,24 @@ class SimulatorMessages:
         return MARKERS, self._markers.pack(t_ns)
 
 
-def state_rows(states: np.ndarray, n: int, measured: np.ndarray | None = None
-               ) -> tuple[np.ndarray, np.ndarray]:
+def state_rows(states: np.ndarray, n: int, measured: np.ndarray | None = None,
+               payload_estimate: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The numbers `SimulatorMessages.state_of` takes, for K formation states (K, len(x))
     of n UAVs at once: (the FormationSnapshot rows (K, 12 n + 6) without the rotor speeds,
     every UAV's odometry row (K, n, 13)). One call of physics.measurement.odometry_states,
     which `FormationSimulator.snapshot` calls too: the same bits tick by tick
     (tests/unit/test_headless_bag.py). The snapshot carries what the controllers received,
-    `measured` (K, n, MEASURED_COLUMNS), where given (the engine's record), else the state's."""
+    `measured` (K, n, MEASURED_COLUMNS), where given (the engine's record), else the state's,
+    and of the payload its estimate `payload_estimate` (K, ESTIMATE_COLUMNS) where given (a
+    payload estimator), else the state's."""
     k, layout = states.shape[0], StateLayout(n)
     rows = np.empty((k, n, ODOMETRY_COLUMNS))
     odometry_states(np.ascontiguousarray(states), n, rows)
     received = rows if measured is None else measured
     snapshot = np.concatenate(
         [received[..., block:block + 3].reshape(k, 3 * n) for block in SNAPSHOT_BLOCKS]
-        + [layout.payload_position(states), layout.payload_velocity(states)], axis=1)
+        + list((layout.payload_position(states), layout.payload_velocity(states))
+               if payload_estimate is None else payload_read(payload_estimate)), axis=1)
     return snapshot, rows[..., ODOMETRY_NUMBERS]
 
 

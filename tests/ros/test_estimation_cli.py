@@ -44,7 +44,10 @@ def test_the_estimator_flies_alike_through_ros_and_headless(tmp_path):
                                                           else [])
         out = subprocess.run(args, capture_output=True, text=True, timeout=600, env=env)
         assert out.returncode == 0, out.stderr[-2000:]
-        assert 'seeds            imu 1, mocap 1' in out.stdout
+        seeds = next(line for line in out.stdout.splitlines() if line.startswith('  seeds'))
+        assert sorted(seeds.split(None, 1)[1].split(', ')) == [
+            'cable_sensor 1', 'imu 1', 'mocap 1']  # the three sensors' seeds, in some order
+        assert 'estimate payload position rms' in out.stdout
     ros_run, headless_run = (load_run(tmp_path / mode) for mode in ('ros', 'headless'))
     assert np.abs(ros_run.uav_positions() - headless_run.uav_positions()).max() < 1e-9
     for i in (1, 2):
@@ -58,6 +61,12 @@ def test_the_estimator_flies_alike_through_ros_and_headless(tmp_path):
         assert np.abs(ros['position'] - headless['position']).max() < 1e-9
         assert np.array_equal(headless['position'],
                               headless_run.topic(f'/uav{i}/measured_odom')['position'])
+    # the payload's estimate (/payload/estimate, with covariance), the same through both
+    ros, headless = (run.topic('/payload/estimate') for run in (ros_run, headless_run))
+    assert len(ros.t) == len(headless.t) == 201
+    assert np.abs(ros['position'] - headless['position']).max() < 1e-9
+    error = headless['position'] - headless_run.topic('/payload/odom')['position']
+    assert 1e-6 < np.abs(error).max() < 0.05
     for mode in ('ros', 'headless'):
         summary = json.loads((tmp_path / mode / 'summary.json').read_text())
-        assert summary['sim']['seeds'] == {'imu': 1, 'mocap': 1}
+        assert summary['sim']['seeds'] == {'imu': 1, 'mocap': 1, 'cable_sensor': 1}

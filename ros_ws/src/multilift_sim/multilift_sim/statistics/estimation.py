@@ -6,7 +6,7 @@ ESTIMATION, PAYLOAD, *_ERROR_SQ, *_NEES), whose summary (statistics.figures) is 
 mean NEES. Units: SI, world frame z up."""
 import numpy as np
 
-from multilift_sim.estimators.published import (COVARIANCE_SIDE, ESTIMATE_LINEAR,
+from multilift_sim.estimators.published import (COVARIANCE_SIDE, ESTIMATE_COLUMNS, ESTIMATE_LINEAR,
                                                 ESTIMATE_ORIENTATION, ESTIMATE_POSE_COVARIANCE,
                                                 ESTIMATE_POSITION)
 from multilift_sim.kernels import jit
@@ -38,8 +38,16 @@ def run_add_estimation(run, state, estimates, payload):
     """One tick's estimates against the formation state x `state`: estimates (n, >=
     ESTIMATE_COLUMNS) every UAV's (the attitude error Log(q_hat^-1 q), body, turned into the
     world's axes as the published covariance has it), payload (0 or >= ESTIMATE_COLUMNS) the
-    payload's (none: 0 columns)."""
+    payload's (none: 0 columns). A tick whose estimates carry no covariance (an estimator that
+    publishes none: a zero on a variance's diagonal, or fewer than ESTIMATE_COLUMNS) is not
+    counted."""
     n = estimates.shape[0]
+    if estimates.shape[1] < ESTIMATE_COLUMNS:
+        return
+    for i in range(n):
+        for j in range(COVARIANCE_SIDE):
+            if not estimates[i, ESTIMATE_POSE_COVARIANCE + (COVARIANCE_SIDE + 1) * j] > 0.0:
+                return
     run[RUN_ESTIMATION_SAMPLES] += 1.0
     error = np.empty(3)
     for i in range(n):

@@ -184,7 +184,8 @@ def advance(a, m, b, speeds, saturated, tension):
     run_add_compression(m.run[b], tension, period)
     if formation[FORMATION_ELASTIC] != 0.0:  # each rope's stretch and tension at the tick
         run_add_ropes(m.run[b], m.state[b], m.reel[b, :, REEL_LENGTH], tension)
-    if formation[FORMATION_WINCH] != 0.0:  # the reels at the new tick, g and g_dot of the reeled lengths there
+    if formation[FORMATION_WINCH] != 0.0:  # the reels at the new tick, g, g_dot of the
+        # reeled lengths there
         reel_end(uavs, m.reel[b], (m.tick[b] + 1) * a.period_ns[b] * 1e-9, g, g_dot)
         run_add_reel(m.run[b], m.reel[b], a.cable_lengths[b])
     if a.slack[b]:

@@ -35,7 +35,7 @@ from multilift_sim.physics.prescribed import prescribe_state
 from multilift_sim.estimators.estimation import estimated_states
 from multilift_sim.payload_estimators.estimation import estimated_payload
 from multilift_sim.physics.cable_sensing import cable_truths
-from multilift_sim.physics.winch import reel_end, reel_period
+from multilift_sim.physics.winch import period_uavs, reel_end
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.estimation import run_add_estimation
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
@@ -179,9 +179,8 @@ def advance(a, m, b, speeds, saturated, tension):
     t0 = m.tick[b] * a.period_ns[b] * 1e-9
     formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
                                 t0)
-    winched = formation[FORMATION_WINCH] != 0.0
     # the UAVs' rows, with each reel's motion over the period where winches reel (physics.winch)
-    uavs = reel_period(a.uavs[b], m.reel[b], t0, period) if winched else a.uavs[b]
+    uavs = period_uavs(a.uavs[b], m.reel[b], formation, t0, period)
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
         uavs, a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
@@ -193,7 +192,8 @@ def advance(a, m, b, speeds, saturated, tension):
     run_add_compression(m.run[b], tension, period)
     if formation[FORMATION_ELASTIC] != 0.0:  # each rope's stretch and tension at the tick
         run_add_ropes(m.run[b], m.state[b], m.reel[b, :, REEL_LENGTH], tension)
-    if winched:  # the reels at the new tick, g and g_dot of the reeled lengths there
+    if formation[FORMATION_WINCH] != 0.0:  # the reels at the new tick, g, g_dot of the
+        # reeled lengths there
         reel_end(uavs, m.reel[b], (m.tick[b] + 1) * a.period_ns[b] * 1e-9, g, g_dot)
         run_add_reel(m.run[b], m.reel[b], a.cable_lengths[b])
     if a.slack[b]:
@@ -272,8 +272,7 @@ def tension_at(a, m, b, speeds, tension):
     t = m.tick[b] * a.period_ns[b] * 1e-9
     formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
                                 t)
-    winched = formation[FORMATION_WINCH] != 0.0
-    uavs = reel_period(a.uavs[b], m.reel[b], t, a.period_ns[b] * 1e-9) if winched else a.uavs[b]
+    uavs = period_uavs(a.uavs[b], m.reel[b], formation, t, a.period_ns[b] * 1e-9)
     solve(x, wrenches, uavs, a.gusts[b], formation, m.taut[b], acc, multipliers,
           np.empty((n, CABLE_COLUMNS)))
     for i in range(n):

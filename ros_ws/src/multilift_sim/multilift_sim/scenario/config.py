@@ -255,6 +255,7 @@ class Scenario:
     payload_estimator: EstimatorConfig | None = None
     parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
     world: WorldConfig | None = None  # obstacles, ground (`world:`); None: no clearance checks
+    comms: Any = None                # links.CommsConfig (`comms:`); None: followers hear at once
 
     @property
     def n_uavs(self) -> int:

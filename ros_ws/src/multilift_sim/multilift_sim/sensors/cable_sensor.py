@@ -1,11 +1,12 @@
 """`cable_sensor`: a sensor at each UAV's attach point on its cable (issue 33 item 1;
 docs/estimation.md): a two-axis gimbal whose encoders read the cable's direction as two angles
 (physics.cable_sensing.gimbal_angles: body frame, zero hanging straight down), and a load cell
-reading its tension, at one rate, `latency` late, with white noise.
+reading its tension, at one rate, `latency` late, with white noise and dropouts.
 
 Sample s, taken at tick s * every, carries the true angles plus `encoder_noise` w [rad] each
 and the tension plus `load_cell_noise` w' [N] (w, w' standard normal), and arrives `latency`
-[s] later (to the nearest control tick); the first sample (tick 0) arrives at once. The
+[s] later (to the nearest control tick) unless lost (probability `dropout`); the first
+sample (tick 0) arrives at once. The
 tension is the one of the last tick flown (physics.tick.advance's; NaN at tick 0, before any:
 the load cell's first reading is then NaN). Errors drawn before the run (`draws`). Not
 modelled: an encoder's non-linearity (a slowly varying error over the angle), the cable's
@@ -28,28 +29,25 @@ from multilift_sim.physics.cable_sensing import gimbal_angles
 from multilift_sim.physics.layout import (MEASURED_EULER, SENSED_CABLE_DIRECTION,
                                           SENSED_CABLE_TENSION)
 from multilift_sim.physics.measurement import euler_rotation
-from multilift_sim.sensors.outputs import ARRIVED, OUTPUT, TAKEN
+from multilift_sim.sensors.outputs import (OUTPUT, delayed_constants, delayed_memory,
+                                          delayed_sample)
 
 NAME = 'cable_sensor'
-UNITS = {'encoder_noise': 'rad', 'load_cell_noise': 'N', 'latency': 's', 'preset': ''}
+UNITS = {'encoder_noise': 'rad', 'load_cell_noise': 'N', 'latency': 's', 'dropout': '',
+         'preset': ''}
 PRESETS = {'cable_gimbal': {'rate': 100.0, 'latency': 0.0,
                             'encoder_noise': math.radians(0.06),
-                            'load_cell_noise': 0.013e-2 * 5.0 * 9.80665}}
+                            'load_cell_noise': 0.013e-2 * 5.0 * 9.80665, 'dropout': 0.0}}
 
 # -- its output (after outputs.OUTPUT) ---------------------------------------------------------
 OUTPUT_ANGLES = 0           # the gimbal's angles (alpha, beta) [rad] (2)
 OUTPUT_TENSION = 2          # T [N]
 OUTPUT_COLUMNS = 3
-# -- its constants row -------------------------------------------------------------------------
-EVERY = 0                   # control ticks between two samples
-LATENCY = 1                 # control ticks from a sample to its arrival
-CONSTANT_COLUMNS = 2
-# -- a sample's draws: its errors, in the output's order ([rad, rad, N]) -----------------------
-DRAW_COLUMNS = OUTPUT_COLUMNS
-# -- one UAV's memory (after outputs.OUTPUT's block) ------------------------------------------
-LAST_TICK = OUTPUT + OUTPUT_COLUMNS  # the tick measured last (-1: none)
-DELAY_LINE = LAST_TICK + 1  # the true outputs of the last latency + 1 ticks, by tick %
-#                             (latency + 1) (rows of OUTPUT_COLUMNS)
+# -- a sample's draws: its errors, in the output's order ([rad, rad, N]), then --------------------
+DRAW_DELIVERED = OUTPUT_COLUMNS  # 1.0: it arrives, 0.0: lost
+DRAW_COLUMNS = OUTPUT_COLUMNS + 1
+# its constants and memory: outputs.delayed_constants, delayed_memory (a delay line of the
+# true outputs, rows of OUTPUT_COLUMNS)
 
 
 @dataclass(frozen=True)
@@ -57,6 +55,7 @@ class CableSensorSettings:
     encoder_noise: float             # [rad], standard deviation of each gimbal angle
     load_cell_noise: float           # [N], standard deviation of the tension
     latency: float                   # [s] from a sample to its arrival
+    dropout: float                   # probability a sample is lost, in [0, 1)
     latency_ticks: int = 0           # the latency in control ticks (`with_simulation`)
 
 
@@ -69,8 +68,11 @@ def parse(d) -> CableSensorSettings:
     """Its keys from `d` (the `cable_sensor:` section), each >= 0, defaults its `preset`'s
     (else 0)."""
     preset = preset_values(d)
-    return CableSensorSettings(**{key: d.non_negative(key, preset.get(key, 0.0)) for key in (
-        'encoder_noise', 'load_cell_noise', 'latency')})
+    return CableSensorSettings(
+        **{key: d.non_negative(key, preset.get(key, 0.0)) for key in (
+            'encoder_noise', 'load_cell_noise', 'latency')},
+        dropout=d.number('dropout', preset.get('dropout', 0.0), lambda v: 0 <= v < 1,
+                         'must be within [0, 1)'))
 
 
 def with_simulation(settings: CableSensorSettings, simulation, every: int
@@ -80,22 +82,22 @@ def with_simulation(settings: CableSensorSettings, simulation, every: int
 
 
 def constants(settings: CableSensorSettings, every: int) -> np.ndarray:
-    row = np.zeros(CONSTANT_COLUMNS)
-    row[EVERY], row[LATENCY] = every, settings.latency_ticks
-    return row
+    return delayed_constants(settings.latency_ticks, every)
 
 
 def memory(settings: CableSensorSettings) -> np.ndarray:
-    row = np.zeros(DELAY_LINE + (settings.latency_ticks + 1) * OUTPUT_COLUMNS)
-    row[ARRIVED] = row[TAKEN] = row[LAST_TICK] = -1.0
-    return row
+    return delayed_memory(OUTPUT_COLUMNS, settings.latency_ticks)
 
 
 def draws(settings: CableSensorSettings, n_uavs: int, samples: int, dt: float,
           rng: np.random.Generator) -> np.ndarray:
-    """Every sample's errors (n_uavs, samples, DRAW_COLUMNS) in a fixed order from `rng`."""
+    """Every sample's draws (n_uavs, samples, DRAW_COLUMNS) in a fixed order from `rng`
+    (the angles' and the tension's noise, dropouts)."""
     sigma = np.array([settings.encoder_noise] * 2 + [settings.load_cell_noise])
-    return rng.standard_normal((n_uavs, samples, DRAW_COLUMNS)) * sigma
+    rows = np.empty((n_uavs, samples, DRAW_COLUMNS))
+    rows[:, :, :OUTPUT_COLUMNS] = rng.standard_normal((n_uavs, samples, OUTPUT_COLUMNS)) * sigma
+    rows[:, :, DRAW_DELIVERED] = rng.random((n_uavs, samples)) >= settings.dropout
+    return rows
 
 
 @jit
@@ -105,12 +107,10 @@ def measure(constants, draws, memory, tick, truth, received):
     tension into the delay line; the sample taken `latency` ticks ago, if one was, into the
     output with its errors (ARRIVED this tick, TAKEN its tick); received left alone. A second
     call at one tick changes nothing."""
-    if memory[LAST_TICK] == tick:
+    line, source, sample = delayed_sample(constants, draws[:, DRAW_DELIVERED], memory, tick,
+                                          OUTPUT_COLUMNS)
+    if line < 0:
         return
-    memory[LAST_TICK] = tick
-    every = int(constants[EVERY])
-    slots = int(constants[LATENCY]) + 1
-    line = DELAY_LINE + (tick % slots) * OUTPUT_COLUMNS
     r = euler_rotation(truth[MEASURED_EULER], truth[MEASURED_EULER + 1],
                        truth[MEASURED_EULER + 2])  # row by row
     d = SENSED_CABLE_DIRECTION
@@ -120,14 +120,7 @@ def measure(constants, draws, memory, tick, truth, received):
     memory[line + OUTPUT_ANGLES], memory[line + OUTPUT_ANGLES + 1] = gimbal_angles(
         body[0], body[1], body[2])
     memory[line + OUTPUT_TENSION] = truth[SENSED_CABLE_TENSION]
-    taken = 0 if tick == 0 else tick - slots + 1
-    if taken < 0 or taken % every != 0 or (taken == 0 and tick > 0):  # tick 0's: at once
+    if sample < 0:
         return
-    sample = taken // every
-    if sample >= draws.shape[0]:
-        return
-    source = DELAY_LINE + (taken % slots) * OUTPUT_COLUMNS
     for j in range(OUTPUT_COLUMNS):
         memory[OUTPUT + j] = memory[source + j] + draws[sample, j]
-    memory[ARRIVED] = tick
-    memory[TAKEN] = taken

@@ -28,6 +28,10 @@ def test_the_estimates_lie_in_their_3_sigma_band_and_are_drawn(tmp_path):
         inside = np.mean(np.abs(error) <= 3.0 * sigma)
         assert 0.98 <= inside < 1.0                  # 99.7 % for a Gaussian error
         assert np.sqrt(np.mean(error ** 2)) < 1e-3   # sub-millimetre (1 mm mocap fused)
+    t, error, sigma = estimate_errors(run, 0)  # the payload's (/payload/estimate)
+    assert len(t) == 2001 and np.all(sigma > 0.0)
+    assert np.mean(np.abs(error) <= 3.0 * sigma) >= 0.97  # 99 % over 120 s: docs/estimation.md
+    assert np.sqrt(np.mean(error ** 2)) < 0.02  # centimetres (the bound: 0.2 m)
     assert plot_main([str(tmp_path / 'bag'), '--out', str(tmp_path / 'plots')]) == 0
     assert (tmp_path / 'plots' / 'estimation.png').stat().st_size > 0
     record_headless(scenario_io.load('twin_lift').with_duration(1.0), tmp_path / 'exact')

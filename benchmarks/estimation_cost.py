@@ -2,7 +2,8 @@
 compiled `estimators.ekf.estimate` of one UAV called on fresh ticks of a twin_lift_realistic
 flight's arrays (propagation of the delayed horizon, the output predictor over the motion
 capture's latency, an update at most ticks), and the engine's whole tick with and without the
-estimator (twin_lift_realistic against twin_lift), CPU time.
+estimator (twin_lift_realistic against twin_lift) and without its cable sensors and payload
+estimator (issue 33 items 1 and 3), CPU time.
 
     python benchmarks/estimation_cost.py
 """
@@ -48,10 +49,16 @@ def per_call() -> tuple[float, float]:
     return inside, (time.process_time() - started) / ticks * 1e6
 
 
-def engine_tick(name: str) -> float:
-    """[us] of CPU per control tick of the engine flying `name` (60 s, one formation)."""
+def engine_tick(name: str, without_payload_estimator: bool = False) -> float:
+    """[us] of CPU per control tick of the engine flying `name` (60 s, one formation; with
+    `without_payload_estimator` its cable sensors and payload estimator left out)."""
     from multilift_control.engine import Engine
-    engine = Engine(scenarios.load(name).with_duration(60.0))
+    scenario = scenarios.load(name).with_duration(60.0)
+    if without_payload_estimator:
+        import dataclasses
+        scenario = dataclasses.replace(scenario, payload_estimator=None, sensor_suite=tuple(
+            c for c in scenario.sensor_suite if c.model != 'cable_sensor'))
+    engine = Engine(scenario)
     engine.step(10)
     started = time.process_time()
     engine.step(5990)
@@ -64,3 +71,5 @@ if __name__ == '__main__':
           f'compiled loop ({from_python:.1f} us called from Python)')
     for name in ('twin_lift', 'twin_lift_realistic'):
         print(f'engine tick of {name}: {engine_tick(name):.1f} us CPU')
+    print('engine tick of twin_lift_realistic without its cable sensors and payload estimator: '
+          f'{engine_tick("twin_lift_realistic", True):.1f} us CPU')

@@ -23,6 +23,18 @@ def test_the_command_line_refuses_bad_input_in_one_line_with_exit_2(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1
 
 
+def test_a_payload_estimator_without_cable_sensors_is_one_line_and_exit_2(tmp_path):
+    data = yaml.safe_load((ROOT / 'scenarios' / 'twin_lift_realistic.yaml').read_text())
+    del data['cable_sensor']
+    path = tmp_path / 'no_cable_sensor.yaml'
+    path.write_text(yaml.safe_dump(data))
+    done = subprocess.run([str(ROOT / 'scripts' / 'multilift'), 'run', str(path), '--headless'],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert "payload_estimator: 'cable_geometry' needs the sensors cable_sensor" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+
+
 def test_the_estimator_flies_alike_through_ros_and_headless(tmp_path):
     """`twin_lift_realistic` (docs/estimation.md) through the ROS nodes and headless: the
     simulator node's estimator gives the controllers the numbers the engine's does (every

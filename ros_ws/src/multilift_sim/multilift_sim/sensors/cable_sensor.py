@@ -20,7 +20,7 @@ rate), a load cell of 5 kg (49 N) capacity with 0.013 % of full scale non-repeat
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -29,8 +29,8 @@ from multilift_sim.physics.cable_sensing import gimbal_angles
 from multilift_sim.physics.layout import (MEASURED_EULER, SENSED_CABLE_DIRECTION,
                                           SENSED_CABLE_TENSION)
 from multilift_sim.physics.measurement import euler_rotation
-from multilift_sim.sensors.outputs import (OUTPUT, delayed_constants, delayed_memory,
-                                          delayed_sample)
+from multilift_sim.sensors.outputs import (OUTPUT, DelayedSettings, delayed_protocol,
+                                          delayed_sample, read_dropout)
 
 NAME = 'cable_sensor'
 UNITS = {'encoder_noise': 'rad', 'load_cell_noise': 'N', 'latency': 's', 'dropout': '',
@@ -46,22 +46,18 @@ OUTPUT_COLUMNS = 3
 # -- a sample's draws: its errors, in the output's order ([rad, rad, N]), then --------------------
 DRAW_DELIVERED = OUTPUT_COLUMNS  # 1.0: it arrives, 0.0: lost
 DRAW_COLUMNS = OUTPUT_COLUMNS + 1
-# its constants and memory: outputs.delayed_constants, delayed_memory (a delay line of the
-# true outputs, rows of OUTPUT_COLUMNS)
 
 
-@dataclass(frozen=True)
-class CableSensorSettings:
+@dataclass(frozen=True, kw_only=True)
+class CableSensorSettings(DelayedSettings):
+    """Its keys (and a delayed sensor's: latency [s], dropout)."""
     encoder_noise: float             # [rad], standard deviation of each gimbal angle
     load_cell_noise: float           # [N], standard deviation of the tension
-    latency: float                   # [s] from a sample to its arrival
-    dropout: float                   # probability a sample is lost, in [0, 1)
-    latency_ticks: int = 0           # the latency in control ticks (`with_simulation`)
 
 
-def preset_values(d) -> dict:
-    """The key values of the section's `preset` (none: {})."""
-    return PRESETS.get(d.text('preset', 'none', choices=('none', *PRESETS)), {})
+# its preset_values, with_simulation, constants and memory: a delayed sensor's (outputs)
+preset_values, with_simulation, constants, memory = delayed_protocol(OUTPUT_COLUMNS,
+                                                                    PRESETS)
 
 
 def parse(d) -> CableSensorSettings:
@@ -71,22 +67,7 @@ def parse(d) -> CableSensorSettings:
     return CableSensorSettings(
         **{key: d.non_negative(key, preset.get(key, 0.0)) for key in (
             'encoder_noise', 'load_cell_noise', 'latency')},
-        dropout=d.number('dropout', preset.get('dropout', 0.0), lambda v: 0 <= v < 1,
-                         'must be within [0, 1)'))
-
-
-def with_simulation(settings: CableSensorSettings, simulation, every: int
-                    ) -> CableSensorSettings:
-    """The settings with the latency in control ticks (the nearest)."""
-    return replace(settings, latency_ticks=int(round(settings.latency * simulation.control_rate)))
-
-
-def constants(settings: CableSensorSettings, every: int) -> np.ndarray:
-    return delayed_constants(settings.latency_ticks, every)
-
-
-def memory(settings: CableSensorSettings) -> np.ndarray:
-    return delayed_memory(OUTPUT_COLUMNS, settings.latency_ticks)
+        dropout=read_dropout(d, preset))
 
 
 def draws(settings: CableSensorSettings, n_uavs: int, samples: int, dt: float,

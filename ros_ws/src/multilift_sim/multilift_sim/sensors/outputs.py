@@ -3,10 +3,10 @@ its memory (one UAV's, `SENSOR_MODELS`' `memory`): its latest output and when it
 the estimators (`multilift_sim.estimators`) read. Such a sensor leaves what the controllers
 receive alone (they read the estimate, or the state without an estimator).
 
-A sensor whose samples arrive late (`mocap`, `gnss`) keeps, after its output, the tick it
-measured last and a delay line of its truths (`delayed_memory`); `delayed_sample` decides, at
-a tick, which row takes the truth and which sample (if any) arrives: the one place that
-logic is written."""
+A sensor whose samples arrive late (`mocap`, `gnss`, `cable_sensor`) keeps, after its output,
+the tick it measured last and a delay line of its truths (`delayed_memory`); `delayed_sample`
+decides, at a tick, which row takes the truth and which sample (if any) arrives: the one place
+that logic is written."""
 from dataclasses import dataclass, replace
 
 import numpy as np

@@ -41,8 +41,27 @@ def initial_state(scenario: Scenario) -> np.ndarray:
     payload = scenario.payload
     if scenario.prescribed or payload.initial_position is not None \
             or payload.initial_velocity is not None:
-        return given_start(scenario, state)
+        state = given_start(scenario, state)
+    if scenario.cable_model == 'chain':
+        return chain_start(state, scenario.n_uavs, scenario.cable['links'])
     return state
+
+
+def chain_start(state: np.ndarray, n: int, links: int) -> np.ndarray:
+    """A point payload's state with each cable's N - 1 inner nodes appended
+    (`cable_model: chain`): on the straight line from its UAV's centre to the payload, node k
+    at k / N of it, moving as that line's point does (the rigid cable's start)."""
+    point = StateLayout(n)
+    layout = StateLayout(n, chain_nodes=links - 1)
+    out = np.zeros(layout.size)
+    out[:point.size] = state
+    uavs, payload = point.uav_positions(state), point.payload_position(state)
+    uav_velocities, payload_velocity = point.uav_velocities(state), point.payload_velocity(state)
+    share = (np.arange(1, links) / links)[None, :, None]
+    layout.chain_positions(out)[:] = uavs[:, None, :] + share * (payload - uavs)[:, None, :]
+    layout.chain_velocities(out)[:] = uav_velocities[:, None, :] + share * (
+        payload_velocity - uav_velocities)[:, None, :]
+    return out
 
 
 def given_start(scenario: Scenario, state: np.ndarray) -> np.ndarray:

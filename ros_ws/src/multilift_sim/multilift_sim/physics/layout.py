@@ -66,6 +66,39 @@ def attitude_slot(n_uavs: int) -> int:
     return 2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES) + BODY_ATTITUDE * n_uavs
 
 
+# a heavy cable's inner nodes (`cable_model: chain`, physics.chain_cables): each cable of N
+# links has N - 1 point masses between its UAV and the payload, node k (1 .. N - 1) from the
+# UAV; their blocks follow a point payload's state (after the UAVs' attitude blocks), cable
+# by cable, node by node, each its position [m] then its velocity [m/s], world (z up)
+NODE_POSITION = 0           # r_ik [m] (3 slots)
+NODE_VELOCITY = 3           # r_ik_dot [m/s] (3)
+NODE_STATE = 6              # a node's block
+
+
+def chain_node_slot(n_uavs: int, inner_nodes: int, i: int, k: int) -> int:
+    """Offset of cable i's node k (1 .. inner_nodes, from the UAV) in x, each cable holding
+    `inner_nodes` = N - 1 inner nodes (`cable_model: chain`)."""
+    return (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES) + BODY_ATTITUDE * n_uavs
+            + NODE_STATE * (inner_nodes * i + k - 1))
+
+
+def chain_inner_nodes(size: int, n_uavs: int) -> int:
+    """The inner nodes per cable (N - 1) a state of length `size` holds for n UAVs: 0 but for
+    a chain's state, a point payload's plus n (N - 1) node blocks (a rigid payload's adds
+    PAYLOAD_ATTITUDE = 7, never a multiple of NODE_STATE n)."""
+    extra = size - (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
+                    + BODY_ATTITUDE * n_uavs)
+    if extra <= 0 or extra % (NODE_STATE * n_uavs) != 0:
+        return 0
+    return extra // (NODE_STATE * n_uavs)
+
+
+def rigid_payload_state(size: int, n_uavs: int) -> bool:
+    """Whether a state of length `size` for n UAVs holds a rigid payload's attitude block."""
+    return size == (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
+                    + BODY_ATTITUDE * n_uavs + PAYLOAD_ATTITUDE)
+
+
 # -- the seed's generalised coordinates q_f (Eq. 2.41): the analysis' minimal coordinates -----
 # (multilift_sim.analysis: per UAV r_i [m] and ZYX eta_i [rad], then r_p [m]; a rigid payload's
 # rotation vector after them), which the state maps to and from (analysis.coordinates)
@@ -110,7 +143,10 @@ UAV_REEL_START = 21         # t_0 [s]
 UAV_REEL_LENGTH = 22        # l_0 [m]
 UAV_REEL_RATE = 23          # v_0 [m/s]
 UAV_REEL_TARGET = 24        # the rate it heads for [m/s] (positive pays out)
-UAV_COLUMNS = 25
+# its cable's inner nodes (`cable_model: chain`, physics.chain_cables; 0: none)
+UAV_NODE_MASS = 25          # each inner node's mass [kg]: the cable's mu l over N - 1 nodes
+UAV_NODE_DRAG = 26          # each node's quadratic drag 0.5 rho C_d d (l / N) [N s^2/m^2]
+UAV_COLUMNS = 27
 
 # -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
@@ -174,7 +210,8 @@ FORMATION_TIME = 18         # with FORMATION_PRESCRIBED or FORMATION_WINCH: the 
 #                             drives and reels are evaluated at (the RK4 stage's; a period's
 #                             copy of these scalars holds it)
 FORMATION_WINCH = 19        # 1: some UAV carries a winch (physics.winch): cable lengths l_i(t)
-FORMATION_SCALARS = 20
+FORMATION_CHAIN_LINKS = 20  # N, the links of every cable (`cable_model: chain`); 0: no chain
+FORMATION_SCALARS = 21
 
 # -- the drive table of prescribed UAVs (physics.prescribed), after the formation's scalars
 # when FORMATION_PRESCRIBED: n slots (UAV i's at FORMATION_SCALARS + i: the offset of its drive

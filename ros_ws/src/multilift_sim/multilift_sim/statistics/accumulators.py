@@ -16,7 +16,8 @@ import numpy as np
 from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import quaternion_norm_error
 from multilift_sim.physics.layout import POSITION, REEL_LENGTH, UAV_COORDINATES
-from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, uav_attitude_slot,
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot,
+                                               rigid_payload_state, uav_attitude_slot,
                                                uav_slot)
 from multilift_sim.statistics.layout import (
     CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, CHECK_QUATERNION, FORMATION_MAX_ABS,
@@ -228,7 +229,7 @@ def quaternion_fault(state: np.ndarray, n: int) -> int:
     for i in range(n):
         if quaternion_norm_error(state, uav_attitude_slot(n, i)) > QUATERNION_NORM_TOLERANCE:
             return i
-    if state.shape[0] > attitude_slot(n) and quaternion_norm_error(
+    if rigid_payload_state(state.shape[0], n) and quaternion_norm_error(
             state, attitude_slot(n)) > QUATERNION_NORM_TOLERANCE:
         return n
     return -1

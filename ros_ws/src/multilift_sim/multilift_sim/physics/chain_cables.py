@@ -1,0 +1,234 @@
+"""Heavy cables (`cable_model: chain`, issue 32 item 2): each cable a chain of N rigid links
+between its UAV's centre (node 0) and the point payload (node N), with N - 1 point masses
+between them (node k of cable i, its state at `chain_node_slot(n, N - 1, i, k)`). World frame
+(z up), SI units; slots: `physics.layout` (NODE_*, UAV_NODE_MASS, UAV_NODE_DRAG,
+FORMATION_CHAIN_LINKS). docs/cables.md, "Heavy cables".
+
+The seed's cable constraint (Eq. 2.42) per link: g_ik = |d_ik|^2 - s_i^2 = 0, d_ik = r_ik -
+r_i(k-1), s_i = l_i / N, held by Lagrange multipliers with Baumgarte's stabilisation as the
+formation's (Eq. 2.59-2.60: g_ddot = -2 alpha_f g_dot - beta_f^2 g). A link's multiplier
+lambda_ik pulls node k by -2 lambda_ik d_ik and node k - 1 by +2 lambda_ik d_ik (Eq. 2.70's
+signs: its tension is 2 s_i lambda_ik). With the payload's acceleration a_p given, each cable's
+multipliers solve a tridiagonal system (row k: link k, which couples only with links k - 1
+and k + 1 through their shared node)
+
+    A_i lambda_i = u_rhs_i + e_N (d_iN . a_p),   A_i = tridiag(-2 d_k.d_k-1 / m_k-1,
+                                                 2 |d_k|^2 (1/m_k-1 + 1/m_k), ...)
+
+(1/m_N = 0: the payload's acceleration is the unknown), so lambda_i = u_i + (d_iN . a_p) w_i
+(u_i = A_i^-1 u_rhs_i, w_i = A_i^-1 e_N: one Thomas sweep with two right-hand sides), and the
+payload's m_p a_p = m_p a_p_free - 2 sum_i lambda_iN d_iN is the 3 x 3 system
+(m_p I + 2 sum_i w_iN d_iN d_iN^T) a_p = m_p a_p_free - 2 sum_i u_iN d_iN (the Schur
+complement on the payload's acceleration): O(n N) a solve. Gravity is common to every body
+and cancels in the links' equations; it is added at the end.
+
+Links are rods: a link's multiplier may go negative (it pushes: a chain folding fast, or
+whipped), which a real rope cannot; the chain keeps it (rods, not a rope) and the run's
+`compression` figure reports it for the top link (the tension the tick reports).
+"""
+import math
+
+import numpy as np
+
+from multilift_sim.kernels import jit
+from multilift_sim.physics.free_motion import air_velocity, payload_motion, uav_free_motion
+from multilift_sim.physics.layout import (FORMATION_BETA_SQ, FORMATION_CHAIN_LINKS,
+                                          FORMATION_GRAVITY, FORMATION_PAYLOAD_MASS,
+                                          FORMATION_TWO_ALPHA, FORMATION_WIND, NODE_POSITION,
+                                          NODE_VELOCITY, POSITION, UAV_LENGTH_SQ, UAV_MASS,
+                                          UAV_NODE_DRAG, UAV_NODE_MASS)
+from multilift_sim.physics.state_slots import (chain_node_slot, payload_slot, rates_slot,
+                                               uav_slot)
+
+# a link's scratch row (per cable, per link k = 1 .. N at row k - 1)
+LINK_OFFSET = 0       # d_k = r_k - r_(k-1) [m] (3)
+LINK_DIAGONAL = 3     # A's diagonal, then the eliminated one
+LINK_UPPER = 4        # A[k, k + 1]
+LINK_U = 5            # the right-hand side, then u
+LINK_W = 6            # e_N, then w
+LINK_COLUMNS = 7
+# a node's scratch row (per cable, node j = 0 .. N - 1): its acceleration without the links
+# [m/s^2], gravity excluded (3), and 1 / its mass [1/kg]
+NODE_FREE = 0
+NODE_INV_MASS = 3
+NODE_COLUMNS = 4
+
+
+@jit
+def node_point(x, n, inner, i, k, p, nq):
+    """The offset in x of node k's position of cable i (0: UAV i's r_i, N: the payload's r_p,
+    else an inner node's) and of its velocity."""
+    if k == 0:
+        r = uav_slot(i) + POSITION
+        return r, nq + r
+    if k == inner + 1:
+        return p, nq + p
+    base = chain_node_slot(n, inner, i, k)
+    return base + NODE_POSITION, base + NODE_VELOCITY
+
+
+@jit
+def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
+    """The state's rates into acc at state x (q_ddot, the attitude blocks' rates, then each
+    inner node's velocity and acceleration at its block's place less 3n + 3), the cables
+    chains of FORMATION_CHAIN_LINKS rigid links; each cable's top link tension T_i = 2 s_i
+    lambda_i1 [N] into multipliers (n,) as T_i / (2 l_i) [N/m] (what the tick reads as a rigid
+    cable's). `taut` is not read: a chain is always held."""
+    n = uavs.shape[0]
+    links = int(formation[FORMATION_CHAIN_LINKS])
+    inner = links - 1
+    p = payload_slot(n)
+    nq = rates_slot(n)
+    px, py, pz, pvx, pvy, pvz, drag_ax, drag_ay, drag_az = payload_motion(x, n, gusts,
+                                                                          formation)
+    two_alpha, beta_sq = formation[FORMATION_TWO_ALPHA], formation[FORMATION_BETA_SQ]
+    gravity = formation[FORMATION_GRAVITY]
+    wind_x, wind_y, wind_z = (formation[FORMATION_WIND], formation[FORMATION_WIND + 1],
+                              formation[FORMATION_WIND + 2])
+    link_rows = np.empty((n, links, LINK_COLUMNS))
+    node_rows = np.empty((n, links, NODE_COLUMNS))
+    payload_mass = formation[FORMATION_PAYLOAD_MASS]
+    # the Schur complement S a_p = rhs on the payload's acceleration (gravity excluded)
+    s00 = s11 = s22 = payload_mass
+    s01 = s02 = s12 = 0.0
+    b0, b1, b2 = payload_mass * drag_ax, payload_mass * drag_ay, payload_mass * drag_az
+    for i in range(n):
+        lk = link_rows[i]
+        nd = node_rows[i]
+        thrust_ax, thrust_ay, thrust_az = uav_free_motion(x, i, wrenches, uavs, formation, acc)
+        nd[0, NODE_FREE], nd[0, NODE_FREE + 1], nd[0, NODE_FREE + 2] = (thrust_ax, thrust_ay,
+                                                                          thrust_az)
+        nd[0, NODE_INV_MASS] = 1.0 / uavs[i, UAV_MASS]
+        node_mass, node_drag_c = uavs[i, UAV_NODE_MASS], uavs[i, UAV_NODE_DRAG]
+        for k in range(1, links):  # the inner nodes: their drag in the air
+            r, v = node_point(x, n, inner, i, k, p, nq)
+            nd[k, NODE_INV_MASS] = 1.0 / node_mass
+            fx = fy = fz = 0.0
+            if node_drag_c > 0.0:  # -c |v_rel| v_rel / m, v_rel against the wind and gusts
+                air_x, air_y, air_z = air_velocity(x[r], x[r + 1], gusts)
+                rel_x = x[v] - air_x - wind_x
+                rel_y = x[v + 1] - air_y - wind_y
+                rel_z = x[v + 2] - air_z - wind_z
+                scale = -node_drag_c / node_mass * math.sqrt(rel_x * rel_x + rel_y * rel_y
+                                                             + rel_z * rel_z)
+                fx, fy, fz = scale * rel_x, scale * rel_y, scale * rel_z
+            nd[k, NODE_FREE], nd[k, NODE_FREE + 1], nd[k, NODE_FREE + 2] = fx, fy, fz
+        link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)   # s_i^2
+        for k in range(1, links + 1):  # link k's row: d_k, A's entries, its right-hand side
+            r0, v0 = node_point(x, n, inner, i, k - 1, p, nq)
+            r1, v1 = node_point(x, n, inner, i, k, p, nq)
+            dx, dy, dz = x[r1] - x[r0], x[r1 + 1] - x[r0 + 1], x[r1 + 2] - x[r0 + 2]
+            dvx, dvy, dvz = x[v1] - x[v0], x[v1 + 1] - x[v0 + 1], x[v1 + 2] - x[v0 + 2]
+            row = lk[k - 1]
+            row[LINK_OFFSET], row[LINK_OFFSET + 1], row[LINK_OFFSET + 2] = dx, dy, dz
+            offset_sq = dx * dx + dy * dy + dz * dz
+            upper_inv = nd[k - 1, NODE_INV_MASS]
+            lower_inv = nd[k, NODE_INV_MASS] if k < links else 0.0
+            row[LINK_DIAGONAL] = 2.0 * offset_sq * (upper_inv + lower_inv)
+            # d_k . (a_k - a_(k-1)) = -|dv_k|^2 - alpha_f g_dot_k - beta_f^2 g_k / 2 (Eq. 2.59)
+            target = (-(dvx * dvx + dvy * dvy + dvz * dvz)
+                      - two_alpha * (dx * dvx + dy * dvy + dz * dvz)
+                      - 0.5 * beta_sq * (offset_sq - link_sq))
+            free_x, free_y, free_z = (-nd[k - 1, NODE_FREE], -nd[k - 1, NODE_FREE + 1],
+                                      -nd[k - 1, NODE_FREE + 2])
+            if k < links:
+                free_x += nd[k, NODE_FREE]
+                free_y += nd[k, NODE_FREE + 1]
+                free_z += nd[k, NODE_FREE + 2]
+            row[LINK_U] = dx * free_x + dy * free_y + dz * free_z - target
+            row[LINK_W] = 1.0 if k == links else 0.0
+            if k > 1:  # A[k - 1, k] = -2 d_(k-1) . d_k / m_(k-1), their shared node's
+                above = lk[k - 2]
+                above[LINK_UPPER] = -2.0 * upper_inv * (
+                    above[LINK_OFFSET] * dx + above[LINK_OFFSET + 1] * dy
+                    + above[LINK_OFFSET + 2] * dz)
+        lk[links - 1, LINK_UPPER] = 0.0
+        # Thomas' algorithm on A (symmetric positive definite), two right-hand sides
+        for k in range(1, links):
+            factor = lk[k - 1, LINK_UPPER] / lk[k - 1, LINK_DIAGONAL]
+            lk[k, LINK_DIAGONAL] -= factor * lk[k - 1, LINK_UPPER]
+            lk[k, LINK_U] -= factor * lk[k - 1, LINK_U]
+            lk[k, LINK_W] -= factor * lk[k - 1, LINK_W]
+        last = links - 1
+        lk[last, LINK_U] /= lk[last, LINK_DIAGONAL]
+        lk[last, LINK_W] /= lk[last, LINK_DIAGONAL]
+        for k in range(links - 2, -1, -1):
+            lk[k, LINK_U] = (lk[k, LINK_U] - lk[k, LINK_UPPER] * lk[k + 1, LINK_U]) \
+                / lk[k, LINK_DIAGONAL]
+            lk[k, LINK_W] = (lk[k, LINK_W] - lk[k, LINK_UPPER] * lk[k + 1, LINK_W]) \
+                / lk[k, LINK_DIAGONAL]
+        dx, dy, dz = lk[last, LINK_OFFSET], lk[last, LINK_OFFSET + 1], lk[last, LINK_OFFSET + 2]
+        w2, u2 = 2.0 * lk[last, LINK_W], 2.0 * lk[last, LINK_U]
+        s00 += w2 * dx * dx
+        s01 += w2 * dx * dy
+        s02 += w2 * dx * dz
+        s11 += w2 * dy * dy
+        s12 += w2 * dy * dz
+        s22 += w2 * dz * dz
+        b0 -= u2 * dx
+        b1 -= u2 * dy
+        b2 -= u2 * dz
+    # a_p = S^-1 b by the adjugate of the symmetric 3 x 3 S (gravity excluded)
+    c00 = s11 * s22 - s12 * s12
+    c01 = s02 * s12 - s01 * s22
+    c02 = s01 * s12 - s02 * s11
+    c11 = s00 * s22 - s02 * s02
+    c12 = s01 * s02 - s00 * s12
+    c22 = s00 * s11 - s01 * s01
+    inv_det = 1.0 / (s00 * c00 + s01 * c01 + s02 * c02)
+    ap_x = (c00 * b0 + c01 * b1 + c02 * b2) * inv_det
+    ap_y = (c01 * b0 + c11 * b1 + c12 * b2) * inv_det
+    ap_z = (c02 * b0 + c12 * b1 + c22 * b2) * inv_det
+    acc[p], acc[p + 1], acc[p + 2] = ap_x, ap_y, ap_z - gravity
+    for i in range(n):
+        lk = link_rows[i]
+        nd = node_rows[i]
+        last = links - 1
+        along = (lk[last, LINK_OFFSET] * ap_x + lk[last, LINK_OFFSET + 1] * ap_y
+                 + lk[last, LINK_OFFSET + 2] * ap_z)
+        for k in range(links):  # lambda_k = u_k + (d_N . a_p) w_k, into LINK_U
+            lk[k, LINK_U] += along * lk[k, LINK_W]
+        multipliers[i] = lk[0, LINK_U] / links   # T_i / (2 l_i) = 2 s_i lambda_1 / (2 l_i)
+        for j in range(links):  # node j: its free acceleration + 2 / m_j (lambda_(j+1) d_(j+1)
+            # - lambda_j d_j) - g e_z (node 0 the UAV, whose block is q's)
+            pull = 2.0 * nd[j, NODE_INV_MASS]
+            ax = nd[j, NODE_FREE] + pull * lk[j, LINK_U] * lk[j, LINK_OFFSET]
+            ay = nd[j, NODE_FREE + 1] + pull * lk[j, LINK_U] * lk[j, LINK_OFFSET + 1]
+            az = nd[j, NODE_FREE + 2] + pull * lk[j, LINK_U] * lk[j, LINK_OFFSET + 2]
+            if j > 0:
+                ax -= pull * lk[j - 1, LINK_U] * lk[j - 1, LINK_OFFSET]
+                ay -= pull * lk[j - 1, LINK_U] * lk[j - 1, LINK_OFFSET + 1]
+                az -= pull * lk[j - 1, LINK_U] * lk[j - 1, LINK_OFFSET + 2]
+            r, v = node_point(x, n, inner, i, j, p, nq)
+            if j == 0:
+                acc[r], acc[r + 1], acc[r + 2] = ax, ay, az - gravity
+                continue
+            at = r - nq   # the node's block in acc: its position's rate, then its velocity's
+            acc[at], acc[at + 1], acc[at + 2] = x[v], x[v + 1], x[v + 2]
+            acc[at + 3], acc[at + 4], acc[at + 5] = ax, ay, az - gravity
+
+
+@jit
+def chain_residuals(x, uavs, inner, g, g_dot):
+    """Each cable's worst link (the largest |g_ik|) at state x: its g_ik = |d_ik|^2 - s_i^2
+    [m^2] into g (n,) and the largest |g_dot_ik| = |2 d_ik . (v_ik - v_i(k-1))| [m^2/s], signed,
+    into g_dot (n,) (`inner` = N - 1 inner nodes per cable)."""
+    n = uavs.shape[0]
+    links = inner + 1
+    p = payload_slot(n)
+    nq = rates_slot(n)
+    for i in range(n):
+        link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)
+        worst = worst_rate = 0.0
+        for k in range(1, links + 1):
+            r0, v0 = node_point(x, n, inner, i, k - 1, p, nq)
+            r1, v1 = node_point(x, n, inner, i, k, p, nq)
+            dx, dy, dz = x[r1] - x[r0], x[r1 + 1] - x[r0 + 1], x[r1 + 2] - x[r0 + 2]
+            value = dx * dx + dy * dy + dz * dz - link_sq
+            rate = 2.0 * (dx * (x[v1] - x[v0]) + dy * (x[v1 + 1] - x[v0 + 1])
+                          + dz * (x[v1 + 2] - x[v0 + 2]))
+            if abs(value) >= abs(worst):
+                worst = value
+            if abs(rate) >= abs(worst_rate):
+                worst_rate = rate
+        g[i], g_dot[i] = worst, worst_rate

@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""Heavy cables (`cable_model: chain`, issue 32 item 4) against mechanics: a chain hanging from
+a held point swings in the continuous hanging chain's modes omega_j = (j_0,j / 2) sqrt(g / L)
+(Bessel), a chain held at both ends hangs on the catenary, a heavy payload on a light chain
+swings at the rigid pendulum's period. Prints each figure's measured value against the
+independent one for several link counts; tests/unit/test_chain_mechanics.py asserts them.
+
+Run: scripts/setup && source scripts/env.sh && python benchmarks/chain_mechanics.py
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import yaml
+from scipy.optimize import brentq
+from scipy.special import j0, jn_zeros
+
+from multilift_sim import scenario as scenario_io
+from multilift_sim.formation_params import StateLayout
+from multilift_sim.scenario.files import resolve
+from multilift_sim.simulation import FormationSimulator
+
+G = 9.81
+HELD_MASS = 1e7   # [kg]: a UAV this heavy is held (a chain's pull of a few N moves it by
+#                   < 1e-5 m over these runs)
+
+
+def held(base: str, links: int, mass_per_length: float, payload_mass: float, duration: float,
+         cable_length: float, physics_rate: float = 400.0, substeps: int = 1, **cable):
+    """`base`'s scenario on chains of `links` links, mu = mass_per_length [kg/m], each
+    cable_length [m], under UAVs of HELD_MASS, no payload drag, no gusts: (scenario,
+    simulator, rotor speeds that lift each UAV's weight and its share of the rest)."""
+    data = yaml.safe_load(resolve(base).read_text())
+    data.update(cable_model='chain', cable_length=cable_length,
+                cable={'links': links, 'mass_per_length': mass_per_length, **cable})
+    for u in data['uavs']:
+        u.pop('cable_length', None)
+    data['vehicle'].update(mass=HELD_MASS, rotor_speed_max=2000.0,
+                           thrust_coefficient=HELD_MASS * G / (4 * 1000.0 ** 2))
+    data['payload'].update(mass=payload_mass, drag_coefficient=0.0)
+    data['payload'].pop('swing_deg', None)
+    data['control'].update(mode='constant_rotor_speed', constant_rotor_speed=1000.0)
+    data['simulation'].update(duration=duration, physics_rate=physics_rate,
+                              control_rate=physics_rate / 2, substeps=substeps)
+    data.pop('gusts', None)
+    s = scenario_io.loads(yaml.safe_dump(data))
+    n = s.n_uavs
+    weight = HELD_MASS + (payload_mass + mass_per_length * cable_length * n) / n
+    speed = 1000.0 * math.sqrt(weight / HELD_MASS)
+    return s, FormationSimulator(s), [np.full(4, speed) for _ in range(n)]
+
+
+def fly(sim, speeds, each) -> None:
+    """The simulator to its end under the held rotor speeds, `each(state)` at every tick."""
+    flags = [np.zeros(4, dtype=bool) for _ in speeds]
+    while not sim.finished:
+        each(sim.state)
+        sim.advance(speeds, flags)
+
+
+def period_of(signal, rate: float) -> tuple[float, int]:
+    """The mean period [s] between upward zero crossings of a signal sampled at rate [Hz]
+    (interpolated), and how many crossings it had."""
+    q = np.asarray(signal)
+    t = np.arange(len(q)) / rate
+    up = np.flatnonzero((q[:-1] < 0.0) & (q[1:] >= 0.0))
+    crossings = t[up] + (t[up + 1] - t[up]) * -q[up] / (q[up + 1] - q[up])
+    return (crossings[-1] - crossings[0]) / (len(crossings) - 1), len(crossings)
+
+
+def hanging_mode(mode: int, links: int, length: float = 2.5,
+                 mass_per_length: float = 0.1) -> tuple[float, float]:
+    """(measured, continuous) omega of a chain's mode j [rad/s]: N links hanging from a held
+    UAV, the payload one inner node's mass (N equal masses, the last at the free end),
+    displaced 1 mm at the foot along the continuous mode's shape u(z) = J0(2 omega_j
+    sqrt(z / g)) (z the height above the foot) and swinging 8 s; omega from its modal
+    coordinate's zero crossings."""
+    node = mass_per_length * length / (links - 1)
+    s, sim, speeds = held('single_lift', links, mass_per_length, node, 8.0, length)
+    layout = StateLayout(1, chain_nodes=links - 1)
+    omega = jn_zeros(0, 3)[mode - 1] / 2 * math.sqrt(G / length)
+    x = sim.state
+    top = layout.uav_positions(x)[0]
+    nodes = np.vstack([layout.chain_positions(x)[0], layout.payload_position(x)[None]])
+    shape = j0(2 * omega * np.sqrt((nodes[:, 2] - nodes[-1, 2]) / G))
+    shape *= 1e-3 / shape[-1]
+    layout.chain_positions(x)[0, :, 0] = top[0] + shape[:-1]   # sideways (x); a 1 mm
+    layout.payload_position(x)[0] = top[0] + shape[-1]         # displacement leaves the links
+    sim.state = x                                              # at 1e-7 of their length^2
+    modal = []
+    fly(sim, speeds, lambda state: modal.append(float((np.append(
+        layout.chain_positions(state)[0, :, 0], layout.payload_position(state)[0])
+        - top[0]) @ shape)))
+    period, _ = period_of(modal, s.simulation.control_rate)
+    return 2 * math.pi / period, omega
+
+
+def catenary(links: int, length: float = 3.0, mass_per_length: float = 0.1,
+             duration: float = 20.0) -> tuple[float, float, float]:
+    """(measured, catenary, straight) depth [m] of the lowest point below two held UAVs
+    (twin_lift's places, 4 m apart), each cable `length` of N links, the payload one node's
+    mass (one chain of 2 l and 2 N links of equal masses), damped by the air (C_d 1.2 on
+    2 cm nodes): the mean of the last 2 s of `duration`; the catenary's sag a (cosh(D / 2a)
+    - 1) with 2 a sinh(D / 2a) = 2 l, D the UAVs' distance; the rigid V's depth."""
+    node = mass_per_length * length / (links - 1)
+    s, sim, speeds = held('twin_lift', links, mass_per_length, node, duration, length,
+                          drag_coefficient=1.2, diameter=0.02)
+    layout = StateLayout(2, chain_nodes=links - 1)
+    depths = []
+    fly(sim, speeds, lambda state: depths.append(float(
+        layout.uav_positions(state)[:, 2].mean() - layout.payload_position(state)[2])))
+    uavs = layout.uav_positions(sim.state)
+    span = float(np.linalg.norm(uavs[0] - uavs[1]))
+    a = brentq(lambda a: 2 * a * math.sinh(span / (2 * a)) - 2 * length, 0.05, 100.0)
+    settled = float(np.mean(depths[-int(2 * s.simulation.control_rate):]))
+    return settled, a * (math.cosh(span / (2 * a)) - 1.0), math.sqrt(length ** 2
+                                                                       - (span / 2) ** 2)
+
+
+def pendulum(links: int = 10, payload_mass: float = 5.0, mass_per_length: float = 0.01,
+             length: float = 2.5, degrees: float = 3.0) -> tuple[float, float, int]:
+    """(measured, rigid pendulum's) period [s] and the crossings counted: a payload of
+    payload_mass on a light chain (mu l = 25 g) under a held UAV, released `degrees` from
+    hanging with the chain straight, 20 s; the rigid pendulum's 2 pi sqrt(l / g)
+    (1 + theta_0^2 / 16)."""
+    theta = math.radians(degrees)
+    s, sim, speeds = held('single_lift', links, mass_per_length, payload_mass, 20.0, length,
+                          substeps=3)
+    layout = StateLayout(1, chain_nodes=links - 1)
+    x = sim.state
+    top = layout.uav_positions(x)[0]
+    offset = length * np.array([math.sin(theta), 0.0, -math.cos(theta)])
+    layout.chain_positions(x)[0] = top + (np.arange(1, links) / links)[:, None] * offset
+    layout.payload_position(x)[:] = top + offset
+    sim.state = x
+    swing = []
+    fly(sim, speeds, lambda state: swing.append(layout.payload_position(state)[0] - top[0]))
+    period, count = period_of(swing, s.simulation.control_rate)
+    return period, 2 * math.pi * math.sqrt(length / G) * (1 + theta ** 2 / 16), count
+
+
+def main() -> None:
+    print('hanging chain, L = 2.5 m, mu = 0.1 kg/m: omega measured / continuous - 1')
+    for links in (10, 25, 40):
+        errors = [m / c - 1 for m, c in (hanging_mode(j, links) for j in (1, 2, 3))]
+        print(f'  N = {links:3d}: ' + ', '.join(f'mode {j + 1} {e:+.4f}'
+                                                for j, e in enumerate(errors)))
+    print('chain held at both ends (D = 4 m, 2 x 3 m): depth measured / catenary - 1')
+    for links in (10, 20):
+        measured, sag, straight = catenary(links)
+        print(f'  N = {links:3d} a cable: {measured:.4f} m against {sag:.4f} m '
+              f'({measured / sag - 1:+.4f}; the rigid V {straight:.4f} m)')
+    period, expected, count = pendulum()
+    print(f'heavy payload (5 kg on 25 g of chain, 10 links): period {period:.5f} s against '
+          f'{expected:.5f} s ({period / expected - 1:+.2e}, {count} crossings)')
+
+
+if __name__ == '__main__':
+    main()

@@ -1,7 +1,7 @@
 """Heavy cables (`cable_model: chain`, issue 32 item 2): each cable a chain of N rigid links
 between its UAV's centre (node 0) and the point payload (node N), with N - 1 point masses
 between them (node k of cable i, its state at `chain_node_slot(n, N - 1, i, k)`). World frame
-(z up), SI units; slots: `physics.layout` (NODE_*, UAV_NODE_MASS, UAV_NODE_DRAG,
+(z up), SI units; slots: `physics.layout` (NODE_*, CHAIN_*, UAV_NODE_MASS, UAV_NODE_DRAG,
 FORMATION_CHAIN_LINKS). docs/cables.md, "Heavy cables".
 
 The seed's cable constraint (Eq. 2.42) per link: g_ik = |d_ik|^2 - s_i^2 = 0, d_ik = r_ik -
@@ -32,7 +32,11 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.free_motion import air_velocity, payload_motion, uav_free_motion
-from multilift_sim.physics.layout import (FORMATION_BETA_SQ, FORMATION_CHAIN_LINKS,
+from multilift_sim.physics.layout import (CHAIN_LINK_COLUMNS, CHAIN_LINK_DIAGONAL,
+                                          CHAIN_LINK_OFFSET, CHAIN_LINK_U, CHAIN_LINK_UPPER,
+                                          CHAIN_LINK_W, CHAIN_NODE_COLUMNS, CHAIN_NODE_FREE,
+                                          CHAIN_NODE_INV_MASS, FORMATION_BETA_SQ,
+                                          FORMATION_CHAIN_LINKS,
                                           FORMATION_GRAVITY, FORMATION_PAYLOAD_MASS,
                                           FORMATION_TWO_ALPHA, FORMATION_WIND, NODE_POSITION,
                                           NODE_VELOCITY, POSITION, UAV_LENGTH_SQ, UAV_MASS,
@@ -40,18 +44,17 @@ from multilift_sim.physics.layout import (FORMATION_BETA_SQ, FORMATION_CHAIN_LIN
 from multilift_sim.physics.state_slots import (chain_node_slot, payload_slot, rates_slot,
                                                uav_slot)
 
-# a link's scratch row (per cable, per link k = 1 .. N at row k - 1)
-LINK_OFFSET = 0       # d_k = r_k - r_(k-1) [m] (3)
-LINK_DIAGONAL = 3     # A's diagonal, then the eliminated one
-LINK_UPPER = 4        # A[k, k + 1]
-LINK_U = 5            # the right-hand side, then u
-LINK_W = 6            # e_N, then w
-LINK_COLUMNS = 7
-# a node's scratch row (per cable, node j = 0 .. N - 1): its acceleration without the links
-# [m/s^2], gravity excluded (3), and 1 / its mass [1/kg]
-NODE_FREE = 0
-NODE_INV_MASS = 3
-NODE_COLUMNS = 4
+
+@jit
+def put3(row, at, a, b, c):
+    """row[at:at + 3] = (a, b, c)."""
+    row[at], row[at + 1], row[at + 2] = a, b, c
+
+
+@jit
+def get3(row, at):
+    """row[at:at + 3] as three floats."""
+    return row[at], row[at + 1], row[at + 2]
 
 
 @jit
@@ -85,8 +88,8 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
     gravity = formation[FORMATION_GRAVITY]
     wind_x, wind_y, wind_z = (formation[FORMATION_WIND], formation[FORMATION_WIND + 1],
                               formation[FORMATION_WIND + 2])
-    link_rows = np.empty((n, links, LINK_COLUMNS))
-    node_rows = np.empty((n, links, NODE_COLUMNS))
+    link_rows = np.empty((n, links, CHAIN_LINK_COLUMNS))
+    node_rows = np.empty((n, links, CHAIN_NODE_COLUMNS))
     payload_mass = formation[FORMATION_PAYLOAD_MASS]
     # the Schur complement S a_p = rhs on the payload's acceleration (gravity excluded)
     s00 = s11 = s22 = payload_mass
@@ -96,13 +99,12 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         lk = link_rows[i]
         nd = node_rows[i]
         thrust_ax, thrust_ay, thrust_az = uav_free_motion(x, i, wrenches, uavs, formation, acc)
-        nd[0, NODE_FREE], nd[0, NODE_FREE + 1], nd[0, NODE_FREE + 2] = (thrust_ax, thrust_ay,
-                                                                          thrust_az)
-        nd[0, NODE_INV_MASS] = 1.0 / uavs[i, UAV_MASS]
+        put3(nd[0], CHAIN_NODE_FREE, thrust_ax, thrust_ay, thrust_az)
+        nd[0, CHAIN_NODE_INV_MASS] = 1.0 / uavs[i, UAV_MASS]
         node_mass, node_drag_c = uavs[i, UAV_NODE_MASS], uavs[i, UAV_NODE_DRAG]
         for k in range(1, links):  # the inner nodes: their drag in the air
             r, v = node_point(x, n, inner, i, k, p, nq)
-            nd[k, NODE_INV_MASS] = 1.0 / node_mass
+            nd[k, CHAIN_NODE_INV_MASS] = 1.0 / node_mass
             fx = fy = fz = 0.0
             if node_drag_c > 0.0:  # -c |v_rel| v_rel / m, v_rel against the wind and gusts
                 air_x, air_y, air_z = air_velocity(x[r], x[r + 1], gusts)
@@ -112,7 +114,7 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                 scale = -node_drag_c / node_mass * math.sqrt(rel_x * rel_x + rel_y * rel_y
                                                              + rel_z * rel_z)
                 fx, fy, fz = scale * rel_x, scale * rel_y, scale * rel_z
-            nd[k, NODE_FREE], nd[k, NODE_FREE + 1], nd[k, NODE_FREE + 2] = fx, fy, fz
+            put3(nd[k], CHAIN_NODE_FREE, fx, fy, fz)
         link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)   # s_i^2
         for k in range(1, links + 1):  # link k's row: d_k, A's entries, its right-hand side
             r0, v0 = node_point(x, n, inner, i, k - 1, p, nq)
@@ -120,45 +122,46 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
             dx, dy, dz = x[r1] - x[r0], x[r1 + 1] - x[r0 + 1], x[r1 + 2] - x[r0 + 2]
             dvx, dvy, dvz = x[v1] - x[v0], x[v1 + 1] - x[v0 + 1], x[v1 + 2] - x[v0 + 2]
             row = lk[k - 1]
-            row[LINK_OFFSET], row[LINK_OFFSET + 1], row[LINK_OFFSET + 2] = dx, dy, dz
+            put3(row, CHAIN_LINK_OFFSET, dx, dy, dz)
             offset_sq = dx * dx + dy * dy + dz * dz
-            upper_inv = nd[k - 1, NODE_INV_MASS]
-            lower_inv = nd[k, NODE_INV_MASS] if k < links else 0.0
-            row[LINK_DIAGONAL] = 2.0 * offset_sq * (upper_inv + lower_inv)
+            upper_inv = nd[k - 1, CHAIN_NODE_INV_MASS]
+            lower_inv = nd[k, CHAIN_NODE_INV_MASS] if k < links else 0.0
+            row[CHAIN_LINK_DIAGONAL] = 2.0 * offset_sq * (upper_inv + lower_inv)
             # d_k . (a_k - a_(k-1)) = -|dv_k|^2 - alpha_f g_dot_k - beta_f^2 g_k / 2 (Eq. 2.59)
             target = (-(dvx * dvx + dvy * dvy + dvz * dvz)
                       - two_alpha * (dx * dvx + dy * dvy + dz * dvz)
                       - 0.5 * beta_sq * (offset_sq - link_sq))
-            free_x, free_y, free_z = (-nd[k - 1, NODE_FREE], -nd[k - 1, NODE_FREE + 1],
-                                      -nd[k - 1, NODE_FREE + 2])
+            free_x, free_y, free_z = (-nd[k - 1, CHAIN_NODE_FREE], -nd[k - 1, CHAIN_NODE_FREE + 1],
+                                      -nd[k - 1, CHAIN_NODE_FREE + 2])
             if k < links:
-                free_x += nd[k, NODE_FREE]
-                free_y += nd[k, NODE_FREE + 1]
-                free_z += nd[k, NODE_FREE + 2]
-            row[LINK_U] = dx * free_x + dy * free_y + dz * free_z - target
-            row[LINK_W] = 1.0 if k == links else 0.0
+                free_x += nd[k, CHAIN_NODE_FREE]
+                free_y += nd[k, CHAIN_NODE_FREE + 1]
+                free_z += nd[k, CHAIN_NODE_FREE + 2]
+            row[CHAIN_LINK_U] = dx * free_x + dy * free_y + dz * free_z - target
+            row[CHAIN_LINK_W] = 1.0 if k == links else 0.0
             if k > 1:  # A[k - 1, k] = -2 d_(k-1) . d_k / m_(k-1), their shared node's
                 above = lk[k - 2]
-                above[LINK_UPPER] = -2.0 * upper_inv * (
-                    above[LINK_OFFSET] * dx + above[LINK_OFFSET + 1] * dy
-                    + above[LINK_OFFSET + 2] * dz)
-        lk[links - 1, LINK_UPPER] = 0.0
+                above[CHAIN_LINK_UPPER] = -2.0 * upper_inv * (
+                    above[CHAIN_LINK_OFFSET] * dx + above[CHAIN_LINK_OFFSET + 1] * dy
+                    + above[CHAIN_LINK_OFFSET + 2] * dz)
+        lk[links - 1, CHAIN_LINK_UPPER] = 0.0
         # Thomas' algorithm on A (symmetric positive definite), two right-hand sides
         for k in range(1, links):
-            factor = lk[k - 1, LINK_UPPER] / lk[k - 1, LINK_DIAGONAL]
-            lk[k, LINK_DIAGONAL] -= factor * lk[k - 1, LINK_UPPER]
-            lk[k, LINK_U] -= factor * lk[k - 1, LINK_U]
-            lk[k, LINK_W] -= factor * lk[k - 1, LINK_W]
+            factor = lk[k - 1, CHAIN_LINK_UPPER] / lk[k - 1, CHAIN_LINK_DIAGONAL]
+            lk[k, CHAIN_LINK_DIAGONAL] -= factor * lk[k - 1, CHAIN_LINK_UPPER]
+            lk[k, CHAIN_LINK_U] -= factor * lk[k - 1, CHAIN_LINK_U]
+            lk[k, CHAIN_LINK_W] -= factor * lk[k - 1, CHAIN_LINK_W]
         last = links - 1
-        lk[last, LINK_U] /= lk[last, LINK_DIAGONAL]
-        lk[last, LINK_W] /= lk[last, LINK_DIAGONAL]
+        lk[last, CHAIN_LINK_U] /= lk[last, CHAIN_LINK_DIAGONAL]
+        lk[last, CHAIN_LINK_W] /= lk[last, CHAIN_LINK_DIAGONAL]
         for k in range(links - 2, -1, -1):
-            lk[k, LINK_U] = (lk[k, LINK_U] - lk[k, LINK_UPPER] * lk[k + 1, LINK_U]) \
-                / lk[k, LINK_DIAGONAL]
-            lk[k, LINK_W] = (lk[k, LINK_W] - lk[k, LINK_UPPER] * lk[k + 1, LINK_W]) \
-                / lk[k, LINK_DIAGONAL]
-        dx, dy, dz = lk[last, LINK_OFFSET], lk[last, LINK_OFFSET + 1], lk[last, LINK_OFFSET + 2]
-        w2, u2 = 2.0 * lk[last, LINK_W], 2.0 * lk[last, LINK_U]
+            row, below = lk[k], lk[k + 1]
+            row[CHAIN_LINK_U] = (row[CHAIN_LINK_U] - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_U]) \
+                / row[CHAIN_LINK_DIAGONAL]
+            row[CHAIN_LINK_W] = (row[CHAIN_LINK_W] - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_W]) \
+                / row[CHAIN_LINK_DIAGONAL]
+        dx, dy, dz = get3(lk[last], CHAIN_LINK_OFFSET)
+        w2, u2 = 2.0 * lk[last, CHAIN_LINK_W], 2.0 * lk[last, CHAIN_LINK_U]
         s00 += w2 * dx * dx
         s01 += w2 * dx * dy
         s02 += w2 * dx * dz
@@ -184,21 +187,22 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         lk = link_rows[i]
         nd = node_rows[i]
         last = links - 1
-        along = (lk[last, LINK_OFFSET] * ap_x + lk[last, LINK_OFFSET + 1] * ap_y
-                 + lk[last, LINK_OFFSET + 2] * ap_z)
-        for k in range(links):  # lambda_k = u_k + (d_N . a_p) w_k, into LINK_U
-            lk[k, LINK_U] += along * lk[k, LINK_W]
-        multipliers[i] = lk[0, LINK_U] / links   # T_i / (2 l_i) = 2 s_i lambda_1 / (2 l_i)
+        along = (lk[last, CHAIN_LINK_OFFSET] * ap_x + lk[last, CHAIN_LINK_OFFSET + 1] * ap_y
+                 + lk[last, CHAIN_LINK_OFFSET + 2] * ap_z)
+        for k in range(links):  # lambda_k = u_k + (d_N . a_p) w_k, into CHAIN_LINK_U
+            lk[k, CHAIN_LINK_U] += along * lk[k, CHAIN_LINK_W]
+        multipliers[i] = lk[0, CHAIN_LINK_U] / links   # T_i / (2 l_i) = 2 s_i lambda_1 / (2 l_i)
         for j in range(links):  # node j: its free acceleration + 2 / m_j (lambda_(j+1) d_(j+1)
             # - lambda_j d_j) - g e_z (node 0 the UAV, whose block is q's)
-            pull = 2.0 * nd[j, NODE_INV_MASS]
-            ax = nd[j, NODE_FREE] + pull * lk[j, LINK_U] * lk[j, LINK_OFFSET]
-            ay = nd[j, NODE_FREE + 1] + pull * lk[j, LINK_U] * lk[j, LINK_OFFSET + 1]
-            az = nd[j, NODE_FREE + 2] + pull * lk[j, LINK_U] * lk[j, LINK_OFFSET + 2]
+            pull = 2.0 * nd[j, CHAIN_NODE_INV_MASS]
+            below_x, below_y, below_z = get3(lk[j], CHAIN_LINK_OFFSET)
+            ax, ay, az = get3(nd[j], CHAIN_NODE_FREE)
+            lam = pull * lk[j, CHAIN_LINK_U]
+            ax, ay, az = ax + lam * below_x, ay + lam * below_y, az + lam * below_z
             if j > 0:
-                ax -= pull * lk[j - 1, LINK_U] * lk[j - 1, LINK_OFFSET]
-                ay -= pull * lk[j - 1, LINK_U] * lk[j - 1, LINK_OFFSET + 1]
-                az -= pull * lk[j - 1, LINK_U] * lk[j - 1, LINK_OFFSET + 2]
+                above_x, above_y, above_z = get3(lk[j - 1], CHAIN_LINK_OFFSET)
+                lam = pull * lk[j - 1, CHAIN_LINK_U]
+                ax, ay, az = ax - lam * above_x, ay - lam * above_y, az - lam * above_z
             r, v = node_point(x, n, inner, i, j, p, nq)
             if j == 0:
                 acc[r], acc[r + 1], acc[r + 2] = ax, ay, az - gravity

@@ -235,6 +235,19 @@ CABLE_PAYLOAD_MOMENT = 11   # c_i = b_i x R_p^T d_i [m^2], a rigid payload's fra
 #                             arm there (3; physics.rigid_payload)
 CABLE_COLUMNS = 14
 
+# -- a chain's solve scratch (`cable_model: chain`, physics.chain_cables): per cable, a row a
+# link k = 1 .. N (at k - 1) and a row a node j = 0 .. N - 1 (node 0 the UAV) ----------------
+CHAIN_LINK_OFFSET = 0       # d_k = r_k - r_(k-1) [m] (3 slots)
+CHAIN_LINK_DIAGONAL = 3     # the links' matrix A's diagonal entry, then the eliminated one
+CHAIN_LINK_UPPER = 4        # A[k, k + 1]
+CHAIN_LINK_U = 5            # the right-hand side, then u = A^-1 of it, then lambda_k [N/m]
+CHAIN_LINK_W = 6            # e_N, then w = A^-1 e_N
+CHAIN_LINK_COLUMNS = 7
+CHAIN_NODE_FREE = 0         # the node's acceleration without the links [m/s^2], gravity
+#                             excluded (3 slots)
+CHAIN_NODE_INV_MASS = 3     # 1 / its mass [1/kg]
+CHAIN_NODE_COLUMNS = 4
+
 # -- an RK4 step's scratch (rows of a (WORK_ROWS, len(x)) array) ---------------------------
 WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives (consecutive rows)
 WORK_STAGE = 4              # the stage's state

@@ -21,9 +21,11 @@ from multilift_control.cascade import ControlOutput, FormationStates, UavState
 from multilift_control.controllers import FollowerController, LeaderController
 from multilift_control.faults import FaultReallocation
 from multilift_control.laws.follower import lift_vectors
+from multilift_control.laws.links import heard_formation
 from multilift_control.laws.layout import UAV_BODY_RATES, UAV_EULER, UAV_POSITION, UAV_VELOCITY
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.mission import Reference
+from multilift_sim.links.radio import link_arrays
 from multilift_sim.scenario import Scenario
 from multilift_sim.simulation import FormationSimulator, Snapshot
 from multilift_sim.statistics import FormationErrorStatistics, TrackingStatistics
@@ -108,6 +110,12 @@ class ControllerRuntime:
             self.follower = FollowerController(scenario, index)
             self.thrusts = ThrustBook(scenario) if thrusts is None else thrusts
             self.statistics = FormationErrorStatistics()
+            # its link from the leader (`comms:`; None: it hears at once)
+            link, delivered, memory = link_arrays(scenario.comms, scenario.n_uavs,
+                                                  scenario.simulation.tick_count)
+            self._link = (link, delivered[index], memory[index]) if link.shape[0] else None
+            self._heard_formation = laws.runnable(heard_formation)
+            self._lift_vectors = laws.runnable(lift_vectors)
         else:
             self.leader = LeaderController(scenario, index)
             self.statistics = TrackingStatistics()
@@ -138,11 +146,22 @@ class ControllerRuntime:
             if reference is not None:
                 self.statistics.add(reference.position, states[0].position)
             return ControllerAnswer(0, t_ns, output, reference=reference)
-        output, errors, rates = self.follower.update(t, states,
-                                                     self.thrusts.vectors(t_ns, states))
+        vectors = self.thrusts.vectors(t_ns, states)
+        if self._link is not None:  # the leader as its link delivered it (laws.links)
+            states, vectors = self._heard(t_ns // self._period_ns, states)
+        output, errors, rates = self.follower.update(t, states, vectors)
         self.statistics.add(errors)
         return ControllerAnswer(self.index, t_ns, output, formation_error=errors,
                                 formation_error_rate=rates)
+
+    def _heard(self, tick: int, states: Sequence[UavState]) -> tuple[np.ndarray, np.ndarray]:
+        """(the states (n, UAV_STATE_SIZE), the lifts (n, 3) [N]) as this follower hears them
+        at `tick` over its link (`laws.links.heard_formation`), the book's thrusts at it."""
+        array = FormationStates.of(states).array
+        heard, heard_thrusts = np.empty_like(array), np.empty(array.shape[0])
+        self._heard_formation(*self._link, tick, self.index,
+                              array, self.thrusts.thrusts, heard, heard_thrusts)
+        return heard, self._lift_vectors(heard, heard_thrusts)
 
     def summary(self) -> dict:
         """This controller's run statistics (`multilift_sim.statistics`)."""

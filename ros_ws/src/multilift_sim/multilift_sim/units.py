@@ -15,6 +15,7 @@ from __future__ import annotations
 import re
 
 from multilift_sim.estimators import ESTIMATORS
+from multilift_sim.links.radio import UNITS as LINK_UNITS
 from multilift_sim.sensors import COMMON_KEYS, SENSOR_MODELS, key_units
 from multilift_sim.wind import WIND_MODELS
 
@@ -126,6 +127,7 @@ SCENARIO_UNITS: dict[str, str] = {
     'events[].time': 's', 'events[].type': NO_UNIT, 'events[].uav': NO_UNIT,
     'events[].rotor': NO_UNIT, 'events[].effectiveness': NO_UNIT, 'events[].duration': 's',
     'events[].velocity': 'm/s', 'events[].rate': 'm/s',
+    **LINK_UNITS,
 }
 
 UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS,

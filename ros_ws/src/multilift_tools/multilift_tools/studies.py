@@ -31,8 +31,8 @@ from multilift_sim.nullspace import NullSpaceModel
 from multilift_sim.scenario import Scenario, ScenarioError, load
 from multilift_sim.start import initial_state
 
-STUDIES = ('baumgarte', 'swing_feedback', 'load_sharing')  # multilift_tools.swing_study,
-#                                                            .load_study
+# multilift_tools.swing_study, .load_study, .comms_study
+STUDIES = ('baumgarte', 'swing_feedback', 'load_sharing', 'comms')
 DEFAULT_DURATION = 60.0   # [s] the drift of alpha_f = 0 needs time to show (Fig. 4.2)
 DEFAULT_STEP = 0.01       # [s] RK4 step; see baumgarte_study
 RESIDUAL_FLOOR = 1e-18    # [m^2] |g| below this is drawn at this value on the log axis
@@ -241,7 +241,8 @@ class _Parser(argparse.ArgumentParser):
 def study_main(argv: list[str] | None = None) -> int:
     """`multilift study NAME [--out DIR] [--duration S] [--dt S] [--scenario S]` (argv without
     the word 'study'). NAME: baumgarte, swing_feedback (multilift_tools.swing_study) or
-    load_sharing (multilift_tools.load_study; both take --out only). Prints the table and
+    load_sharing (multilift_tools.load_study) or comms (multilift_tools.comms_study; these
+    take --out only). Prints the table and
     writes the files to DIR (default runs/study).
     Exit 0, or 2 with one line on stderr for bad input."""
     parser = _Parser(prog='multilift study', description='numerical studies (seed Ch. 4)')
@@ -261,6 +262,9 @@ def study_main(argv: list[str] | None = None) -> int:
         elif args.study == 'load_sharing':
             from multilift_tools.load_study import load_sharing_study
             result = load_sharing_study(args.out)
+        elif args.study == 'comms':
+            from multilift_tools.comms_study import comms_study
+            result = comms_study(args.out)
         else:
             result = baumgarte_study(args.out, duration=args.duration, dt=args.dt,
                                      scenario=args.scenario)

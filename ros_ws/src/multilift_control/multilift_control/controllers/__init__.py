@@ -210,14 +210,16 @@ class FollowerController:
     def update(self, t: float, states: Sequence, thrust_vectors: np.ndarray
                ) -> tuple[ControlOutput, np.ndarray, np.ndarray]:
         """(the answer at t [s], its rows of g_vc [m or m^2], their rates) to every UAV's
-        states and lifts thrust_vectors (n, 3), world [N]."""
+        states (UavStates, or the laws' (n, UAV_STATE_SIZE) array) and lifts thrust_vectors
+        (n, 3), world [N]."""
         c = self.cascade
         rotors = c.mixer.rows.shape[0]
         speeds, saturated = np.zeros(rotors), np.zeros(rotors, dtype=bool)
         setpoint = np.zeros(3)
         errors, rates = np.full(self.own_rows, math.nan), np.full(self.own_rows, math.nan)
         thrust = self._answer(self.law, self.index, self.constants, self.memory, c.constants,
-                              c.mixer.rows, float(t), FormationStates.of(states).array,
+                              c.mixer.rows, float(t), states if isinstance(states, np.ndarray)
+                              else FormationStates.of(states).array,
                               np.asarray(thrust_vectors, dtype=float), self.masses,
                               self.constraints.rows, self.constraints.targets, self.law_p,
                               self.law_q, speeds, saturated, setpoint, errors, rates)

@@ -24,6 +24,7 @@ from multilift_control.faults import fault_mixers, mixer_uavs, target_schedule
 from multilift_control.laws.layout import MIXER_SIZE, REFERENCE_SIZE, ROW_SIZE, UAV_STATE_SIZE
 from multilift_control.runtime import ThrustBook
 from multilift_sim.estimators.published import ESTIMATE_COLUMNS
+from multilift_sim.links.radio import link_arrays
 from multilift_sim.physics.layout import (STATUS_FINISHED, STATUS_NOT_FINITE,
                                           STATUS_OFF_CONSTRAINT, STATUS_OFF_RATE, STATUS_RUNNING)
 from multilift_sim.scenario import Scenario
@@ -66,6 +67,10 @@ class ControlArrays(NamedTuple):
     law_q: np.ndarray             # (B, n, 3, 3n): its second (linear VC: Q)
     own_rows: np.ndarray          # (B, n) int: how many rows of g_vc involve UAV i
     thrust_coefficients: np.ndarray  # (B, n) [N s^2/rad^2]
+    # the followers' links from the leader (`comms:`, multilift_sim.links.radio): (B, 0) and
+    # (B, n, 0) without
+    link: np.ndarray              # (B, LINK_COLUMNS)
+    link_delivered: np.ndarray    # (B, n, ticks + 1): 1.0 where follower i gets that packet
 
 
 class ControlMemory(NamedTuple):
@@ -78,6 +83,7 @@ class ControlMemory(NamedTuple):
     thrusts: np.ndarray           # (B, n): the thrust book u_T,j [N]
     tracking: np.ndarray          # (B, TRACKING_SIZE): the leader's tracking error
     formation_errors: np.ndarray  # (B, n, FORMATION_SIZE): each follower's (row 0 unused)
+    link_memory: np.ndarray       # (B, n, M): each follower's link (row 0 unused)
 
 
 def _joined(name: str, *parts: type) -> type:
@@ -150,7 +156,9 @@ def formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         if p is not None:  # a part without matrices leaves them zeros
             law_p[i], law_q[i] = p, q
         own_rows[i] = len(constraints.rows_of(i))
+    link, delivered, link_memory = link_arrays(scenario.comms, n, scenario.simulation.tick_count)
     arrays.update(
+        link=link, link_delivered=delivered,
         rotor_counts=counts, controlled=scenario.controlled,
         cascade=np.stack([c.constants for c in cascades]),
         fault_mixers=fault_mixers(scenario), mixer_uavs=mixer_uavs(scenario),
@@ -170,7 +178,8 @@ def formation_fields(scenario: Scenario) -> tuple[dict, dict]:
         leader_memory=leader_memory, follower_memory=follower_memory,
         thrusts=np.array(ThrustBook(scenario).thrusts, dtype=float),
         tracking=TrackingStatistics().acc,
-        formation_errors=np.stack([FormationErrorStatistics().acc for _ in range(n)]))
+        formation_errors=np.stack([FormationErrorStatistics().acc for _ in range(n)]),
+        link_memory=link_memory)
     return arrays, memory
 
 

@@ -17,6 +17,7 @@ from multilift_control.engine.arrays import RUNNING
 from multilift_control.laws import jit
 from multilift_control.laws.cascade import attitude_command
 from multilift_control.laws.follower import lift_vectors
+from multilift_control.laws.links import heard_formation
 from multilift_control.laws.layout import REFERENCE_POSITION, REFERENCE_SIZE, UAV_POSITION
 from multilift_control.laws.mixer import collective_thrust
 from multilift_control.laws.reference import mission_reference
@@ -35,6 +36,7 @@ PHYSICS_MEMORY_FIELDS = len(PhysicsMemory._fields)
 # rebound when a registry changes (controllers.compiled.refresh)
 leader_answer = controllers.dispatchers().leader_answer
 followers_answer = controllers.dispatchers().followers_answer
+follower_answer = controllers.dispatchers().follower_answer
 
 
 @jit(inline=True)
@@ -71,11 +73,24 @@ def answer_formation(a, m, b, t, states, speeds, saturated, setpoints, thrust, r
                      states[0, UAV_POSITION:UAV_POSITION + 3])
     thrusts = m.thrusts[b]
     thrusts[0] = collective_thrust(a.thrust_coefficients[b, 0], speeds[0])
-    vectors = lift_vectors(states, thrusts)
-    followers_answer(a.follower_law[b], a.follower[b], m.follower_memory[b], a.cascade[b],
-                     m.mixers[b], a.rotor_counts[b], a.own_rows[b], t, states, vectors,
-                     a.masses[b], a.rows[b], m.targets[b], a.law_p[b], a.law_q[b], speeds,
-                     saturated, setpoints, thrust, errors, rates)
+    if a.link.shape[1]:  # each follower on what it hears of the leader (`comms:`)
+        heard, heard_thrusts = np.empty_like(states), np.empty(n)
+        for i in range(1, n):
+            heard_formation(a.link[b], a.link_delivered[b, i], m.link_memory[b, i], m.tick[b],
+                            i, states, thrusts, heard, heard_thrusts)
+            count, rows_i = a.rotor_counts[b, i], a.own_rows[b, i]
+            thrust[i] = follower_answer(
+                a.follower_law[b], i, a.follower[b, i], m.follower_memory[b, i],
+                a.cascade[b, i], m.mixers[b, i, :count], t, heard,
+                lift_vectors(heard, heard_thrusts), a.masses[b], a.rows[b], m.targets[b],
+                a.law_p[b, i], a.law_q[b, i], speeds[i, :count], saturated[i, :count],
+                setpoints[i], errors[i, :rows_i], rates[i, :rows_i])
+    else:
+        followers_answer(a.follower_law[b], a.follower[b], m.follower_memory[b], a.cascade[b],
+                         m.mixers[b], a.rotor_counts[b], a.own_rows[b], t, states,
+                         lift_vectors(states, thrusts), a.masses[b], a.rows[b], m.targets[b],
+                         a.law_p[b], a.law_q[b], speeds, saturated, setpoints, thrust, errors,
+                         rates)
     for i in range(1, n):
         formation_error_add(m.formation_errors[b, i], errors[i, :a.own_rows[b, i]])
         thrusts[i] = collective_thrust(a.thrust_coefficients[b, i], speeds[i])

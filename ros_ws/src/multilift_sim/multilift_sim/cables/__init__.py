@@ -9,6 +9,7 @@ A cable model's module declares:
 - `KEEPS_LENGTH`: whether the cable is the seed's constraint g_i = 0 (Eq. 2.42), so that
   Algorithm 1's check of g and g_dot applies and the start hangs at the rest lengths;
 - `SLACKENS`: whether a cable may go slack and snap taut (physics.slack_cables' taut set);
+- `REELS`: whether a winch may reel it (`uavs[i].winch`: cables.winch, physics.winch);
 - `parse_cable(top) -> base` (the scenario's `cable:` section, a `reading.Section`; kept as
   `Scenario.cable`) and `parse_uav_cable(u, length, base) -> (k [N/m], c [N s/m])`
   (`uavs[i].cable:` over it);
@@ -24,6 +25,7 @@ from multilift_sim.registry import Registry
 
 CABLE_MODELS = Registry(
     'cable model', ('NAME', 'NEEDS', 'RELEASE_LIMIT_DEG', 'KEEPS_LENGTH', 'SLACKENS',
-                    'parse_cable', 'parse_uav_cable', 'check'), (rigid, slack, elastic, chain))
+                    'REELS', 'parse_cable', 'parse_uav_cable', 'check'),
+    (rigid, slack, elastic, chain))
 register, unregister, registered = (CABLE_MODELS.register, CABLE_MODELS.unregister,
                                     CABLE_MODELS.registered)

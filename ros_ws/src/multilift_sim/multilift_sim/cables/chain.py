@@ -20,6 +20,7 @@ NEEDS = frozenset({'chain'})
 RELEASE_LIMIT_DEG = 90.0
 KEEPS_LENGTH = True   # each link is the seed's constraint (per link); the start hangs at l_i
 SLACKENS = False      # (a chain folds by itself: its links keep their lengths)
+REELS = False         # a winch on a chain (its links' lengths reeled): not modelled
 
 CHAIN_KEYS = ('links', 'mass_per_length', 'drag_coefficient', 'diameter')
 AIR_DENSITY = 1.225   # rho [kg/m^3], the ISA's at sea level
@@ -52,7 +53,7 @@ def drag_per_length(keys: dict[str, Any]) -> float:
 
 
 def check(scenario: Any) -> str | None:
-    """A point payload on cables from the UAVs' centres, no UAV prescribed, no winch, the
+    """A point payload on cables from the UAVs' centres, no UAV prescribed (no winch: REELS), the
     chains' transverse waves stepped at omega h <= ELASTIC_OMEGA_H (`chain_stepping`)."""
     if scenario.payload.type != 'point' or any(any(u.attach_point) for u in scenario.uavs):
         return 'cable_model: chain is for a point payload on cables from the UAVs\' centres'

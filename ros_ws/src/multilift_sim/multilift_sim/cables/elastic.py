@@ -15,6 +15,7 @@ NEEDS = frozenset({'elastic'})
 RELEASE_LIMIT_DEG = 90.0
 KEEPS_LENGTH = False  # a rope stretches: no constraint g_i = 0, no check of it
 SLACKENS = False      # (a rope shorter than its rest length pulls nothing: its tension law)
+REELS = True         # its rest length (physics.winch)
 
 ROPE_KEYS = ('stiffness', 'axial_stiffness', 'damping')
 # the largest omega h [-] an elastic formation is stepped at (omega its fastest mode's bound,

@@ -10,6 +10,7 @@ NEEDS: frozenset[str] = frozenset()
 RELEASE_LIMIT_DEG = 90.0
 KEEPS_LENGTH = True
 SLACKENS = False
+REELS = True
 
 
 def parse_cable(top: Any) -> None:

@@ -10,3 +10,4 @@ NEEDS = frozenset({'slack'})
 RELEASE_LIMIT_DEG = 180.0  # the payload may start above its UAV: it falls and snaps taut
 KEEPS_LENGTH = True
 SLACKENS = True
+REELS = False  # a reeled cable that snaps taut: not modelled

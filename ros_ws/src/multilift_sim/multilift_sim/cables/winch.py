@@ -40,13 +40,15 @@ def parse_winch(u: Any, length: float) -> Winch | None:
 
 
 def check(scenario: Any) -> str | None:
-    """What winches cannot reel, in one line (None: they fly): the seed's rigid cables or
-    elastic ropes, no UAV prescribed (the formulations' FEATURES: Baumgarte's, `winch`)."""
+    """What winches cannot reel, in one line (None: they fly): a cable model that declares
+    REELS (the cable-model registry), no UAV prescribed (the formulations' FEATURES:
+    Baumgarte's, `winch`)."""
+    from multilift_sim.cables import CABLE_MODELS
     if not any(u.winch for u in scenario.uavs):
         return None
-    if scenario.cable_model not in ('rigid', 'elastic'):
-        return (f'uavs[].winch reels rigid or elastic cables, not cable_model: '
-                f'{scenario.cable_model}')
+    if not CABLE_MODELS[scenario.cable_model].REELS:
+        reeled = ' or '.join(name for name, model in CABLE_MODELS.items() if model.REELS)
+        return f'uavs[].winch reels {reeled} cables, not cable_model: {scenario.cable_model}'
     if scenario.prescribed:
         return 'uavs[].winch is not for a formation with prescribed UAVs (uavs[i].trajectory)'
     return None

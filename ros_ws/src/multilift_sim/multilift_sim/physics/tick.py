@@ -32,7 +32,7 @@ from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rate
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.prescribed import prescribe_state
 from multilift_sim.estimators.estimation import estimated_states
-from multilift_sim.physics.winch import reel_end, reel_period
+from multilift_sim.physics.winch import period_uavs, reel_end
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
                                                    run_add_compression, run_add_gust_speed,
@@ -172,9 +172,8 @@ def advance(a, m, b, speeds, saturated, tension):
     t0 = m.tick[b] * a.period_ns[b] * 1e-9
     formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
                                 t0)
-    winched = formation[FORMATION_WINCH] != 0.0
     # the UAVs' rows, with each reel's motion over the period where winches reel (physics.winch)
-    uavs = reel_period(a.uavs[b], m.reel[b], t0, period) if winched else a.uavs[b]
+    uavs = period_uavs(a.uavs[b], m.reel[b], formation, t0, period)
     state, multipliers, g, g_dot = actuated_period(
         m.state[b], m.held[b], m.rotors[b], a.actuators[b], m.effectiveness[b], a.allocation[b],
         uavs, a.gusts[b], formation, m.taut[b], m.released[b], a.slack[b],
@@ -185,7 +184,8 @@ def advance(a, m, b, speeds, saturated, tension):
     run_add_compression(m.run[b], tension, period)
     if formation[FORMATION_ELASTIC] != 0.0:  # each rope's stretch and tension at the tick
         run_add_ropes(m.run[b], m.state[b], m.reel[b, :, REEL_LENGTH], tension)
-    if winched:  # the reels at the new tick, g and g_dot of the reeled lengths there
+    if formation[FORMATION_WINCH] != 0.0:  # the reels at the new tick, g, g_dot of the
+        # reeled lengths there
         reel_end(uavs, m.reel[b], (m.tick[b] + 1) * a.period_ns[b] * 1e-9, g, g_dot)
         run_add_reel(m.run[b], m.reel[b], a.cable_lengths[b])
     if a.slack[b]:
@@ -255,8 +255,7 @@ def tension_at(a, m, b, speeds, tension):
     t = m.tick[b] * a.period_ns[b] * 1e-9
     formation = timed_formation(period_formation(a.formation[b], a.wind_series[b], m.tick[b]),
                                 t)
-    winched = formation[FORMATION_WINCH] != 0.0
-    uavs = reel_period(a.uavs[b], m.reel[b], t, a.period_ns[b] * 1e-9) if winched else a.uavs[b]
+    uavs = period_uavs(a.uavs[b], m.reel[b], formation, t, a.period_ns[b] * 1e-9)
     solve(x, wrenches, uavs, a.gusts[b], formation, m.taut[b], acc, multipliers,
           np.empty((n, CABLE_COLUMNS)))
     for i in range(n):

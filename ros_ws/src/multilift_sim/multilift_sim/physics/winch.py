@@ -94,6 +94,15 @@ def reel_period(uavs, reel, t0, period):
 
 
 @jit
+def period_uavs(uavs, reel, formation, t0, period):
+    """The UAVs' constants rows a period [s] from t0 [s] is stepped with: `reel_period`'s where
+    winches reel (FORMATION_WINCH), else `uavs` themselves."""
+    if formation[FORMATION_WINCH] != 0.0:
+        return reel_period(uavs, reel, t0, period)
+    return uavs
+
+
+@jit
 def reel_end(rows, reel, t1, g, g_dot):
     """The reels' length and rate at the period's end t1 [s] into `reel` (n, REEL_COLUMNS)
     (`rows` the period's, `reel_period`), and the residuals g [m^2], g_dot [m^2/s] there,

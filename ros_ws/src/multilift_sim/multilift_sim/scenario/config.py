@@ -252,6 +252,7 @@ class Scenario:
     estimator: EstimatorConfig | None = None  # None: no estimator (`estimator: none`)
     parts: tuple[str, ...] = ()      # part files it imports (`parts:`, multilift_sim.parts)
     world: WorldConfig | None = None  # obstacles, ground (`world:`); None: no clearance checks
+    comms: Any = None                # links.CommsConfig (`comms:`); None: followers hear at once
 
     @property
     def n_uavs(self) -> int:

@@ -31,6 +31,7 @@ from multilift_sim.scenario.part_files import scenario_parts
 from multilift_sim.scenario.prescribed import (check_prescribed, finite_vector, read_trajectory,
                                                scenario_folder)
 from multilift_sim.scenario.reading import Section
+from multilift_sim.links import read_comms
 from multilift_sim.scenario.sensor_sections import estimator_section, sensor_suite, sensors_section
 from multilift_sim.scenario.world import check_start, read_world
 from multilift_sim.scenario.vehicle import (SEED_INERTIA, inertia_source, inertia_warning,
@@ -205,6 +206,9 @@ def scenario_of(data: Any, where: str) -> Scenario:
     from multilift_sim.missions import read_mission  # its parts import scenario's names
     mission = read_mission(top, uavs[0].position)
     world = read_world(top)
+    comms = read_comms(top, sim.control_rate)
+    if comms is not None and len(uavs) < 2:
+        raise top.fail('comms', top.raw('comms'), 'links a leader to its followers: needs n >= 2')
     top.done()
 
     scenario = Scenario(name=name, description=description, source=where, simulation=sim,
@@ -213,7 +217,8 @@ def scenario_of(data: Any, where: str) -> Scenario:
                         formation=formation, warnings=tuple(warnings),
                         cable_model=cable_model, cable=rope, events=events, wind=tuple(wind),
                         wind_models=tuple(wind_models), sensors=sensors,
-                        sensor_suite=suite, estimator=estimator, parts=parts, world=world)
+                        sensor_suite=suite, estimator=estimator, parts=parts, world=world,
+                        comms=comms)
     _check_feasible(scenario)
     check_limits(scenario)
     check_prescribed(scenario)  # the files cover the run, the payload's start fits the cables

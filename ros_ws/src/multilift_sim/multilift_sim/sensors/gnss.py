@@ -19,7 +19,8 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import MEASURED_POSITION, MEASURED_VELOCITY
-from multilift_sim.sensors.outputs import ARRIVED, OUTPUT, TAKEN
+from multilift_sim.sensors.outputs import (OUTPUT, delayed_constants, delayed_memory,
+                                          delayed_sample)
 
 NAME = 'gnss'
 UNITS = {'horizontal_position_noise': 'm', 'vertical_position_noise': 'm',
@@ -34,18 +35,12 @@ PRESETS = {'gnss_outdoor': {'rate': 10.0, 'latency': 0.11,
 OUTPUT_POSITION = 0         # p [m], world (3)
 OUTPUT_VELOCITY = 3         # v [m/s], world (3)
 OUTPUT_COLUMNS = 6
-# -- its constants row -------------------------------------------------------------------------
-EVERY = 0                   # control ticks between two samples
-LATENCY = 1                 # control ticks from a sample to its arrival
-CONSTANT_COLUMNS = 2
 # -- a sample's draws --------------------------------------------------------------------------
 DRAW_ERROR = 0              # its position and velocity errors [m, m/s] (6)
 DRAW_DELIVERED = 6          # 1.0: it arrives, 0.0: lost
 DRAW_COLUMNS = 7
-# -- one UAV's memory (after outputs.OUTPUT's block) ------------------------------------------
-LAST_TICK = OUTPUT + OUTPUT_COLUMNS  # the tick measured last (-1: none)
-DELAY_LINE = LAST_TICK + 1  # the true (p, v) of the last latency + 1 ticks, by tick %
-#                             (latency + 1) (rows of OUTPUT_COLUMNS)
+# its constants and memory: outputs.delayed_constants, delayed_memory (a delay line of the
+# true (p, v), rows of OUTPUT_COLUMNS)
 
 
 @dataclass(frozen=True)
@@ -80,15 +75,11 @@ def with_simulation(settings: GnssSettings, simulation, every: int) -> GnssSetti
 
 
 def constants(settings: GnssSettings, every: int) -> np.ndarray:
-    row = np.zeros(CONSTANT_COLUMNS)
-    row[EVERY], row[LATENCY] = every, settings.latency_ticks
-    return row
+    return delayed_constants(settings.latency_ticks, every)
 
 
 def memory(settings: GnssSettings) -> np.ndarray:
-    row = np.zeros(DELAY_LINE + (settings.latency_ticks + 1) * OUTPUT_COLUMNS)
-    row[ARRIVED] = row[TAKEN] = row[LAST_TICK] = -1.0
-    return row
+    return delayed_memory(OUTPUT_COLUMNS, settings.latency_ticks)
 
 
 def draws(settings: GnssSettings, n_uavs: int, samples: int, dt: float,
@@ -109,23 +100,13 @@ def measure(constants, draws, memory, tick, truth, received):
     line; the sample taken `latency` ticks ago, if one was and is not lost, into the output
     with its errors (ARRIVED this tick, TAKEN its tick); received left alone. A second call
     at one tick changes nothing."""
-    if memory[LAST_TICK] == tick:
+    line, source, sample = delayed_sample(constants, draws[:, DRAW_DELIVERED], memory, tick,
+                                          OUTPUT_COLUMNS)
+    if line < 0:
         return
-    memory[LAST_TICK] = tick
-    every = int(constants[EVERY])
-    slots = int(constants[LATENCY]) + 1
-    line = DELAY_LINE + (tick % slots) * OUTPUT_COLUMNS
     for j in range(3):
         memory[line + OUTPUT_POSITION + j] = truth[MEASURED_POSITION + j]
         memory[line + OUTPUT_VELOCITY + j] = truth[MEASURED_VELOCITY + j]
-    taken = 0 if tick == 0 else tick - slots + 1
-    if taken < 0 or taken % every != 0 or (taken == 0 and tick > 0):  # tick 0's: at once
-        return
-    sample = taken // every
-    if sample >= draws.shape[0] or (draws[sample, DRAW_DELIVERED] == 0.0 and tick > 0):
-        return
-    source = DELAY_LINE + (taken % slots) * OUTPUT_COLUMNS
-    for j in range(OUTPUT_COLUMNS):
-        memory[OUTPUT + j] = memory[source + j] + draws[sample, DRAW_ERROR + j]
-    memory[ARRIVED] = tick
-    memory[TAKEN] = taken
+    if sample >= 0:
+        for j in range(OUTPUT_COLUMNS):
+            memory[OUTPUT + j] = memory[source + j] + draws[sample, DRAW_ERROR + j]

@@ -23,7 +23,8 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import rotation_quaternion, quaternion_product
 from multilift_sim.physics.layout import MEASURED_EULER, MEASURED_POSITION
 from multilift_sim.physics.measurement import euler_quaternion
-from multilift_sim.sensors.outputs import ARRIVED, OUTPUT, TAKEN
+from multilift_sim.sensors.outputs import (OUTPUT, delayed_constants, delayed_memory,
+                                          delayed_sample)
 
 NAME = 'mocap'
 UNITS = {'position_noise': 'm', 'attitude_noise': 'rad', 'latency': 's', 'dropout': '',
@@ -35,19 +36,13 @@ PRESETS = {'mocap_indoor': {'rate': 100.0, 'latency': 0.007, 'position_noise': 0
 OUTPUT_POSITION = 0         # p [m], world (3)
 OUTPUT_QUATERNION = 3       # q (w, x, y, z), body -> world (4)
 OUTPUT_COLUMNS = 7
-# -- its constants row -------------------------------------------------------------------------
-EVERY = 0                   # control ticks between two samples
-LATENCY = 1                 # control ticks from a sample to its arrival
-CONSTANT_COLUMNS = 2
 # -- a sample's draws --------------------------------------------------------------------------
 DRAW_POSITION = 0           # its position error [m] (3)
 DRAW_ATTITUDE = 3           # its attitude error [rad], body rotation vector (3)
 DRAW_DELIVERED = 6          # 1.0: it arrives, 0.0: lost
 DRAW_COLUMNS = 7
-# -- one UAV's memory (after outputs.OUTPUT's block) ------------------------------------------
-LAST_TICK = OUTPUT + OUTPUT_COLUMNS  # the tick measured last (-1: none)
-DELAY_LINE = LAST_TICK + 1  # the true poses (p, q) of the last latency + 1 ticks, by tick %
-#                             (latency + 1) (rows of OUTPUT_COLUMNS)
+# its constants and memory: outputs.delayed_constants, delayed_memory (a delay line of the
+# true poses (p, q), rows of OUTPUT_COLUMNS)
 
 
 @dataclass(frozen=True)
@@ -83,15 +78,11 @@ def with_simulation(settings: MocapSettings, simulation, every: int) -> MocapSet
 
 
 def constants(settings: MocapSettings, every: int) -> np.ndarray:
-    row = np.zeros(CONSTANT_COLUMNS)
-    row[EVERY], row[LATENCY] = every, settings.latency_ticks
-    return row
+    return delayed_constants(settings.latency_ticks, every)
 
 
 def memory(settings: MocapSettings) -> np.ndarray:
-    row = np.zeros(DELAY_LINE + (settings.latency_ticks + 1) * OUTPUT_COLUMNS)
-    row[ARRIVED] = row[TAKEN] = row[LAST_TICK] = -1.0
-    return row
+    return delayed_memory(OUTPUT_COLUMNS, settings.latency_ticks)
 
 
 def draws(settings: MocapSettings, n_uavs: int, samples: int, dt: float,
@@ -113,25 +104,18 @@ def measure(constants, draws, memory, tick, truth, received):
     line; the sample taken `latency` ticks ago, if one was and is not lost, into the output
     with its errors (ARRIVED this tick, TAKEN its tick); received left alone. A second call
     at one tick changes nothing."""
-    if memory[LAST_TICK] == tick:
+    line, source, sample = delayed_sample(constants, draws[:, DRAW_DELIVERED], memory, tick,
+                                          OUTPUT_COLUMNS)
+    if line < 0:
         return
-    memory[LAST_TICK] = tick
-    every = int(constants[EVERY])
-    slots = int(constants[LATENCY]) + 1
-    line = DELAY_LINE + (tick % slots) * OUTPUT_COLUMNS
     for j in range(3):
         memory[line + OUTPUT_POSITION + j] = truth[MEASURED_POSITION + j]
     x, y, z, w = euler_quaternion(truth[MEASURED_EULER], truth[MEASURED_EULER + 1],
                                   truth[MEASURED_EULER + 2])
     q = line + OUTPUT_QUATERNION
     memory[q], memory[q + 1], memory[q + 2], memory[q + 3] = w, x, y, z
-    taken = 0 if tick == 0 else tick - slots + 1
-    if taken < 0 or taken % every != 0 or (taken == 0 and tick > 0):  # tick 0's: at once
+    if sample < 0:
         return
-    sample = taken // every
-    if sample >= draws.shape[0] or (draws[sample, DRAW_DELIVERED] == 0.0 and tick > 0):
-        return
-    source = DELAY_LINE + (taken % slots) * OUTPUT_COLUMNS
     for j in range(3):
         memory[OUTPUT + OUTPUT_POSITION + j] = (memory[source + OUTPUT_POSITION + j]
                                                 + draws[sample, DRAW_POSITION + j])
@@ -142,5 +126,3 @@ def measure(constants, draws, memory, tick, truth, received):
     o = OUTPUT + OUTPUT_QUATERNION
     memory[o], memory[o + 1], memory[o + 2], memory[o + 3] = quaternion_product(
         memory[s], memory[s + 1], memory[s + 2], memory[s + 3], e0, e1, e2, e3)
-    memory[ARRIVED] = tick
-    memory[TAKEN] = taken

@@ -106,3 +106,39 @@ def test_a_chain_stepped_too_coarsely_is_refused_naming_its_sub_steps():
     assert 'substeps >= 2' in text and '\n' not in text
     data['simulation']['substeps'] = 2
     scenario_io.loads(yaml.safe_dump(data))
+
+
+def test_the_summary_gives_each_chain_s_sag_and_the_markers_draw_its_links():
+    """A second of twin_lift_chain hovering: each cable's max sag (an inner node's largest
+    distance from its chord, at the ticks) as measured here from the states, in the figures
+    and summary.json's `max_sag`; the cable markers are the N links through the nodes."""
+    from multilift_sim.wire.scene import FormationScene
+    s = scenario_io.load(SCENARIOS / 'twin_lift_chain.yaml').with_duration(1.0)
+    sim = FormationSimulator(s)
+    links = s.cable['links']
+    state = StateLayout(2, chain_nodes=links - 1)
+    speeds = [np.full(4, 1900.0) for _ in range(2)]
+    idle = [np.zeros(4, bool) for _ in range(2)]
+    sags = np.zeros(2)
+    while not sim.finished:
+        x = sim.state
+        for i in range(2):
+            top, chord = state.uav_positions(x)[i], state.payload_position(x) - \
+                state.uav_positions(x)[i]
+            off = state.chain_positions(x)[i] - top
+            along = off @ chord / (chord @ chord)
+            sags[i] = max(sags[i], np.linalg.norm(off - np.outer(along, chord), axis=1).max())
+        sim.advance(speeds, idle)
+    assert np.all(sags > 1e-3)    # they sag from the straight start
+    np.testing.assert_allclose(sim.stats.chain_figures['max_sag'], sags, rtol=1e-12)
+    assert sim.stats.as_dict()['max_sag'] == sim.stats.chain_figures['max_sag']
+    snap = sim.snapshot()
+    scene = FormationScene(s)
+    scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],
+                 snap.payload_position, [5.0, 5.0], None, None, snap.chain_points)
+    cable = scene.cables[1]
+    assert len(cable.points) == 2 * links
+    np.testing.assert_allclose(cable.points[1], state.chain_positions(sim.state)[1, 0])
+    np.testing.assert_allclose(cable.points[-1], state.payload_position(sim.state))
+    rigid = FormationScene(scenario_io.load(SCENARIOS / 'twin_lift.yaml'))
+    assert len(rigid.cables[0].points) == 16   # other cables drawn as before

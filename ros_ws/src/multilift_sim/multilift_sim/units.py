@@ -65,6 +65,7 @@ CHAIN_UNITS = {'links': '', 'mass_per_length': 'kg/m', 'drag_coefficient': '',
                'diameter': 'm'}
 # an elastic run's figures per cable (the summary's, not a sweep column)
 ROPE_FIGURE_UNITS = {'max_stretch': 'm', 'peak_tension': 'N'}
+CHAIN_FIGURE_UNITS = {'max_sag': 'm'}   # a chain run's figure per cable (cables.chain)
 # a winch's keys (`uavs[i].winch`, multilift_sim.cables.winch) and a winched run's figures
 WINCH_UNITS = {'rate_limit': 'm/s', 'acceleration_limit': 'm/s^2', 'min_length': 'm',
                'max_length': 'm'}
@@ -131,7 +132,8 @@ SCENARIO_UNITS: dict[str, str] = {
 }
 
 UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS,
-                         **ROPE_FIGURE_UNITS, **REEL_FIGURE_UNITS}
+                         **ROPE_FIGURE_UNITS, **REEL_FIGURE_UNITS,
+                         **CHAIN_FIGURE_UNITS}
 
 _INDEX = re.compile(r'\[\d+\]')
 _WIND_KEY = re.compile(r'^wind\.(\w+)\.(\w+)(?:\[\])?$')  # wind.<model>.<key>

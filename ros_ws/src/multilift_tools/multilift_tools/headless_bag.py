@@ -83,6 +83,8 @@ class EngineBag:
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.measures  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
+        # a heavy cable's inner nodes per cable (cable_model: chain; 0: none), in its markers
+        self._chain_nodes = scenario.cable['links'] - 1 if scenario.cable_model == 'chain' else 0
         # /formation/wind by tick (physics.tick.period_winds), where the air moves everywhere
         self._wind = None
         if scenario.has_wind:
@@ -174,7 +176,7 @@ class EngineBag:
         state = memory.state[0]
         _, odometry = state_rows(state[None], n)
         odometry = odometry[0].tolist()
-        layout = StateLayout(n)
+        layout = StateLayout(n, chain_nodes=self._chain_nodes)
         payload_position = layout.payload_position(state).tolist()
         measured = measured_odometry(engine.measured()[:1])[0].tolist() if self._sensors \
             else None
@@ -198,7 +200,8 @@ class EngineBag:
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
                         layout.uav_euler(state).tolist(), payload_position,
-                        None if pose is None else pose[0])
+                        None if pose is None else pose[0],
+                        layout.chain_positions(state) if self._chain_nodes else None)
 
     def _events_at(self, tick: int, t_ns: int) -> list:
         """/formation/events of the events that fall on `tick` (the state there shows them)."""
@@ -208,13 +211,13 @@ class EngineBag:
 
     def _formation(self, tick: int, t_ns: int, tension: list, g: list, g_dot: list,
                    taut: list, odometry: list, euler: list, payload_position: list,
-                   payload_orientation=None) -> None:
+                   payload_orientation=None, chain_points=None) -> None:
         """`/formation/state` of a tick and, every MARKER_DECIMATION-th, its markers."""
         messages = [self._simulator.formation_of(t_ns, tension, g, g_dot, taut)]
         if tick % MARKER_DECIMATION == 0:
             messages.append(self._simulator.markers_of(
                 t_ns, [u[:3] for u in odometry], euler, payload_position, tension, taut,
-                payload_orientation))
+                payload_orientation, chain_points))
         self._write(messages, t_ns)
 
 

@@ -119,8 +119,9 @@ class EngineBag:
         self._held = flat[-1].copy()
         previous_count = flat.shape[1]
         odometry = odometry.tolist()
-        layout = StateLayout(n)
+        layout = StateLayout(n, chain_nodes=self._chain_nodes)
         euler = layout.uav_euler(states).tolist()
+        chains = layout.chain_positions(states) if self._chain_nodes else [None] * count
         payload_position = layout.payload_position(states).tolist()
         payload_velocity = layout.payload_velocity(states)
         poses = [None] * count
@@ -165,7 +166,7 @@ class EngineBag:
                                       errors[i][k] if i else None, rates[i][k] if i else None)
             write(messages, t_ns)
             self._formation(tick, t_ns, tension[k], g[k], g_dot[k], taut[k], odometry[k],
-                            euler[k], payload_position[k], orientations[k])
+                            euler[k], payload_position[k], orientations[k], chains[k])
 
     def last(self) -> None:
         """Write the state at t_max (the engine's current state, which nothing answers) and

@@ -270,7 +270,11 @@ class FormationScene:
             body.orientation[:] = quaternion(euler)
             heading.position[:] = xyz
             heading.orientation[:] = body.orientation
-            cable.points[:] = (_cable_points(xyz, end, bool(is_taut)) if chain_points is None
-                               else _chain_points(xyz, chain_points[i], end))
+            points = (_cable_points(xyz, end, bool(is_taut)) if chain_points is None
+                      else _chain_points(xyz, chain_points[i], end))
+            if len(points) != len(cable.points):  # a chain's markers need its nodes
+                raise ValueError(f'formation_markers: cable {i + 1} has {len(cable.points)} '
+                                 f'points, got {len(points)}')
+            cable.points[:] = points
             cable.color[:3] = tension_color(float(tension), self.reference_tension)
         return self.specs

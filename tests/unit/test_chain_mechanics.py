@@ -47,6 +47,17 @@ def test_a_heavy_payload_on_a_light_chain_swings_at_the_pendulum_s_period():
     assert period == pytest.approx(expected, rel=0.005)
 
 
+def test_a_chain_whirling_in_free_fall_keeps_its_energy_and_folds():
+    """No drag, rotors off: a payload thrown sideways at 1 m/s on a 10-link chain at rest
+    drags it into a fold (the payload within 0.95 l of the UAV) and whirls about the falling
+    UAV; kinetic + gravitational energy of every body (UAV, payload, nodes) stays within 1e-8
+    of the throw's m_p v^2 / 2 over 5 s (`chain_mechanics.free_fall_energy`: 3.9e-9)."""
+    drift, throw, reach, worst = chain_mechanics.free_fall_energy()
+    assert drift < 1e-8 * throw
+    assert reach < 0.95 * 2.5
+    assert worst < 1e-8
+
+
 def test_the_links_keep_their_lengths_over_the_twin_lift_chain_mission():
     """twin_lift_chain flies its whole mission (120 s) with every link within the constraint
     tolerance: each cable's worst |g_ik| = ||d_ik|^2 - (l / N)^2| at every tick, measured from

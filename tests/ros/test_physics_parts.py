@@ -63,7 +63,7 @@ def register_parts():
         NAME='sphere', NEEDS=frozenset(), MIN_UAVS=1, parse=_sphere_parse))
     CABLE_MODELS.register(types.SimpleNamespace(
         NAME='rated', NEEDS=frozenset(), RELEASE_LIMIT_DEG=90.0, KEEPS_LENGTH=True,
-        SLACKENS=False, parse_cable=_rated_cable, parse_uav_cable=_rated_uav_cable,
+        SLACKENS=False, REELS=False, parse_cable=_rated_cable, parse_uav_cable=_rated_uav_cable,
         check=_rated_check))
     baumgarte = FORMULATIONS['baumgarte']
     FORMULATIONS.register(types.SimpleNamespace(

@@ -141,19 +141,27 @@ def pendulum(links: int = 10, payload_mass: float = 5.0, mass_per_length: float 
 
 
 def free_fall_energy(links: int = 10, mass_per_length: float = 0.1, length: float = 2.5,
-                     physics_rate: float = 400.0) -> tuple[float, float, float, float]:
+                     physics_rate: float = 400.0, attach_point=None
+                     ) -> tuple[float, float, float, float]:
     """single_lift's UAV and payload on a chain of `links` links, rotors off, no drag, no
     gusts, the payload thrown sideways at 1 m/s, the nodes at rest (every link's g_dot 0): in
     free fall the payload drags the chain into a fold and whirls about the UAV for 5 s. Returns
     (the largest change of kinetic + gravitational energy [J] over the run (every body: the
     UAV, the payload, each node), the throw's energy m_p v^2 / 2 [J], the shortest distance
-    UAV -> payload [m] (below l: folded), the run's max |g| [m^2])."""
+    UAV -> payload [m] (below l: folded), the run's max |g| [m^2]). With `attach_point` [m],
+    body FLU, the cable holds the UAV there (the payload starting l below it): the chain
+    turns the UAV too (its rotational energy 1/2 omega . J omega counted)."""
     data = yaml.safe_load(resolve('single_lift').read_text())
     data.update(cable_model='chain', cable_length=length,
                 cable={'links': links, 'mass_per_length': mass_per_length})
     for u in data['uavs']:
         u.pop('cable_length', None)
+        if attach_point is not None:
+            u['attach_point'] = list(attach_point)
     data['payload'].update(drag_coefficient=0.0, initial_velocity=[1.0, 0.0, 0.0])
+    if attach_point is not None:  # hanging from the attach point (the UAV level at 0)
+        data['payload']['initial_position'] = [attach_point[0], attach_point[1],
+                                               attach_point[2] - length]
     data['control'].update(mode='constant_rotor_speed', constant_rotor_speed=1.0)
     data['simulation'].update(duration=5.0, physics_rate=physics_rate, control_rate=100.0,
                               substeps=1)
@@ -166,12 +174,15 @@ def free_fall_energy(links: int = 10, mass_per_length: float = 0.1, length: floa
     sim.state = x
     node = mass_per_length * length / (links - 1)
     uav, payload = s.uavs[0].vehicle.mass, s.payload.mass
+    inertia = np.array(s.uavs[0].vehicle.inertia)   # principal, body [kg m^2]
     energies, reach = [], []
 
     def each(x):
         bodies = ((uav, layout.uav_positions(x)[0], layout.uav_velocities(x)[0]),
                   (payload, layout.payload_position(x), layout.payload_velocity(x)))
         energy = sum(0.5 * m * v @ v + m * G * p[2] for m, p, v in bodies)
+        rates = layout.uav_body_rates(x)[0]
+        energy += 0.5 * rates @ (inertia * rates)
         nodes, speeds = layout.chain_positions(x)[0], layout.chain_velocities(x)[0]
         energies.append(energy + 0.5 * node * (speeds * speeds).sum()
                         + node * G * nodes[:, 2].sum())
@@ -195,6 +206,9 @@ def main() -> None:
         print(f'  N = {links:3d} a cable: {measured:.4f} m against {sag:.4f} m '
               f'({measured / sag - 1:+.4f}; the rigid V {straight:.4f} m)')
     period, expected, count = pendulum()
+    drift, throw, reach, worst = free_fall_energy(attach_point=(0.1, 0.05, -0.1))
+    print(f'the same held 0.1, 0.05, -0.1 m off the UAV\'s centre: energy kept to '
+          f'{drift:.2e} J ({drift / throw:.1e}), folded to {reach:.3f} m, max |g| {worst:.1e}')
     drift, throw, reach, worst = free_fall_energy()
     print(f'a chain whirling in free fall (10 links, 5 s at 400 Hz): energy kept to '
           f'{drift:.2e} J ({drift / throw:.1e} of the throw\'s {throw:.2f} J), folded to '

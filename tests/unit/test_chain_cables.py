@@ -23,10 +23,15 @@ def _chain(**cable):
     return yaml.safe_dump(data)
 
 
-def _swinging():
-    """twin_lift_chain after 20 ticks of uneven rotors (the chains swinging), its payload moved
-    into the first gust: (simulator, state, wrenches)."""
-    sim = FormationSimulator(scenario_io.load(SCENARIOS / 'twin_lift_chain.yaml'))
+def _swinging(attach: bool = False):
+    """twin_lift_chain (its cables held off the UAVs' centres with `attach`) after 20 ticks
+    of uneven rotors (the chains swinging), its payload moved into the first gust:
+    (simulator, state, wrenches)."""
+    data = yaml.safe_load(_chain())
+    if attach:
+        data['uavs'][0]['attach_point'] = [0.05, -0.02, -0.08]
+        data['uavs'][1]['attach_point'] = [-0.03, 0.04, -0.08]
+    sim = FormationSimulator(scenario_io.loads(yaml.safe_dump(data)))
     hover = [np.array([1800.0, 1790.0, 1800.0, 1810.0]) for _ in range(2)]
     idle = [np.zeros(4, bool) for _ in range(2)]
     for _ in range(20):
@@ -40,8 +45,9 @@ def _swinging():
     return sim, x, sim.model.wrenches(hover)
 
 
-def test_the_chain_s_solve_and_period_compiled_are_their_source_bit_for_bit():
-    sim, x, wrenches = _swinging()
+@pytest.mark.parametrize('attach', [False, True])
+def test_the_chain_s_solve_and_period_compiled_are_their_source_bit_for_bit(attach):
+    sim, x, wrenches = _swinging(attach)
     model, n = sim.model, 2
     constants = (model._uavs, model._gusts, model._formation)
     taut = np.ones(n, bool)

@@ -58,6 +58,16 @@ def test_a_chain_whirling_in_free_fall_keeps_its_energy_and_folds():
     assert worst < 1e-8
 
 
+def test_a_chain_held_off_the_uav_s_centre_keeps_its_energy_turning_the_uav():
+    """The same throw on a cable held 0.1, 0.05, -0.1 m off the UAV's centre (body FLU): the
+    chain's pull turns the UAV (0.07 rad/s), and kinetic (its rotation's 1/2 omega . J omega
+    included) + gravitational energy stays within 1e-8 of the throw's over 5 s (3.9e-9)."""
+    drift, throw, reach, worst = chain_mechanics.free_fall_energy(
+        attach_point=(0.1, 0.05, -0.1))
+    assert drift < 1e-8 * throw
+    assert worst < 1e-8
+
+
 def test_the_links_keep_their_lengths_over_the_twin_lift_chain_mission():
     """twin_lift_chain flies its whole mission (120 s) with every link within the constraint
     tolerance: each cable's worst |g_ik| = ||d_ik|^2 - (l / N)^2| at every tick, measured from

@@ -43,19 +43,25 @@ def initial_state(scenario: Scenario) -> np.ndarray:
             or payload.initial_velocity is not None:
         state = given_start(scenario, state)
     if scenario.cable_model == 'chain':
-        return chain_start(state, scenario.n_uavs, scenario.cable['links'])
+        return chain_start(state, scenario.n_uavs, scenario.cable['links'],
+                           uav_offsets(scenario))
     return state
 
 
-def chain_start(state: np.ndarray, n: int, links: int) -> np.ndarray:
+def chain_start(state: np.ndarray, n: int, links: int,
+                offsets: np.ndarray | None = None) -> np.ndarray:
     """A point payload's state with each cable's N - 1 inner nodes appended
-    (`cable_model: chain`): on the straight line from its UAV's centre to the payload, node k
-    at k / N of it, moving as that line's point does (the rigid cable's start)."""
+    (`cable_model: chain`): on the straight line from where the cable holds its UAV (its
+    centre, or `offsets` (n, 3) [m] from it, world: `uav_offsets`, each UAV level and not
+    turning at the start) to the payload, node k at k / N of it, moving as that line's point
+    does (the rigid cable's start)."""
     point = StateLayout(n)
     layout = StateLayout(n, chain_nodes=links - 1)
     out = np.zeros(layout.size)
     out[:point.size] = state
     uavs, payload = point.uav_positions(state), point.payload_position(state)
+    if offsets is not None:
+        uavs = uavs + offsets
     uav_velocities, payload_velocity = point.uav_velocities(state), point.payload_velocity(state)
     share = (np.arange(1, links) / links)[None, :, None]
     layout.chain_positions(out)[:] = uavs[:, None, :] + share * (payload - uavs)[:, None, :]

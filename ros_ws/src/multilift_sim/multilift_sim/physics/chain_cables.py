@@ -1,8 +1,12 @@
 """Heavy cables (`cable_model: chain`, issue 32 item 2): each cable a chain of N rigid links
-between its UAV's centre (node 0) and the point payload (node N), with N - 1 point masses
+between its UAV (node 0) and the point payload (node N), with N - 1 point masses
 between them (node k of cable i, its state at `chain_node_slot(n, N - 1, i, k)`). World frame
 (z up), SI units; slots: `physics.layout` (NODE_*, CHAIN_*, UAV_NODE_MASS, UAV_NODE_DRAG,
 FORMATION_CHAIN_LINKS). docs/cables.md, "Heavy cables".
+
+Node 0 is UAV i's attach point r_i + R_i a_i where its cable holds it off its centre (issue
+20): the top link's pull then turns the UAV too (its moment a_i x R_i^T 2 lambda_i1 d_i1,
+Eq. 2.28), and adds 2 k . J^-1 k to the top link's diagonal (k = a_i x R_i^T d_i1).
 
 The seed's cable constraint (Eq. 2.42) per link: g_ik = |d_ik|^2 - s_i^2 = 0, d_ik = r_ik -
 r_i(k-1), s_i = l_i / N, held by Lagrange multipliers with Baumgarte's stabilisation as the
@@ -31,8 +35,11 @@ import math
 import numpy as np
 
 from multilift_sim.kernels import jit
-from multilift_sim.physics.free_motion import air_velocity, payload_motion, uav_free_motion
-from multilift_sim.physics.layout import (CHAIN_LINK_COLUMNS, CHAIN_LINK_DIAGONAL,
+from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,
+                                              attached_off_centre, cable_moment_arm,
+                                              payload_motion, rotational_compliance,
+                                              uav_attach_motion, uav_free_motion)
+from multilift_sim.physics.layout import (BODY_RATES, CHAIN_LINK_COLUMNS, CHAIN_LINK_DIAGONAL,
                                           CHAIN_LINK_OFFSET, CHAIN_LINK_U, CHAIN_LINK_UPPER,
                                           CHAIN_LINK_W, CHAIN_NODE_COLUMNS, CHAIN_NODE_FREE,
                                           CHAIN_NODE_INV_MASS, FORMATION_BETA_SQ,
@@ -42,7 +49,7 @@ from multilift_sim.physics.layout import (CHAIN_LINK_COLUMNS, CHAIN_LINK_DIAGONA
                                           NODE_VELOCITY, POSITION, UAV_LENGTH_SQ, UAV_MASS,
                                           UAV_NODE_DRAG, UAV_NODE_MASS)
 from multilift_sim.physics.state_slots import (chain_node_slot, payload_slot, rates_slot,
-                                               uav_slot)
+                                               uav_attitude_slot, uav_slot)
 
 
 @jit
@@ -55,6 +62,12 @@ def put3(row, at, a, b, c):
 def get3(row, at):
     """row[at:at + 3] as three floats."""
     return row[at], row[at + 1], row[at + 2]
+
+
+@jit
+def off_centre_any(moments, i):
+    """Whether cable i's top link pulls UAV i off its centre (a moment arm not 0)."""
+    return moments[i, 0] != 0.0 or moments[i, 1] != 0.0 or moments[i, 2] != 0.0
 
 
 @jit
@@ -90,6 +103,13 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                               formation[FORMATION_WIND + 2])
     link_rows = np.empty((n, links, CHAIN_LINK_COLUMNS))
     node_rows = np.empty((n, links, CHAIN_NODE_COLUMNS))
+    # where a cable holds its UAV off its centre (issue 20): the attach point's offset R_i a_i,
+    # its rate and its acceleration without the cable (rows 0-2; all 0 at the centre), the
+    # pull's moment arm k_i = a_i x R_i^T d_i1 [m^2], body FLU, and the UAV's thrust [m/s^2]
+    attach = np.zeros((n, 3, 3))
+    moments = np.zeros((n, 3))
+    thrusts = np.empty((n, 3))
+    rotation = np.empty((3, 3))
     payload_mass = formation[FORMATION_PAYLOAD_MASS]
     # the Schur complement S a_p = rhs on the payload's acceleration (gravity excluded)
     s00 = s11 = s22 = payload_mass
@@ -99,7 +119,12 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         lk = link_rows[i]
         nd = node_rows[i]
         thrust_ax, thrust_ay, thrust_az = uav_free_motion(x, i, wrenches, uavs, formation, acc)
-        put3(nd[0], CHAIN_NODE_FREE, thrust_ax, thrust_ay, thrust_az)
+        put3(thrusts[i], 0, thrust_ax, thrust_ay, thrust_az)
+        off_centre = attached_off_centre(uavs, i)
+        if off_centre:  # node 0 is the attach point r_i + R_i a_i
+            rotation[:, :] = uav_attach_motion(x, i, wrenches, uavs, attach[i])
+        put3(nd[0], CHAIN_NODE_FREE, thrust_ax + attach[i, 2, 0], thrust_ay + attach[i, 2, 1],
+             thrust_az + attach[i, 2, 2])
         nd[0, CHAIN_NODE_INV_MASS] = 1.0 / uavs[i, UAV_MASS]
         node_mass, node_drag_c = uavs[i, UAV_NODE_MASS], uavs[i, UAV_NODE_DRAG]
         for k in range(1, links):  # the inner nodes: their drag in the air
@@ -121,12 +146,20 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
             r1, v1 = node_point(x, n, inner, i, k, p, nq)
             dx, dy, dz = x[r1] - x[r0], x[r1 + 1] - x[r0 + 1], x[r1 + 2] - x[r0 + 2]
             dvx, dvy, dvz = x[v1] - x[v0], x[v1 + 1] - x[v0 + 1], x[v1 + 2] - x[v0 + 2]
+            if k == 1 and off_centre:  # from the attach point
+                dx, dy, dz = dx - attach[i, 0, 0], dy - attach[i, 0, 1], dz - attach[i, 0, 2]
+                dvx, dvy, dvz = (dvx - attach[i, 1, 0], dvy - attach[i, 1, 1],
+                                 dvz - attach[i, 1, 2])
             row = lk[k - 1]
             put3(row, CHAIN_LINK_OFFSET, dx, dy, dz)
             offset_sq = dx * dx + dy * dy + dz * dz
             upper_inv = nd[k - 1, CHAIN_NODE_INV_MASS]
             lower_inv = nd[k, CHAIN_NODE_INV_MASS] if k < links else 0.0
             row[CHAIN_LINK_DIAGONAL] = 2.0 * offset_sq * (upper_inv + lower_inv)
+            if k == 1 and off_centre:  # the UAV's turn adds 2 k . J^-1 k (Eq. 2.28)
+                k0, k1, k2 = cable_moment_arm(uavs, i, rotation, dx, dy, dz)
+                put3(moments[i], 0, k0, k1, k2)
+                row[CHAIN_LINK_DIAGONAL] += 2.0 * rotational_compliance(uavs, i, k0, k1, k2)
             # d_k . (a_k - a_(k-1)) = -|dv_k|^2 - alpha_f g_dot_k - beta_f^2 g_k / 2 (Eq. 2.59)
             target = (-(dvx * dvx + dvy * dvy + dvz * dvz)
                       - two_alpha * (dx * dvx + dy * dvy + dz * dvz)
@@ -204,8 +237,15 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                 lam = pull * lk[j - 1, CHAIN_LINK_U]
                 ax, ay, az = ax - lam * above_x, ay - lam * above_y, az - lam * above_z
             r, v = node_point(x, n, inner, i, j, p, nq)
-            if j == 0:
-                acc[r], acc[r + 1], acc[r + 2] = ax, ay, az - gravity
+            if j == 0:  # the UAV's centre: its thrust and the top link's pull (and its moment)
+                lam = pull * lk[0, CHAIN_LINK_U]
+                acc[r] = thrusts[i, 0] + lam * below_x
+                acc[r + 1] = thrusts[i, 1] + lam * below_y
+                acc[r + 2] = thrusts[i, 2] + lam * below_z - gravity
+                if off_centre_any(moments, i):
+                    add_cable_torque(uavs, i, acc, uav_attitude_slot(n, i) - nq + BODY_RATES,
+                                     2.0 * lk[0, CHAIN_LINK_U], moments[i, 0], moments[i, 1],
+                                     moments[i, 2])
                 continue
             at = r - nq   # the node's block in acc: its position's rate, then its velocity's
             acc[at], acc[at + 1], acc[at + 2] = x[v], x[v + 1], x[v + 2]
@@ -221,16 +261,23 @@ def chain_residuals(x, uavs, inner, g, g_dot):
     links = inner + 1
     p = payload_slot(n)
     nq = rates_slot(n)
+    attach = np.zeros((3, 3))
     for i in range(n):
         link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)
         worst = worst_rate = 0.0
+        off_centre = attached_off_centre(uavs, i)
+        if off_centre:  # node 0 the attach point r_i + R_i a_i
+            uav_attach_motion(x, i, np.zeros((n, 4)), uavs, attach)
         for k in range(1, links + 1):
             r0, v0 = node_point(x, n, inner, i, k - 1, p, nq)
             r1, v1 = node_point(x, n, inner, i, k, p, nq)
             dx, dy, dz = x[r1] - x[r0], x[r1 + 1] - x[r0 + 1], x[r1 + 2] - x[r0 + 2]
+            dvx, dvy, dvz = x[v1] - x[v0], x[v1 + 1] - x[v0 + 1], x[v1 + 2] - x[v0 + 2]
+            if k == 1 and off_centre:
+                dx, dy, dz = dx - attach[0, 0], dy - attach[0, 1], dz - attach[0, 2]
+                dvx, dvy, dvz = dvx - attach[1, 0], dvy - attach[1, 1], dvz - attach[1, 2]
             value = dx * dx + dy * dy + dz * dz - link_sq
-            rate = 2.0 * (dx * (x[v1] - x[v0]) + dy * (x[v1 + 1] - x[v0 + 1])
-                          + dz * (x[v1 + 2] - x[v0 + 2]))
+            rate = 2.0 * (dx * dvx + dy * dvy + dz * dvz)
             if abs(value) >= abs(worst):
                 worst = value
             if abs(rate) >= abs(worst_rate):

@@ -158,3 +158,17 @@ def test_engine_and_simulator_fly_a_chain_twin_lift_alike():
     engine, simulator = fly(s), run_headless(s)
     np.testing.assert_array_equal(engine.engine.state[0], simulator.simulator.state)
     assert engine.engine.memory.status[0] == 1  # finished
+
+
+def test_what_a_chain_cannot_carry_is_one_line():
+    """A rigid-body payload, a winch and a prescribed UAV are refused with chains, one line."""
+    beam = yaml.safe_load((SCENARIOS / 'beam_lift.yaml').read_text())
+    beam.update(cable_model='chain', cable={'links': 10, 'mass_per_length': 0.01})
+    winch = yaml.safe_load(_chain())
+    winch['uavs'][0]['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5,
+                                 'min_length': 2.0, 'max_length': 15.0}
+    for data, says in ((beam, 'cable_model: chain is for a point payload'),
+                       (winch, 'cable_model: chain')):
+        with pytest.raises(scenario_io.ScenarioError) as caught:
+            scenario_io.loads(yaml.safe_dump(data))
+        assert says in str(caught.value) and '\n' not in str(caught.value)

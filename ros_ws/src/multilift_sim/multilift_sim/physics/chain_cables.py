@@ -28,7 +28,7 @@ and cancels in the links' equations; it is added at the end.
 
 Links are rods: a link's multiplier may go negative (it pushes: a chain folding fast, or
 whipped), which a real rope cannot; the chain keeps it (rods, not a rope) and the run's
-`compression` figure reports it for the top link (the tension the tick reports).
+`compressed_time` figure reports it for the top link (the tension the tick reports).
 """
 import math
 

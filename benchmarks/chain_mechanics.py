@@ -194,6 +194,53 @@ def free_fall_energy(links: int = 10, mass_per_length: float = 0.1, length: floa
             sim.stats.max_abs_constraint)
 
 
+def beam_energy(links: int = 10, mass_per_length: float = 0.05,
+                speeds: tuple[float, float] = (1900.0, 1890.0),
+                duration: float = 5.0) -> tuple[float, float, float, float]:
+    """beam_lift's 1.5 kg beam (a rigid body, held at its ends) on chains of `links` links, no
+    drag, no gusts, UAV i's rotors all held at `speeds`[i] [rad/s] (no torque: the UAVs stay
+    level, their thrust F_i = n k_T speed_i^2 straight up; uneven, so the beam tilts): the
+    chains start straight and sag, the beam swings and turns. Returns (the largest
+    |E(t) - E(0) - sum_i F_i (z_i(t) - z_i(0))| [J] over the run,
+    E kinetic (the beam's rotation 1/2 omega . J omega included) + gravitational energy of every
+    body; the largest |E(t) - E(0)| [J] (what the rotors did); the beam's largest rate
+    [rad/s]; the run's max |g| [m^2])."""
+    data = yaml.safe_load(resolve('beam_lift').read_text())
+    data.update(cable_model='chain', cable={'links': links, 'mass_per_length': mass_per_length})
+    data['payload'].update(drag_coefficient=0.0)
+    data['control'].update(mode='constant_rotor_speed', constant_rotor_speed=speeds[0])
+    data['simulation'].update(duration=duration, substeps=2)
+    data.pop('gusts', None)
+    s = scenario_io.loads(yaml.safe_dump(data))
+    sim = FormationSimulator(s)
+    n = s.n_uavs
+    layout = StateLayout(n, True, chain_nodes=links - 1)
+    vehicle = s.uavs[0].vehicle
+    lift = vehicle.n_rotors * vehicle.thrust_coefficient * np.square(speeds)   # [N] (n,)
+    node = mass_per_length * s.uavs[0].cable_length / (links - 1)
+    inertia = np.array(s.payload.inertia)
+    start = layout.uav_positions(sim.state)[:, 2].copy()
+    energies, works, rates = [], [], []
+
+    def each(x):
+        v, w = layout.uav_velocities(x), layout.payload_velocity(x)
+        omega = layout.payload_body_rates(x)
+        nodes, speeds = layout.chain_positions(x), layout.chain_velocities(x)
+        energies.append(0.5 * vehicle.mass * (v * v).sum()
+                        + vehicle.mass * G * layout.uav_positions(x)[:, 2].sum()
+                        + 0.5 * s.payload.mass * w @ w
+                        + s.payload.mass * G * layout.payload_position(x)[2]
+                        + 0.5 * omega @ (inertia * omega)
+                        + 0.5 * node * (speeds * speeds).sum() + node * G * nodes[..., 2].sum())
+        works.append(float(lift @ (layout.uav_positions(x)[:, 2] - start)))
+        rates.append(float(np.linalg.norm(omega)))
+
+    fly(sim, [np.full(vehicle.n_rotors, speed) for speed in speeds], each)
+    change = np.array(energies) - energies[0]
+    return (float(np.abs(change - np.array(works)).max()), float(np.abs(change).max()),
+            max(rates), sim.stats.max_abs_constraint)
+
+
 def main() -> None:
     print('hanging chain, L = 2.5 m, mu = 0.1 kg/m: omega measured / continuous - 1')
     for links in (10, 25, 40):
@@ -206,6 +253,11 @@ def main() -> None:
         print(f'  N = {links:3d} a cable: {measured:.4f} m against {sag:.4f} m '
               f'({measured / sag - 1:+.4f}; the rigid V {straight:.4f} m)')
     period, expected, count = pendulum()
+    mismatch, change, turn, worst = beam_energy()
+    print(f'beam_lift\'s beam on 10-link chains, rotors at 1900 and 1890 rad/s, 5 s: energy '
+          f'change {change:.1f} J, the rotors\' work less it {mismatch:.2e} J '
+          f'({mismatch / change:.1e}), the beam turning up to {turn:.3f} rad/s, '
+          f'max |g| {worst:.1e} m^2')
     drift, throw, reach, worst = free_fall_energy(attach_point=(0.1, 0.05, -0.1))
     print(f'the same held 0.1, 0.05, -0.1 m off the UAV\'s centre: energy kept to '
           f'{drift:.2e} J ({drift / throw:.1e}), folded to {reach:.3f} m, max |g| {worst:.1e}')

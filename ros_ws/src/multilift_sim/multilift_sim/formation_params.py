@@ -189,7 +189,7 @@ class StateLayout:
         return self._chain_blocks(x)[..., slots.NODE_VELOCITY:slots.NODE_VELOCITY + 3]
 
     def _chain_blocks(self, x: np.ndarray) -> np.ndarray:
-        start = slots.chain_node_slot(self.n_uavs, self.chain_nodes, 0, 1)
+        start = slots.chain_node_slot(self.size, self.n_uavs, self.chain_nodes, 0, 1)
         return x[..., start:start + slots.NODE_STATE * self.n_uavs * self.chain_nodes].reshape(
             x.shape[:-1] + (self.n_uavs, self.chain_nodes, slots.NODE_STATE))
 

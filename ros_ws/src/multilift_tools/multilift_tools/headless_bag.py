@@ -119,7 +119,7 @@ class EngineBag:
         self._held = flat[-1].copy()
         previous_count = flat.shape[1]
         odometry = odometry.tolist()
-        layout = StateLayout(n, chain_nodes=self._chain_nodes)
+        layout = StateLayout(n, self._rigid, self._chain_nodes)
         euler = layout.uav_euler(states).tolist()
         chains = layout.chain_positions(states) if self._chain_nodes else [None] * count
         payload_position = layout.payload_position(states).tolist()
@@ -177,7 +177,7 @@ class EngineBag:
         state = memory.state[0]
         _, odometry = state_rows(state[None], n)
         odometry = odometry[0].tolist()
-        layout = StateLayout(n, chain_nodes=self._chain_nodes)
+        layout = StateLayout(n, self._rigid, self._chain_nodes)
         payload_position = layout.payload_position(state).tolist()
         measured = measured_odometry(engine.measured()[:1])[0].tolist() if self._sensors \
             else None

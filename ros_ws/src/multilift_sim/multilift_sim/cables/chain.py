@@ -53,10 +53,9 @@ def drag_per_length(keys: dict[str, Any]) -> float:
 
 
 def check(scenario: Any) -> str | None:
-    """A point payload (held at the UAVs' attach points), no UAV prescribed (no winch: REELS),
-    the chains' transverse waves stepped at omega h <= ELASTIC_OMEGA_H (`chain_stepping`)."""
-    if scenario.payload.type != 'point':
-        return 'cable_model: chain is for a point payload'
+    """A point or rigid payload (the UAVs' attach points too), no UAV prescribed (no winch:
+    REELS), the chains' transverse waves stepped at omega h <= ELASTIC_OMEGA_H
+    (`chain_stepping`)."""
     if scenario.prescribed:
         return ('cable_model: chain is not for a formation with prescribed UAVs '
                 '(uavs[i].trajectory)')

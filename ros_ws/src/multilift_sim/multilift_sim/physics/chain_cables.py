@@ -1,7 +1,8 @@
 """Heavy cables (`cable_model: chain`, issue 32 item 2): each cable a chain of N rigid links
-between its UAV (node 0) and the point payload (node N), with N - 1 point masses
-between them (node k of cable i, its state at `chain_node_slot(n, N - 1, i, k)`). World frame
-(z up), SI units; slots: `physics.layout` (NODE_*, CHAIN_*, UAV_NODE_MASS, UAV_NODE_DRAG,
+between its UAV (node 0) and the payload (node N: a point payload's centre, or a rigid one's
+attach point, physics.chain_payload), with N - 1 point masses between them (node k of cable
+i, its state at `chain_node_slot(len(x), n, N - 1, i, k)`). World frame (z up), SI units;
+slots: `physics.layout` (NODE_*, CHAIN_*, UAV_NODE_MASS, UAV_NODE_DRAG,
 FORMATION_CHAIN_LINKS). docs/cables.md, "Heavy cables".
 
 Node 0 is UAV i's attach point r_i + R_i a_i where its cable holds it off its centre (issue
@@ -48,7 +49,11 @@ from multilift_sim.physics.layout import (BODY_RATES, CHAIN_LINK_COLUMNS, CHAIN_
                                           FORMATION_TWO_ALPHA, FORMATION_WIND, NODE_POSITION,
                                           NODE_VELOCITY, POSITION, UAV_LENGTH_SQ, UAV_MASS,
                                           UAV_NODE_DRAG, UAV_NODE_MASS)
-from multilift_sim.physics.state_slots import (chain_node_slot, payload_slot, rates_slot,
+from multilift_sim.physics.attitude import quaternion_rotation
+from multilift_sim.physics.chain_payload import (payload_ends, payload_moment,
+                                                 rigid_payload_acceleration)
+from multilift_sim.physics.state_slots import (attitude_slot, chain_node_slot, payload_slot,
+                                               rates_slot, rigid_payload_state,
                                                uav_attitude_slot, uav_slot)
 
 
@@ -79,7 +84,7 @@ def node_point(x, n, inner, i, k, p, nq):
         return r, nq + r
     if k == inner + 1:
         return p, nq + p
-    base = chain_node_slot(n, inner, i, k)
+    base = chain_node_slot(x.shape[0], n, inner, i, k)
     return base + NODE_POSITION, base + NODE_VELOCITY
 
 
@@ -108,6 +113,16 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
     # pull's moment arm k_i = a_i x R_i^T d_i1 [m^2], body FLU, and the UAV's thrust [m/s^2]
     attach = np.zeros((n, 3, 3))
     moments = np.zeros((n, 3))
+    # a rigid payload (physics.chain_payload): each cable's end on it (e_i, its rate, its
+    # centripetal acceleration), the last links' (d_iN, u_iN, w_iN) and their moment arms c_i
+    rigid = rigid_payload_state(x.shape[0], n)
+    ends = np.zeros((n, 3, 3))
+    last_links = np.empty((n, 5))
+    payload_moments = np.zeros((n, 3))
+    payload_rotation = np.eye(3)
+    if rigid:
+        payload_rotation = quaternion_rotation(x, attitude_slot(n))
+        payload_ends(x, uavs, payload_rotation, ends)
     thrusts = np.empty((n, 3))
     rotation = np.empty((3, 3))
     payload_mass = formation[FORMATION_PAYLOAD_MASS]
@@ -150,6 +165,9 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                 dx, dy, dz = dx - attach[i, 0, 0], dy - attach[i, 0, 1], dz - attach[i, 0, 2]
                 dvx, dvy, dvz = (dvx - attach[i, 1, 0], dvy - attach[i, 1, 1],
                                  dvz - attach[i, 1, 2])
+            if k == links and rigid:  # to the payload's attach point
+                dx, dy, dz = dx + ends[i, 0, 0], dy + ends[i, 0, 1], dz + ends[i, 0, 2]
+                dvx, dvy, dvz = dvx + ends[i, 1, 0], dvy + ends[i, 1, 1], dvz + ends[i, 1, 2]
             row = lk[k - 1]
             put3(row, CHAIN_LINK_OFFSET, dx, dy, dz)
             offset_sq = dx * dx + dy * dy + dz * dz
@@ -170,6 +188,10 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                 free_x += nd[k, CHAIN_NODE_FREE]
                 free_y += nd[k, CHAIN_NODE_FREE + 1]
                 free_z += nd[k, CHAIN_NODE_FREE + 2]
+            elif rigid:  # the payload's end's centripetal part, w x (w x e_i)
+                free_x += ends[i, 2, 0]
+                free_y += ends[i, 2, 1]
+                free_z += ends[i, 2, 2]
             row[CHAIN_LINK_U] = dx * free_x + dy * free_y + dz * free_z - target
             row[CHAIN_LINK_W] = 1.0 if k == links else 0.0
             if k > 1:  # A[k - 1, k] = -2 d_(k-1) . d_k / m_(k-1), their shared node's
@@ -194,6 +216,12 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
             row[CHAIN_LINK_W] = (row[CHAIN_LINK_W] - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_W]) \
                 / row[CHAIN_LINK_DIAGONAL]
         dx, dy, dz = get3(lk[last], CHAIN_LINK_OFFSET)
+        if rigid:  # the 6 x 6 system's terms (physics.chain_payload)
+            put3(last_links[i], 0, dx, dy, dz)
+            last_links[i, 3], last_links[i, 4] = lk[last, CHAIN_LINK_U], lk[last, CHAIN_LINK_W]
+            c0, c1, c2 = payload_moment(uavs, i, payload_rotation, dx, dy, dz)
+            put3(payload_moments[i], 0, c0, c1, c2)
+            continue
         w2, u2 = 2.0 * lk[last, CHAIN_LINK_W], 2.0 * lk[last, CHAIN_LINK_U]
         s00 += w2 * dx * dx
         s01 += w2 * dx * dy
@@ -204,24 +232,30 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         b0 -= u2 * dx
         b1 -= u2 * dy
         b2 -= u2 * dz
-    # a_p = S^-1 b by the adjugate of the symmetric 3 x 3 S (gravity excluded)
-    c00 = s11 * s22 - s12 * s12
-    c01 = s02 * s12 - s01 * s22
-    c02 = s01 * s12 - s02 * s11
-    c11 = s00 * s22 - s02 * s02
-    c12 = s01 * s02 - s00 * s12
-    c22 = s00 * s11 - s01 * s01
-    inv_det = 1.0 / (s00 * c00 + s01 * c01 + s02 * c02)
-    ap_x = (c00 * b0 + c01 * b1 + c02 * b2) * inv_det
-    ap_y = (c01 * b0 + c11 * b1 + c12 * b2) * inv_det
-    ap_z = (c02 * b0 + c12 * b1 + c22 * b2) * inv_det
+    turn = np.zeros(6)   # a rigid payload's (a_p, alpha_p)
+    if rigid:
+        rigid_payload_acceleration(x, formation, np.array([drag_ax, drag_ay, drag_az]),
+                                   last_links, payload_moments, acc, turn)
+        ap_x, ap_y, ap_z = turn[0], turn[1], turn[2]
+    else:  # a_p = S^-1 b by the adjugate of the symmetric 3 x 3 S (gravity excluded)
+        c00 = s11 * s22 - s12 * s12
+        c01 = s02 * s12 - s01 * s22
+        c02 = s01 * s12 - s02 * s11
+        c11 = s00 * s22 - s02 * s02
+        c12 = s01 * s02 - s00 * s12
+        c22 = s00 * s11 - s01 * s01
+        inv_det = 1.0 / (s00 * c00 + s01 * c01 + s02 * c02)
+        ap_x = (c00 * b0 + c01 * b1 + c02 * b2) * inv_det
+        ap_y = (c01 * b0 + c11 * b1 + c12 * b2) * inv_det
+        ap_z = (c02 * b0 + c12 * b1 + c22 * b2) * inv_det
     acc[p], acc[p + 1], acc[p + 2] = ap_x, ap_y, ap_z - gravity
     for i in range(n):
         lk = link_rows[i]
         nd = node_rows[i]
         last = links - 1
         along = (lk[last, CHAIN_LINK_OFFSET] * ap_x + lk[last, CHAIN_LINK_OFFSET + 1] * ap_y
-                 + lk[last, CHAIN_LINK_OFFSET + 2] * ap_z)
+                 + lk[last, CHAIN_LINK_OFFSET + 2] * ap_z + payload_moments[i, 0] * turn[3]
+                 + payload_moments[i, 1] * turn[4] + payload_moments[i, 2] * turn[5])
         for k in range(links):  # lambda_k = u_k + (d_N . a_p) w_k, into CHAIN_LINK_U
             lk[k, CHAIN_LINK_U] += along * lk[k, CHAIN_LINK_W]
         multipliers[i] = lk[0, CHAIN_LINK_U] / links   # T_i / (2 l_i) = 2 s_i lambda_1 / (2 l_i)
@@ -262,6 +296,10 @@ def chain_residuals(x, uavs, inner, g, g_dot):
     p = payload_slot(n)
     nq = rates_slot(n)
     attach = np.zeros((3, 3))
+    rigid = rigid_payload_state(x.shape[0], n)
+    ends = np.zeros((n, 3, 3))
+    if rigid:  # the last links end at the payload's attach points
+        payload_ends(x, uavs, quaternion_rotation(x, attitude_slot(n)), ends)
     for i in range(n):
         link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)
         worst = worst_rate = 0.0
@@ -276,6 +314,9 @@ def chain_residuals(x, uavs, inner, g, g_dot):
             if k == 1 and off_centre:
                 dx, dy, dz = dx - attach[0, 0], dy - attach[0, 1], dz - attach[0, 2]
                 dvx, dvy, dvz = dvx - attach[1, 0], dvy - attach[1, 1], dvz - attach[1, 2]
+            if k == links and rigid:
+                dx, dy, dz = dx + ends[i, 0, 0], dy + ends[i, 0, 1], dz + ends[i, 0, 2]
+                dvx, dvy, dvz = dvx + ends[i, 1, 0], dvy + ends[i, 1, 1], dvz + ends[i, 1, 2]
             value = dx * dx + dy * dy + dz * dz - link_sq
             rate = 2.0 * (dx * dvx + dy * dvy + dz * dvz)
             if abs(value) >= abs(worst):

@@ -251,12 +251,12 @@ def residuals(x, uavs, g, g_dot):
     n = uavs.shape[0]
     p = payload_slot(n)
     nq = rates_slot(n)
+    inner = chain_inner_nodes(x.shape[0], n)
+    if inner > 0:  # a chain's worst link per cable (chain_cables), a point or rigid payload
+        chain_residuals(x, uavs, inner, g, g_dot)
+        return
     if rigid_payload_state(x.shape[0], n):
         rigid_residuals(x, uavs, g, g_dot)
-        return
-    inner = chain_inner_nodes(x.shape[0], n)
-    if inner > 0:  # a chain's worst link per cable (chain_cables)
-        chain_residuals(x, uavs, inner, g, g_dot)
         return
     for i in range(n):
         b = uav_slot(i) + POSITION

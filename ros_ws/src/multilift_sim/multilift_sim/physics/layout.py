@@ -68,35 +68,40 @@ def attitude_slot(n_uavs: int) -> int:
 
 # a heavy cable's inner nodes (`cable_model: chain`, physics.chain_cables): each cable of N
 # links has N - 1 point masses between its UAV and the payload, node k (1 .. N - 1) from the
-# UAV; their blocks follow a point payload's state (after the UAVs' attitude blocks), cable
-# by cable, node by node, each its position [m] then its velocity [m/s], world (z up)
+# UAV; their blocks end the state (after the attitude blocks: the UAVs', a rigid payload's),
+# cable by cable, node by node, each its position [m] then its velocity [m/s], world (z up)
 NODE_POSITION = 0           # r_ik [m] (3 slots)
 NODE_VELOCITY = 3           # r_ik_dot [m/s] (3)
 NODE_STATE = 6              # a node's block
 
 
-def chain_node_slot(n_uavs: int, inner_nodes: int, i: int, k: int) -> int:
-    """Offset of cable i's node k (1 .. inner_nodes, from the UAV) in x, each cable holding
-    `inner_nodes` = N - 1 inner nodes (`cable_model: chain`)."""
-    return (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES) + BODY_ATTITUDE * n_uavs
-            + NODE_STATE * (inner_nodes * i + k - 1))
+def chain_node_slot(size: int, n_uavs: int, inner_nodes: int, i: int, k: int) -> int:
+    """Offset of cable i's node k (1 .. inner_nodes, from the UAV) in a state x of length
+    `size`, each cable holding `inner_nodes` = N - 1 inner nodes (`cable_model: chain`): the
+    node blocks end the state."""
+    return size - NODE_STATE * (inner_nodes * n_uavs - (inner_nodes * i + k - 1))
 
 
 def chain_inner_nodes(size: int, n_uavs: int) -> int:
     """The inner nodes per cable (N - 1) a state of length `size` holds for n UAVs: 0 but for
-    a chain's state, a point payload's plus n (N - 1) node blocks (a rigid payload's adds
-    PAYLOAD_ATTITUDE = 7, never a multiple of NODE_STATE n)."""
+    a chain's state, a point payload's (a rigid payload's with its PAYLOAD_ATTITUDE = 7) plus
+    n (N - 1) node blocks of NODE_STATE = 6 (7 is 1 more than a multiple of 6: the two
+    cannot be confused)."""
     extra = size - (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
                     + BODY_ATTITUDE * n_uavs)
+    if extra % NODE_STATE == PAYLOAD_ATTITUDE % NODE_STATE:
+        extra -= PAYLOAD_ATTITUDE
     if extra <= 0 or extra % (NODE_STATE * n_uavs) != 0:
         return 0
     return extra // (NODE_STATE * n_uavs)
 
 
 def rigid_payload_state(size: int, n_uavs: int) -> bool:
-    """Whether a state of length `size` for n UAVs holds a rigid payload's attitude block."""
-    return size == (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
-                    + BODY_ATTITUDE * n_uavs + PAYLOAD_ATTITUDE)
+    """Whether a state of length `size` for n UAVs holds a rigid payload's attitude block
+    (PAYLOAD_ATTITUDE = 7 after the UAVs' blocks, a chain's node blocks of 6 after it)."""
+    extra = size - (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
+                    + BODY_ATTITUDE * n_uavs)
+    return extra > 0 and extra % NODE_STATE == PAYLOAD_ATTITUDE % NODE_STATE
 
 
 # -- the seed's generalised coordinates q_f (Eq. 2.41): the analysis' minimal coordinates -----

@@ -140,7 +140,7 @@ def run_add_sag(run: np.ndarray, state: np.ndarray, n: int, inner: int) -> None:
         chord_sq = cx * cx + cy * cy + cz * cz
         sag = 0.0
         for k in range(1, inner + 1):
-            at = chain_node_slot(n, inner, i, k)
+            at = chain_node_slot(state.shape[0], n, inner, i, k)
             ex, ey, ez = state[at] - state[r], state[at + 1] - state[r + 1], \
                 state[at + 2] - state[r + 2]
             along = (ex * cx + ey * cy + ez * cz) / chord_sq if chord_sq > 0.0 else 0.0

@@ -128,7 +128,8 @@ def test_the_imu_measures_the_specific_force_and_rate_of_a_known_motion():
 
 
 def test_motion_capture_delivers_samples_latency_ticks_late_and_the_first_at_once():
-    settings = mocap.MocapSettings(0.0, 0.0, 0.03, 0.0, latency_ticks=3)
+    settings = mocap.MocapSettings(position_noise=0.0, attitude_noise=0.0, latency=0.03,
+                                   dropout=0.0, latency_ticks=3)
     every, ticks = 2, 14
     memory = mocap.memory(settings)
     draws = np.zeros((ticks, mocap.DRAW_COLUMNS))
@@ -261,8 +262,10 @@ def test_every_estimation_function_compiled_equals_its_source_bit_for_bit():
                         m.sensor_memory[0, mocap_row, 0], 151, truth,
                         np.zeros(MEASURED_COLUMNS)),
         gnss.measure: (np.array([2.0, 3.0]), np.ones((100, gnss.DRAW_COLUMNS)),
-                       gnss.memory(gnss.GnssSettings(1.0, 2.0, 0.1, 0.0, 0.0, 3)), 151, truth,
-                       np.zeros(MEASURED_COLUMNS))}
+                       gnss.memory(gnss.GnssSettings(
+                           horizontal_position_noise=1.0, vertical_position_noise=2.0,
+                           velocity_noise=0.1, latency=0.0, dropout=0.0, latency_ticks=3)),
+                       151, truth, np.zeros(MEASURED_COLUMNS))}
     met = set()
     for name, function in _compiled_functions().items():
         short = name.rsplit('.', 1)[1]
@@ -317,7 +320,8 @@ def test_gnss_draws_its_datasheet_noise_and_delivers_latency_ticks_late():
     sigma = rows[:, :, gnss.DRAW_ERROR:gnss.DRAW_ERROR + 6].reshape(-1, 6).std(axis=0)
     cep = 2.5 / math.sqrt(2.0 * math.log(2.0))
     assert np.allclose(sigma, [cep, cep, 2 * cep, 0.05, 0.05, 0.05], rtol=0.02)
-    settings = gnss.GnssSettings(0.0, 0.0, 0.0, 0.03, 0.0, latency_ticks=3)
+    settings = gnss.GnssSettings(horizontal_position_noise=0.0, vertical_position_noise=0.0,
+                                 velocity_noise=0.0, latency=0.03, dropout=0.0, latency_ticks=3)
     memory = gnss.memory(settings)
     draws = np.zeros((10, gnss.DRAW_COLUMNS))
     draws[:, gnss.DRAW_DELIVERED] = 1.0

@@ -32,3 +32,14 @@ def test_the_estimates_lie_in_their_3_sigma_band_and_are_drawn(tmp_path):
     assert (tmp_path / 'plots' / 'estimation.png').stat().st_size > 0
     record_headless(scenario_io.load('twin_lift').with_duration(1.0), tmp_path / 'exact')
     assert lacks_estimates(load_run(tmp_path / 'exact'))
+
+
+def test_the_foxglove_layout_shows_each_estimate_beside_the_truth_only_with_an_estimator():
+    from multilift_tools.foxglove.layout import layout
+    config = layout(scenario_io.load('twin_lift_realistic'))['configById']
+    for i in (1, 2):
+        paths = [s['value'] for s in config[f'Plot!estimate{i}']['paths']]
+        assert paths == [f'/uav{i}/{topic}.pose.pose.position.{axis}'
+                         for topic in ('estimate', 'odom') for axis in 'xyz']
+    assert not any(key.startswith('Plot!estimate')
+                   for key in layout(scenario_io.load('twin_lift'))['configById'])

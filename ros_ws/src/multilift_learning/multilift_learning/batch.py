@@ -34,6 +34,7 @@ from multilift_learning.observations import (finished_observation, observation_n
 from multilift_learning.options import GROUND_BELOW_REST, TaskOptions
 from multilift_learning.tasks import Targets, task, task_scenario
 from multilift_sim.formation_params import StateLayout
+from multilift_sim.physics.layout import REEL_COMMAND
 from multilift_sim.scenario import Scenario
 from multilift_sim.start import cable_reach
 from multilift_sim.statistics.swing import equilibrium_point
@@ -94,11 +95,19 @@ class FormationBatch:
         self._expert_at: np.ndarray | None = None
         self._expert = np.zeros((self.batch, n * self.rotors))
         self._rate_commands = laws.runnable(body_rates.body_rate_commands)
+        self.reel_limits = _reel_limits(scenarios) if options.winch_actions else None  # (B, n)
+
+    @property
+    def uav_action_size(self) -> int:
+        """The length of one UAV's action: its rotors' speeds (or a collective thrust and
+        three body rates), then with winch_actions its reel rate."""
+        flight = self.rotors if self.options.action_mode == 'rotor_speeds' else 4
+        return flight + (self.reel_limits is not None)
 
     @property
     def action_size(self) -> int:
-        """The length of one formation's action."""
-        return self.n * (self.rotors if self.options.action_mode == 'rotor_speeds' else 4)
+        """The length of one formation's action (each UAV's `uav_action_size` in turn)."""
+        return self.n * self.uav_action_size
 
     # -------------------------------------------------------------------------- episodes
     def seed(self, seeds: list[int | None]) -> None:
@@ -127,15 +136,13 @@ class FormationBatch:
         [rad/s] and which sit at a vehicle limit (saturated), in this batch's action mode; the
         rate loop of thrust_body_rates at the measured `states` (B, n, UAV_STATE_SIZE), the
         engine's own by default."""
-        a = np.asarray(actions, dtype=float)
-        if a.shape != (self.batch, self.action_size):
-            raise ValueError(f'actions must be ({self.batch}, {self.action_size}) in '
-                             f'action_mode {self.options.action_mode!r}, got {a.shape}')
+        a = self._uav_actions(actions)
+        if self.reel_limits is not None:
+            a = a[:, :, :-1]   # the reel rates: `step`
         if self.options.action_mode == 'rotor_speeds':
-            speeds = centred(a.reshape(self.batch, self.n, self.rotors), self.speed_hover,
-                             self.speed_min, self.speed_max)
+            speeds = centred(a, self.speed_hover, self.speed_min, self.speed_max)
             return speeds, (speeds <= self.speed_min) | (speeds >= self.speed_max)
-        a = np.clip(a.reshape(self.batch, self.n, 4), -1.0, 1.0)
+        a = np.clip(a, -1.0, 1.0)
         # symmetric about hover (zero-mean exploration keeps the mean thrust), at least 0
         span = self.thrust_max - self.thrust_hover
         thrust = np.maximum(self.thrust_hover + a[:, :, 0] * span, 0.0)
@@ -147,6 +154,16 @@ class FormationBatch:
                             else np.ascontiguousarray(states, dtype=float),
                             rates, thrust, speeds, saturated)
         return speeds, saturated
+
+    def _uav_actions(self, actions: np.ndarray) -> np.ndarray:
+        """Actions (B, action_size) as (B, n, uav_action_size), or a ValueError."""
+        a = np.asarray(actions, dtype=float)
+        if a.shape != (self.batch, self.action_size):
+            raise ValueError(f'actions must be ({self.batch}, {self.action_size}) in '
+                             f'action_mode {self.options.action_mode!r}'
+                             f'{" with winch_actions" if self.reel_limits is not None else ""}'
+                             f', got {a.shape}')
+        return a.reshape(self.batch, self.n, self.uav_action_size)
 
     def actions(self, speeds: np.ndarray) -> np.ndarray:
         """Rotor speeds (B, n, rotors) [rad/s] -> `rotor_speeds` actions (B, n * rotors)."""
@@ -166,12 +183,21 @@ class FormationBatch:
             speeds, _ = self.engine.answer()
             self._expert[:] = self.actions(speeds)
             self._expert_at = tick.copy()
-        return self._expert.copy()
+        if self.reel_limits is None:
+            return self._expert.copy()
+        # with winch_actions: each UAV's reel rate as the scenario commands it now (events)
+        reels = self.engine.memory.reel[:, :, REEL_COMMAND] / self.reel_limits
+        return np.concatenate([self._expert.reshape(self.batch, self.n, self.rotors),
+                               reels[:, :, None]], axis=2).reshape(self.batch, -1)
 
     def step(self, actions: np.ndarray, which: np.ndarray | None = None) -> np.ndarray:
         """One control tick of every running formation (those in `which`) under `actions`;
         returns the rotor speeds commanded (B, n, rotors) [rad/s]."""
         speeds, saturated = self.speeds(actions)
+        if self.reel_limits is not None:  # each winch's reel rate [m/s] (physics.winch)
+            rows = slice(None) if which is None else np.asarray(which, dtype=bool)
+            rates = np.clip(self._uav_actions(actions)[:, :, -1], -1.0, 1.0) * self.reel_limits
+            self.engine.memory.reel[rows, :, REEL_COMMAND] = rates[rows]
         tension = self.engine.step_commanded(speeds, saturated, which)
         if which is None:
             self.tension[:] = tension
@@ -256,3 +282,14 @@ class FormationBatch:
         terminated = ended
         truncated = self.engine.finished & ~terminated
         return terminated, truncated, reasons
+
+
+def _reel_limits(scenarios: list[Scenario]) -> np.ndarray:
+    """Each UAV's winch's rate_limit (B, n) [m/s], or a ValueError naming winch_actions when a
+    UAV carries none."""
+    for s in scenarios:
+        bare = [i + 1 for i, u in enumerate(s.uavs) if u.winch is None]
+        if bare:
+            raise ValueError(f'winch_actions needs a winch on every UAV (uavs[i].winch): '
+                             f'scenario {s.name!r} has none on uav{bare[0]}')
+    return np.array([[u.winch.rate_limit for u in s.uavs] for s in scenarios])

@@ -32,7 +32,10 @@ class TaskOptions:
     the episode. tilt_limit_deg [deg]: a UAV tilted more (the angle between its thrust axis and
     the vertical) ends it. body_rate_limit [rad/s]: the body rate an action of 1 asks
     (thrust_body_rates). start_speed [m/s]: every body starts with one common velocity drawn
-    uniformly in a ball of this radius (0: at rest).
+    uniformly in a ball of this radius (0: at rest). winch_actions: each UAV's action gains a
+    last entry, its winch's reel rate (1: its rate_limit, paying out; -1 reeling in; physics.
+    winch keeps the acceleration limit and the stops): for a scenario whose every UAV carries a
+    winch (`uavs[i].winch`, e.g. winch_lower).
     """
     action_mode: str = 'rotor_speeds'
     normalise: bool = False
@@ -44,12 +47,14 @@ class TaskOptions:
     tilt_limit_deg: float = 60.0
     body_rate_limit: float = 1.0
     start_speed: float = 0.0
+    winch_actions: bool = False
 
     def __post_init__(self) -> None:
         one_of('action_mode', self.action_mode, ACTION_MODES)
         one_of('start', self.start, STARTS)
-        if not isinstance(self.normalise, bool):
-            raise ValueError(f'normalise must be True or False, got {self.normalise!r}')
+        for name in ('normalise', 'winch_actions'):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f'{name} must be True or False, got {getattr(self, name)!r}')
         _positive('duration', self.duration, allow_none=True)
         _at_least_zero('target_radius', self.target_radius)
         _positive('bound', self.bound)

@@ -91,8 +91,8 @@ class FormationParallelEnv(ParallelEnv):
     def expert_actions(self) -> dict[str, np.ndarray]:
         """The seed's controllers' answers, per agent (the baseline)."""
         flat = self.batch.expert_actions()[0]
-        rotors = self.action_per_agent
-        return {agent: flat[k * rotors:(k + 1) * rotors]
+        size = self.action_per_agent
+        return {agent: flat[k * size:(k + 1) * size]
                 for k, agent in enumerate(self.possible_agents)}
 
 

@@ -79,12 +79,12 @@ def scenario_of(source: str | Scenario, overrides: dict[str, Any] | None = None,
 
 
 def task_scenario(scenario: Scenario, task_name: str, start: str = 'rest') -> Scenario:
-    """The scenario as `task_name` flies it: its cables slack-capable (`cable_model: slack`:
+    """The scenario as `task_name` flies it: its cables slack-capable (`learning_cable_model`:
     a cable pulls, never pushes); with start 'rest' the payload hangs still at its rest place
     (no release swing; multilift_learning.options.STARTS); for hover, a leader with a mission
     hovers at its start for the whole duration (one segment at rest)."""
     task(task_name)
-    scenario = replace(scenario, cable_model='slack')
+    scenario = replace(scenario, cable_model=learning_cable_model(scenario))
     if start == 'rest':
         scenario = replace(scenario, payload=replace(scenario.payload, swing=0.0, alpha=0.0,
                                                      beta=0.0))
@@ -99,6 +99,16 @@ def task_scenario(scenario: Scenario, task_name: str, start: str = 'rest') -> Sc
                                                    segments=(hold,)))
 
 
+def learning_cable_model(scenario: Scenario) -> str:
+    """The cable model a learning task flies: the seed's rigid cables become `slack` (a cable
+    that pulls, never pushes), except on winches, which the slack model does not reel yet (a
+    reeled rigid cable stays bilateral: docs/learning.md); other models as they are (an
+    elastic rope pushes never)."""
+    if scenario.cable_model == 'rigid' and not scenario.winches:
+        return 'slack'
+    return scenario.cable_model
+
+
 def _seed_mission(scenario: Scenario) -> bool:
     """Whether the scenario's mission is the default source's (segments) for the leader."""
     return scenario.mission.type == 'segments' and scenario.mission.tracks == 'leader'
@@ -111,7 +121,7 @@ def task_scenario_yaml(source: str, task_name: str, start: str = 'rest',
     the same physics through ROS (`policy_node`)."""
     path, data = load_base(source)
     scenario = task_scenario(scenario_of(source, duration=duration), task_name, start)
-    data = dict(data, cable_model='slack')
+    data = dict(data, cable_model=scenario.cable_model)
     data['simulation'] = dict(data['simulation'], duration=scenario.simulation.duration)
     if start == 'rest':
         data['payload'] = {k: v for k, v in data['payload'].items()

@@ -243,12 +243,13 @@ def publish(constants, x, covariance, memory):
                 if jacobian[r, k] != 0.0:
                     for c in range(ERROR_SIZE):
                         product[r, c] += jacobian[r, k] * covariance[k, c]
-        for r in range(6):
+        for r in range(6):  # J (J P)^T = J P J^T (P symmetric), over J's nonzeros
             for c in range(6):
-                total = 0.0
-                for k in range(ERROR_SIZE):
-                    total += product[r, k] * jacobian[c, k]
-                memory[start + COVARIANCE_SIDE * r + c] = total
+                memory[start + COVARIANCE_SIDE * r + c] = 0.0
+            for k in range(ERROR_SIZE):
+                if jacobian[r, k] != 0.0:
+                    for c in range(6):
+                        memory[start + COVARIANCE_SIDE * r + c] += jacobian[r, k] * product[c, k]
     for j in range(3):
         memory[ESTIMATE_TWIST_COVARIANCE + COVARIANCE_SIDE * (3 + j) + 3 + j] += \
             constants[RATE_VARIANCE]

@@ -97,20 +97,19 @@ def propagate(x, covariance, accel, gyro, dt, gravity, noise):
                                     + 0.5 * a_world[j] * dt * dt)
         x[NOMINAL_VELOCITY + j] += a_world[j] * dt
     turn(x, NOMINAL_QUATERNION, rate[0], rate[1], rate[2])
-    # P = F P F^T + Q
+    # P = F P F^T + Q, as F (F P)^T (P symmetric), both products over F's nonzeros only
     fp = np.zeros((ERROR_SIZE, ERROR_SIZE))
     for r in range(ERROR_SIZE):
         for k in range(ERROR_SIZE):
             if f[r, k] != 0.0:
                 for c in range(ERROR_SIZE):
                     fp[r, c] += f[r, k] * covariance[k, c]
+    covariance[:, :] = 0.0
     for r in range(ERROR_SIZE):
-        for c in range(ERROR_SIZE):
-            total = 0.0
-            for k in range(ERROR_SIZE):
-                if f[c, k] != 0.0:
-                    total += fp[r, k] * f[c, k]
-            covariance[r, c] = total
+        for k in range(ERROR_SIZE):
+            if f[r, k] != 0.0:
+                for c in range(ERROR_SIZE):
+                    covariance[r, c] += f[r, k] * fp[c, k]
     accel_white = noise[NOISE_ACCEL] ** 2  # N^2 / dt per sample, through dt^2/2 and dt
     for j in range(3):
         p, v, a = ERROR_POSITION + j, ERROR_VELOCITY + j, ERROR_ATTITUDE + j

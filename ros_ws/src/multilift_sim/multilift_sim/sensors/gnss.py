@@ -13,14 +13,14 @@ that, velocity 0.05 m/s, 110 ms latency (PX4 EKF2's default EKF2_GPS_DELAY), non
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import MEASURED_POSITION, MEASURED_VELOCITY
-from multilift_sim.sensors.outputs import (OUTPUT, delayed_constants, delayed_memory,
-                                          delayed_sample)
+from multilift_sim.sensors.outputs import (OUTPUT, DelayedSettings, delayed_protocol,
+                                          delayed_sample, read_dropout)
 
 NAME = 'gnss'
 UNITS = {'horizontal_position_noise': 'm', 'vertical_position_noise': 'm',
@@ -39,23 +39,18 @@ OUTPUT_COLUMNS = 6
 DRAW_ERROR = 0              # its position and velocity errors [m, m/s] (6)
 DRAW_DELIVERED = 6          # 1.0: it arrives, 0.0: lost
 DRAW_COLUMNS = 7
-# its constants and memory: outputs.delayed_constants, delayed_memory (a delay line of the
-# true (p, v), rows of OUTPUT_COLUMNS)
 
 
-@dataclass(frozen=True)
-class GnssSettings:
+@dataclass(frozen=True, kw_only=True)
+class GnssSettings(DelayedSettings):
     horizontal_position_noise: float  # [m], standard deviation per horizontal axis
     vertical_position_noise: float    # [m]
     velocity_noise: float             # [m/s], per axis
-    latency: float                    # [s]
-    dropout: float                    # probability a sample is lost, in [0, 1)
-    latency_ticks: int = 0            # the latency in control ticks (`with_simulation`)
 
 
-def preset_values(d) -> dict:
-    """The key values of the section's `preset` (none: {})."""
-    return PRESETS.get(d.text('preset', 'none', choices=('none', *PRESETS)), {})
+# its preset_values, with_simulation, constants and memory: a delayed sensor's (outputs)
+preset_values, with_simulation, constants, memory = delayed_protocol(OUTPUT_COLUMNS,
+                                                                    PRESETS)
 
 
 def parse(d) -> GnssSettings:
@@ -65,21 +60,7 @@ def parse(d) -> GnssSettings:
         **{key: d.non_negative(key, preset.get(key, 0.0)) for key in (
             'horizontal_position_noise', 'vertical_position_noise', 'velocity_noise',
             'latency')},
-        dropout=d.number('dropout', preset.get('dropout', 0.0), lambda v: 0 <= v < 1,
-                         'must be within [0, 1)'))
-
-
-def with_simulation(settings: GnssSettings, simulation, every: int) -> GnssSettings:
-    """The settings with the latency in control ticks (the nearest)."""
-    return replace(settings, latency_ticks=int(round(settings.latency * simulation.control_rate)))
-
-
-def constants(settings: GnssSettings, every: int) -> np.ndarray:
-    return delayed_constants(settings.latency_ticks, every)
-
-
-def memory(settings: GnssSettings) -> np.ndarray:
-    return delayed_memory(OUTPUT_COLUMNS, settings.latency_ticks)
+        dropout=read_dropout(d, preset))
 
 
 def draws(settings: GnssSettings, n_uavs: int, samples: int, dt: float,
@@ -96,10 +77,9 @@ def draws(settings: GnssSettings, n_uavs: int, samples: int, dt: float,
 
 @jit
 def measure(constants, draws, memory, tick, truth, received):
-    """At control tick `tick`: the true position and velocity from `truth` into the delay
-    line; the sample taken `latency` ticks ago, if one was and is not lost, into the output
-    with its errors (ARRIVED this tick, TAKEN its tick); received left alone. A second call
-    at one tick changes nothing."""
+    """UAV truth's position and velocity at `tick` into the delay line and, when a sample
+    arrives now (`outputs.delayed_sample`: latency, dropouts, one call a tick), that sample
+    plus its errors into the output; received is left alone."""
     line, source, sample = delayed_sample(constants, draws[:, DRAW_DELIVERED], memory, tick,
                                           OUTPUT_COLUMNS)
     if line < 0:

@@ -23,8 +23,8 @@ from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import rotation_quaternion, quaternion_product
 from multilift_sim.physics.layout import MEASURED_EULER, MEASURED_POSITION
 from multilift_sim.physics.measurement import euler_quaternion
-from multilift_sim.sensors.outputs import (OUTPUT, delayed_constants, delayed_memory,
-                                          delayed_sample)
+from multilift_sim.sensors.outputs import (OUTPUT, DelayedSettings, delayed_protocol,
+                                          delayed_sample, read_dropout)
 
 NAME = 'mocap'
 UNITS = {'position_noise': 'm', 'attitude_noise': 'rad', 'latency': 's', 'dropout': '',
@@ -41,23 +41,18 @@ DRAW_POSITION = 0           # its position error [m] (3)
 DRAW_ATTITUDE = 3           # its attitude error [rad], body rotation vector (3)
 DRAW_DELIVERED = 6          # 1.0: it arrives, 0.0: lost
 DRAW_COLUMNS = 7
-# its constants and memory: outputs.delayed_constants, delayed_memory (a delay line of the
-# true poses (p, q), rows of OUTPUT_COLUMNS)
 
 
-@dataclass(frozen=True)
-class MocapSettings:
+@dataclass(frozen=True, kw_only=True)
+class MocapSettings(DelayedSettings):
     """Its keys."""
     position_noise: float            # [m], standard deviation per axis
     attitude_noise: float            # [rad], standard deviation per body axis
-    latency: float                   # [s] from a sample to its arrival
-    dropout: float                   # probability a sample is lost, in [0, 1)
-    latency_ticks: int = 0           # the latency in control ticks (`with_simulation`)
 
 
-def preset_values(d) -> dict:
-    """The key values of the section's `preset` (none: {})."""
-    return PRESETS.get(d.text('preset', 'none', choices=('none', *PRESETS)), {})
+# its preset_values, with_simulation, constants and memory: a delayed sensor's (outputs)
+preset_values, with_simulation, constants, memory = delayed_protocol(OUTPUT_COLUMNS,
+                                                                    PRESETS)
 
 
 def parse(d) -> MocapSettings:
@@ -67,22 +62,7 @@ def parse(d) -> MocapSettings:
         position_noise=d.non_negative('position_noise', preset.get('position_noise', 0.0)),
         attitude_noise=d.non_negative('attitude_noise', preset.get('attitude_noise', 0.0)),
         latency=d.non_negative('latency', preset.get('latency', 0.0)),
-        dropout=d.number('dropout', preset.get('dropout', 0.0), lambda v: 0 <= v < 1,
-                         'must be within [0, 1)'))
-
-
-def with_simulation(settings: MocapSettings, simulation, every: int) -> MocapSettings:
-    """The settings with the latency in control ticks (the nearest)."""
-    return MocapSettings(**{**settings.__dict__, 'latency_ticks': int(round(
-        settings.latency * simulation.control_rate))})
-
-
-def constants(settings: MocapSettings, every: int) -> np.ndarray:
-    return delayed_constants(settings.latency_ticks, every)
-
-
-def memory(settings: MocapSettings) -> np.ndarray:
-    return delayed_memory(OUTPUT_COLUMNS, settings.latency_ticks)
+        dropout=read_dropout(d, preset))
 
 
 def draws(settings: MocapSettings, n_uavs: int, samples: int, dt: float,
@@ -100,10 +80,9 @@ def draws(settings: MocapSettings, n_uavs: int, samples: int, dt: float,
 
 @jit
 def measure(constants, draws, memory, tick, truth, received):
-    """At control tick `tick`: the true pose from `truth` (MEASURED_COLUMNS,) into the delay
-    line; the sample taken `latency` ticks ago, if one was and is not lost, into the output
-    with its errors (ARRIVED this tick, TAKEN its tick); received left alone. A second call
-    at one tick changes nothing."""
+    """The pose of `truth` (MEASURED_COLUMNS,) at `tick`, its quaternion from the Euler
+    angles, into the delay line; a sample that arrives now (`outputs.delayed_sample`), its
+    position error added and its attitude turned by its error, into the output."""
     line, source, sample = delayed_sample(constants, draws[:, DRAW_DELIVERED], memory, tick,
                                           OUTPUT_COLUMNS)
     if line < 0:

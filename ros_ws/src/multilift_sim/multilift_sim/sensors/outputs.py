@@ -7,6 +7,8 @@ A sensor whose samples arrive late (`mocap`, `gnss`) keeps, after its output, th
 measured last and a delay line of its truths (`delayed_memory`); `delayed_sample` decides, at
 a tick, which row takes the truth and which sample (if any) arrives: the one place that
 logic is written."""
+from dataclasses import dataclass, replace
+
 import numpy as np
 
 from multilift_sim.kernels import jit
@@ -18,6 +20,42 @@ OUTPUT = 2       # the output itself, its model's slots (the model's OUTPUT_* na
 EVERY = 0        # control ticks between two samples
 LATENCY = 1      # control ticks from a sample to its arrival
 DELAYED_CONSTANT_COLUMNS = 2
+
+
+@dataclass(frozen=True, kw_only=True)
+class DelayedSettings:
+    """The keys every delayed sensor has (its own settings add theirs)."""
+    latency: float                   # [s] from a sample to its arrival
+    dropout: float                   # probability a sample is lost, in [0, 1)
+    latency_ticks: int = 0           # the latency in control ticks (`with_simulation`)
+
+
+def delayed_protocol(output_columns: int, presets: dict):
+    """(preset_values, with_simulation, constants, memory): the protocol functions
+    (`SENSOR_MODELS`) of a delayed sensor whose output has `output_columns` slots, whose
+    presets are `presets` (name -> key values) and whose settings are DelayedSettings."""
+    def preset_values(d) -> dict:
+        """The key values of the section's `preset` (none: {})."""
+        return presets.get(d.text('preset', 'none', choices=('none', *presets)), {})
+
+    def with_simulation(settings, simulation, every: int):
+        """The settings with the latency in control ticks (the nearest)."""
+        return replace(settings,
+                       latency_ticks=int(round(settings.latency * simulation.control_rate)))
+
+    def constants(settings, every: int) -> np.ndarray:
+        return delayed_constants(settings.latency_ticks, every)
+
+    def memory(settings) -> np.ndarray:
+        return delayed_memory(output_columns, settings.latency_ticks)
+
+    return preset_values, with_simulation, constants, memory
+
+
+def read_dropout(d, preset: dict) -> float:
+    """A delayed sensor's `dropout`: the probability a sample is lost, in [0, 1)."""
+    return d.number('dropout', preset.get('dropout', 0.0), lambda v: 0 <= v < 1,
+                    'must be within [0, 1)')
 
 
 def delayed_constants(latency_ticks: int, every: int) -> np.ndarray:

@@ -4,7 +4,8 @@ The layout has the 3D panel (the markers of /visualization/markers and the tf fr
 following `world`) beside plots, every series against its message's header stamp: every
 cable's tension, every UAV's rotor speeds (as many as its frame type has), the leader's position
 against its mission reference, every UAV's attitude set-point, and every follower's formation
-(virtual-constraint) errors, and where UAVs carry winches each one's cable length. A scenario
+(virtual-constraint) errors, where UAVs carry winches each one's cable length, and with an
+estimator each UAV's estimated position beside its true one. A scenario
 with `events:` has, under the 3D panel, the messages
 of /formation/events as they happen (docs/events.md).
 """
@@ -99,6 +100,15 @@ def layout(scenario) -> dict:
         plots['Plot!winches'] = _plot('Cable length [m] (/uav{i}/cable_length)', [
             _series(f'/uav{i}/cable_length.data', f'cable {i}', i - 1, 'receiveTime')
             for i in scenario.winches])
+    if scenario.estimator is not None:  # each UAV's estimated position beside the truth
+        for i in range(1, n + 1):
+            plots[f'Plot!estimate{i}'] = _plot(
+                f'uav{i} position [m]: estimate (/uav{i}/estimate) and truth (/uav{i}/odom)', [
+                    _series(f'/uav{i}/{topic}.pose.pose.position.{axis}', f'{label} {axis}',
+                            k + 3 * j)
+                    for j, (topic, label) in enumerate((('estimate', 'estimate'),
+                                                        ('odom', 'truth')))
+                    for k, axis in enumerate('xyz')])
     frames = ['world', 'payload'] + [f'uav{i}/base_link' for i in range(1, n + 1)]
     config = {'3D!multilift': _three_d(frames), **plots}
     scene: str | dict = '3D!multilift'

@@ -70,6 +70,8 @@ class Snapshot:
     # every UAV's estimate as /uav{i}/estimate carries it (n, ESTIMATE_COLUMNS:
     # estimators.published), None without an estimator
     estimate: np.ndarray | None = None
+    # heavy cables' inner nodes (n, N - 1, 3) [m], world (`cable_model: chain`), else None
+    chain_points: np.ndarray | None = None
 
 
 def stop_message(status: int, cable: int, value: float, t: float, sim, n_uavs: int) -> str:
@@ -229,7 +231,8 @@ class FormationSimulator:
                         layout.payload_velocity(state).copy(), odometry, measured, attitude,
                         self.memory.reel[0, :, REEL_LENGTH].copy(),
                         self.memory.estimator_memory[0, 0, :, :ESTIMATE_COLUMNS].copy()
-                        if self.memory.estimator_memory.shape[1] else None)
+                        if self.memory.estimator_memory.shape[1] else None,
+                        layout.chain_positions(state).copy() if layout.chain_nodes else None)
 
     # ------------------------------------------------------------------------- the cables
     def cable_state(self, rotor_speeds: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray,

@@ -45,7 +45,10 @@ RUN_PEAK_TENSION = 5        # its rope's largest tension T_i [N] (cable_model: e
 RUN_SHORTEST_CABLE = 6      # its cable's shortest length l_i [m] reeled by its winch (+inf:
 #                             none yet, and in every run without winches)
 RUN_LONGEST_CABLE = 7       # its cable's longest length [m] (-inf)
-RUN_UAV_COLUMNS = 8
+RUN_MAX_SAG = 8             # its chain's largest sag [m]: an inner node's distance from the
+#                             chord UAV -> payload (cable_model: chain; -inf: none, and in
+#                             every other cable model's run)
+RUN_UAV_COLUMNS = 9
 
 
 def run_size(n_uavs: int) -> int:

@@ -137,6 +137,8 @@ def test_the_accumulators_compiled_and_uncompiled_agree(n):
         _same(accumulators.run_add_tensions, run, tension)
         _same(accumulators.run_add_ropes, run, rng.normal(size=StateLayout(n).size),
               rng.uniform(0.5, 2.0, n), tension)
+        _same(accumulators.run_add_sag, run, rng.normal(size=StateLayout(n, chain_nodes=4).size),
+              n, 4)
         _same(accumulators.run_add_reel, run, rng.uniform(0.5, 2.0, (n, REEL_COLUMNS)),
               rng.uniform(0.5, 2.0, n))
         _same(accumulators.run_add_slack, run, rng.random(n) < 0.5, 0.01)

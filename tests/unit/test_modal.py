@@ -26,7 +26,8 @@ from multilift_tools.modal_cli import modal_main
 
 SCENARIO_NAMES = sorted(p.stem for p in SCENARIOS.glob('*.yaml')
                         if 'rigid_body' not in p.read_text()  # point (bodies: test_modal_rigid)
-                        and 'cable_model: elastic' not in p.read_text())  # refused (below)
+                        and 'cable_model: elastic' not in p.read_text()  # refused (below)
+                        and 'cable_model: chain' not in p.read_text())
 
 
 def load(name: str) -> scenario_io.Scenario:
@@ -258,6 +259,16 @@ def test_modal_main_bad_scenario_is_one_line_and_exit_2(tmp_path, capsys):
     assert err.count('\n') == 1 and err.startswith('error: ')
     assert modal_main([]) == 2
     assert capsys.readouterr().err.count('\n') == 1
+    assert not any(tmp_path.iterdir())
+
+
+def test_modal_main_refuses_chain_cables_in_one_line(tmp_path, capsys):
+    """Heavy cables' inner nodes are not linearised: one line, exit 2, nothing written."""
+    assert modal_main(['twin_lift_chain', '--out', str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert err.startswith('error: cable_model: chain: the modal analysis linearises massless '
+                          'cables')
     assert not any(tmp_path.iterdir())
 
 

@@ -80,7 +80,7 @@ class FormationModel:
 
     def __init__(self, params: FormationParams, null_space: bool = False):
         self.params = params
-        self.layout = StateLayout(params.n_uavs, params.rigid_payload)
+        self.layout = StateLayout(params.n_uavs, params.rigid_payload, params.chain_nodes)
         n = params.n_uavs
         self._n = n
         self._nq = self.layout.n_coordinates

@@ -17,7 +17,8 @@ from multilift_sim.multirotor import MultirotorParams
 from multilift_sim.physics import layout as slots
 from multilift_sim.physics.layout import (
     ACTUATOR_COLUMNS, ACTUATOR_RATE_LIMIT, ACTUATOR_TIME_CONSTANT, FORMATION_BETA_SQ,
-    FORMATION_DRAG, FORMATION_ELASTIC, FORMATION_GRAVITY, FORMATION_INV_PAYLOAD_MASS,
+    FORMATION_CHAIN_LINKS, FORMATION_DRAG, FORMATION_ELASTIC, FORMATION_GRAVITY,
+    FORMATION_INV_PAYLOAD_MASS,
     FORMATION_NULL_SPACE, FORMATION_PAYLOAD_INERTIA, FORMATION_PAYLOAD_MASS,
     FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
     FORMATION_SCALARS, FORMATION_TIME, FORMATION_WINCH, UAV_WINCH_ACCELERATION_LIMIT,
@@ -25,7 +26,7 @@ from multilift_sim.physics.layout import (
     FORMATION_SUBSTEPS, FORMATION_TWO_ALPHA, FORMATION_WIND, GUST_CENTER, GUST_COLUMNS,
     GUST_DIRECTION, GUST_GRADIENT_DISTANCE, GUST_REFERENCE_SPEED, UAV_ATTACH,
     UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS, UAV_COLUMNS, UAV_DRAG, UAV_GYRO, UAV_INV_INERTIA,
-    UAV_LENGTH_SQ, UAV_MASS, UAV_PAYLOAD_ATTACH)
+    UAV_LENGTH_SQ, UAV_MASS, UAV_NODE_DRAG, UAV_NODE_MASS, UAV_PAYLOAD_ATTACH)
 from multilift_sim.wind.gusts import Gust
 
 
@@ -59,6 +60,12 @@ class FormationParams:
     drives: tuple[Any, ...] | None = None
     # winches (issue 32; physics.winch): each UAV's cables.winch.Winch or None (None: no winch)
     winches: tuple[Any, ...] | None = None
+    # heavy cables (`cable_model: chain`, physics.chain_cables): N links a cable (0: none), its
+    # mass per length mu [kg/m] (the N - 1 inner nodes carry mu l_i / (N - 1) each) and its
+    # drag per length 0.5 rho C_d d [kg/m^2] (a node's drag: that times l_i / N)
+    chain_links: int = 0
+    cable_mass_per_length: float = 0.0
+    cable_drag_per_length: float = 0.0
 
     def __post_init__(self) -> None:
         uavs = tuple(self.uavs)
@@ -132,6 +139,11 @@ class FormationParams:
         """Whether the payload is a rigid body (its attitude in the state)."""
         return self.payload_inertia is not None
 
+    @property
+    def chain_nodes(self) -> int:
+        """Inner nodes per cable (N - 1 of a chain's N links; 0: no chain)."""
+        return max(0, self.chain_links - 1)
+
 
 @dataclass(frozen=True)
 class StateLayout:
@@ -149,6 +161,7 @@ class StateLayout:
 
     n_uavs: int
     rigid_payload: bool = False
+    chain_nodes: int = 0    # each cable's inner nodes (`cable_model: chain`: N - 1), after all
 
     def __post_init__(self) -> None:
         if self.n_uavs < 1:
@@ -161,9 +174,24 @@ class StateLayout:
 
     @property
     def size(self) -> int:
-        """Length of the state x: 2 (3n + 3) + 7n, plus 7 with a rigid payload."""
+        """Length of the state x: 2 (3n + 3) + 7n, plus 7 with a rigid payload, plus a chain's
+        6 n (N - 1) (its inner nodes' blocks)."""
         return slots.attitude_slot(self.n_uavs) + (
-            slots.BODY_ATTITUDE if self.rigid_payload else 0)
+            slots.BODY_ATTITUDE if self.rigid_payload else 0) + (
+                slots.NODE_STATE * self.n_uavs * self.chain_nodes)
+
+    def chain_positions(self, x: np.ndarray) -> np.ndarray:
+        """A chain's inner nodes' positions [m], world, shape (n, N - 1, 3)."""
+        return self._chain_blocks(x)[..., slots.NODE_POSITION:slots.NODE_POSITION + 3]
+
+    def chain_velocities(self, x: np.ndarray) -> np.ndarray:
+        """A chain's inner nodes' velocities [m/s], world, shape (n, N - 1, 3)."""
+        return self._chain_blocks(x)[..., slots.NODE_VELOCITY:slots.NODE_VELOCITY + 3]
+
+    def _chain_blocks(self, x: np.ndarray) -> np.ndarray:
+        start = slots.chain_node_slot(self.size, self.n_uavs, self.chain_nodes, 0, 1)
+        return x[..., start:start + slots.NODE_STATE * self.n_uavs * self.chain_nodes].reshape(
+            x.shape[:-1] + (self.n_uavs, self.chain_nodes, slots.NODE_STATE))
 
     def coordinates(self, x: np.ndarray) -> np.ndarray:
         """q, the translations (r_1, ..., r_n, r_p) [m], shape (3n + 3,)."""
@@ -310,6 +338,12 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
             uavs[i, [UAV_WINCH_RATE_LIMIT, UAV_WINCH_ACCELERATION_LIMIT, UAV_WINCH_MIN_LENGTH,
                      UAV_WINCH_MAX_LENGTH]] = (winch.rate_limit, winch.acceleration_limit,
                                                winch.min_length, winch.max_length)
+    formation[FORMATION_CHAIN_LINKS] = float(params.chain_links)
+    lengths = np.array(params.cable_lengths)
+    uavs[:, UAV_NODE_MASS] = (params.cable_mass_per_length * lengths / params.chain_nodes
+                              if params.chain_nodes else 0.0)
+    uavs[:, UAV_NODE_DRAG] = (params.cable_drag_per_length * lengths / params.chain_links
+                              if params.chain_nodes else 0.0)
     if params.drives is not None:  # the drive table after the scalars (physics.layout DRIVE_*)
         from multilift_sim.drives import drive_table
         formation = np.concatenate([formation, drive_table(params.drives)])

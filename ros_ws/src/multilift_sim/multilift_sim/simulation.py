@@ -70,6 +70,8 @@ class Snapshot:
     # every UAV's estimate as /uav{i}/estimate carries it (n, ESTIMATE_COLUMNS:
     # estimators.published), None without an estimator
     estimate: np.ndarray | None = None
+    # heavy cables' inner nodes (n, N - 1, 3) [m], world (`cable_model: chain`), else None
+    chain_points: np.ndarray | None = None
     # the payload's estimate as /payload/estimate carries it (ESTIMATE_COLUMNS), None without
     # a payload estimator: what the controllers then read of the payload
     payload_estimate: np.ndarray | None = None
@@ -233,6 +235,7 @@ class FormationSimulator:
                         self.memory.reel[0, :, REEL_LENGTH].copy(),
                         self.memory.estimator_memory[0, 0, :, :ESTIMATE_COLUMNS].copy()
                         if self.memory.estimator_memory.shape[1] else None,
+                        layout.chain_positions(state).copy() if layout.chain_nodes else None,
                         self.memory.payload_estimator_memory[0, 0, :ESTIMATE_COLUMNS].copy()
                         if self.memory.payload_estimator_memory.shape[1] else None)
 

@@ -41,8 +41,42 @@ def initial_state(scenario: Scenario) -> np.ndarray:
     payload = scenario.payload
     if scenario.prescribed or payload.initial_position is not None \
             or payload.initial_velocity is not None:
-        return given_start(scenario, state)
+        state = given_start(scenario, state)
+    if scenario.cable_model == 'chain':
+        return chain_start(state, scenario.n_uavs, scenario.cable['links'],
+                           uav_offsets(scenario), scenario.payload.attach_points)
     return state
+
+
+def chain_start(state: np.ndarray, n: int, links: int, offsets: np.ndarray | None = None,
+                payload_points=None) -> np.ndarray:
+    """A point or rigid payload's state with each cable's N - 1 inner nodes appended
+    (`cable_model: chain`): on the straight line from where the cable holds its UAV (its
+    centre, or `offsets` (n, 3) [m] from it, world: `uav_offsets`, each UAV not turning at the
+    start) to where it holds the payload (its centre, or a rigid one's `payload_points` (n, 3)
+    [m], payload frame, turned by its attitude; the payload not turning at the start), node k
+    at k / N of it, moving as that line's point does (the rigid cable's start)."""
+    rigid = payload_points is not None
+    point = StateLayout(n, rigid)
+    layout = StateLayout(n, rigid, chain_nodes=links - 1)
+    out = np.zeros(layout.size)
+    out[:point.size] = state
+    uavs, payload = point.uav_positions(state), point.payload_position(state)
+    if offsets is not None:
+        uavs = uavs + offsets
+    ends = np.tile(payload, (n, 1))
+    if rigid:
+        w, x, y, z = point.payload_quaternion(state)
+        rotation = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                             [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                             [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+        ends = ends + np.asarray(payload_points, dtype=float) @ rotation.T
+    uav_velocities, payload_velocity = point.uav_velocities(state), point.payload_velocity(state)
+    share = (np.arange(1, links) / links)[None, :, None]
+    layout.chain_positions(out)[:] = uavs[:, None, :] + share * (ends - uavs)[:, None, :]
+    layout.chain_velocities(out)[:] = uav_velocities[:, None, :] + share * (
+        payload_velocity - uav_velocities)[:, None, :]
+    return out
 
 
 def given_start(scenario: Scenario, state: np.ndarray) -> np.ndarray:

@@ -61,8 +61,12 @@ VEHICLE_UNITS: dict[str, str] = {
 
 # an elastic rope's keys (`cable:` and `uavs[i].cable:`, multilift_sim.cables.elastic)
 ROPE_UNITS = {'stiffness': 'N/m', 'axial_stiffness': 'N', 'damping': 'N s/m'}
+# a heavy cable's keys (`cable:`, multilift_sim.cables.chain)
+CHAIN_UNITS = {'links': '', 'mass_per_length': 'kg/m', 'drag_coefficient': '',
+               'diameter': 'm'}
 # an elastic run's figures per cable (the summary's, not a sweep column)
 ROPE_FIGURE_UNITS = {'max_stretch': 'm', 'peak_tension': 'N'}
+CHAIN_FIGURE_UNITS = {'max_sag': 'm'}   # a chain run's figure per cable (cables.chain)
 # a winch's keys (`uavs[i].winch`, multilift_sim.cables.winch) and a winched run's figures
 WINCH_UNITS = {'rate_limit': 'm/s', 'acceleration_limit': 'm/s^2', 'min_length': 'm',
                'max_length': 'm'}
@@ -83,6 +87,7 @@ SCENARIO_UNITS: dict[str, str] = {
     'simulation.constraint_rate_tolerance': 'm^2/s', 'simulation.command_timeout': 's',
     'simulation.integrator': NO_UNIT, 'simulation.substeps': NO_UNIT,
     **{f'{where}cable.{k}': u for where in ('', 'uavs[].') for k, u in ROPE_UNITS.items()},
+    **{f'cable.{k}': u for k, u in CHAIN_UNITS.items()},
     **{f'vehicle.{k}': u for k, u in VEHICLE_UNITS.items()},
     **{f'uavs[].{k}': u for k, u in VEHICLE_UNITS.items()},
     'uavs[].cable_length': 'm', 'uavs[].position': 'm', 'uavs[].yaw': 'rad',
@@ -128,7 +133,8 @@ SCENARIO_UNITS: dict[str, str] = {
 }
 
 UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS,
-                         **ROPE_FIGURE_UNITS, **REEL_FIGURE_UNITS}
+                         **ROPE_FIGURE_UNITS, **REEL_FIGURE_UNITS,
+                         **CHAIN_FIGURE_UNITS}
 
 _INDEX = re.compile(r'\[\d+\]')
 _WIND_KEY = re.compile(r'^wind\.(\w+)\.(\w+)(?:\[\])?$')  # wind.<model>.<key>

@@ -15,19 +15,17 @@ import sys
 
 from multilift_sim.topics import GOAL
 from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp
-from multilift_tools.live_publish import publish_acknowledged
+from multilift_tools.live_publish import live_parser, publish_acknowledged
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog='multilift goal', description=__doc__.split('\n')[0])
+    parser = live_parser('goal', __doc__)
     for axis in 'XYZ':
         parser.add_argument(axis.lower(), type=float, metavar=axis, help=f'{axis} [m], world')
     parser.add_argument('--yaw', type=float, metavar='DEG',
                         help='heading [deg] (default: keep the current one)')
     parser.add_argument('--at', type=float, metavar='T',
                         help='simulated time [s] it takes effect (default: the latest /clock)')
-    parser.add_argument('--timeout', type=float, default=10.0, metavar='S',
-                        help='wall seconds to wait for the run (default 10)')
     return parser
 
 

@@ -83,6 +83,8 @@ class EngineBag:
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
         self._sensors = scenario.measures  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
+        # a heavy cable's inner nodes per cable (cable_model: chain; 0: none), in its markers
+        self._chain_nodes = scenario.cable['links'] - 1 if scenario.cable_model == 'chain' else 0
         # /formation/wind by tick (physics.tick.period_winds), where the air moves everywhere
         self._wind = None
         if scenario.has_wind:
@@ -119,8 +121,9 @@ class EngineBag:
         self._held = flat[-1].copy()
         previous_count = flat.shape[1]
         odometry = odometry.tolist()
-        layout = StateLayout(n)
+        layout = StateLayout(n, self._rigid, self._chain_nodes)
         euler = layout.uav_euler(states).tolist()
+        chains = layout.chain_positions(states) if self._chain_nodes else [None] * count
         payload_position = layout.payload_position(states).tolist()
         payload_velocity = layout.payload_velocity(states)
         poses = [None] * count
@@ -167,7 +170,7 @@ class EngineBag:
                                       errors[i][k] if i else None, rates[i][k] if i else None)
             write(messages, t_ns)
             self._formation(tick, t_ns, tension[k], g[k], g_dot[k], taut[k], odometry[k],
-                            euler[k], payload_position[k], orientations[k])
+                            euler[k], payload_position[k], orientations[k], chains[k])
 
     def last(self) -> None:
         """Write the state at t_max (the engine's current state, which nothing answers) and
@@ -178,7 +181,7 @@ class EngineBag:
         state = memory.state[0]
         _, odometry = state_rows(state[None], n)
         odometry = odometry[0].tolist()
-        layout = StateLayout(n)
+        layout = StateLayout(n, self._rigid, self._chain_nodes)
         payload_position = layout.payload_position(state).tolist()
         measured = measured_odometry(engine.measured()[:1])[0].tolist() if self._sensors \
             else None
@@ -204,7 +207,8 @@ class EngineBag:
         self._formation(tick, t_ns, tension.tolist(), memory.g[0].tolist(),
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
                         layout.uav_euler(state).tolist(), payload_position,
-                        None if pose is None else pose[0])
+                        None if pose is None else pose[0],
+                        layout.chain_positions(state) if self._chain_nodes else None)
 
     def _events_at(self, tick: int, t_ns: int) -> list:
         """/formation/events of the events that fall on `tick` (the state there shows them)."""
@@ -214,13 +218,13 @@ class EngineBag:
 
     def _formation(self, tick: int, t_ns: int, tension: list, g: list, g_dot: list,
                    taut: list, odometry: list, euler: list, payload_position: list,
-                   payload_orientation=None) -> None:
+                   payload_orientation=None, chain_points=None) -> None:
         """`/formation/state` of a tick and, every MARKER_DECIMATION-th, its markers."""
         messages = [self._simulator.formation_of(t_ns, tension, g, g_dot, taut)]
         if tick % MARKER_DECIMATION == 0:
             messages.append(self._simulator.markers_of(
                 t_ns, [u[:3] for u in odometry], euler, payload_position, tension, taut,
-                payload_orientation))
+                payload_orientation, chain_points))
         self._write(messages, t_ns)
 
 

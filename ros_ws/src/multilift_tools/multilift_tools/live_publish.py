@@ -10,6 +10,7 @@ the kept message).
 """
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from typing import Any, Callable
@@ -20,6 +21,15 @@ SETTLE = 0.5  # [s] without a new reader of the topic before the message is sent
 UNKNOWN = '_NODE_NAME_UNKNOWN_'  # an endpoint's node before its participant's names arrive
 RECORDER = 'recorder'  # the recorder node's name (multilift_sim.ros.recorder_node)
 LINGER = 2.0  # [s] the message kept for readers that match after it was acknowledged
+
+
+def live_parser(command: str, doc: str) -> argparse.ArgumentParser:
+    """The argument parser of `multilift COMMAND` (its description `doc`'s first line) with
+    the option every live command has: --timeout, the wall seconds to wait for the run."""
+    parser = argparse.ArgumentParser(prog=f'multilift {command}', description=doc.split('\n')[0])
+    parser.add_argument('--timeout', type=float, default=10.0, metavar='S',
+                        help='wall seconds to wait for the run (default 10)')
+    return parser
 
 
 def publish_acknowledged(command: str, msg_type: type, topic: str,

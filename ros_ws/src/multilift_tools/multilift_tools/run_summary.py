@@ -110,6 +110,9 @@ def print_summary(name: str, data: dict, bag: Path | None, scenario) -> None:
             lines.append(f'  rope {i + 1}           max stretch {stretch:.3g} '
                          f'{unit_of("max_stretch")}, peak '
                          f'tension {peak:.2f} {unit_of("peak_tension")} (at the control ticks)')
+        for i, sag in enumerate(sim.get('max_sag', [])):  # a chain's (cable_model: chain)
+            lines.append(f'  chain {i + 1}          max sag {sag:.3f} {unit_of("max_sag")} '
+                         '(from its chord, at the control ticks)')
         for i in scenario.winches if 'longest_cable' in sim else ():  # a winch's reeled range
             shortest, longest = sim['shortest_cable'][i - 1], sim['longest_cable'][i - 1]
             lines.append(f'  cable {i} (winch)  length {shortest:.3f} .. {longest:.3f} '

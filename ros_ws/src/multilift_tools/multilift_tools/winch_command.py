@@ -14,16 +14,14 @@ import math
 import sys
 
 from multilift_sim.topics import WINCH_CMD, uav_topic
-from multilift_tools.live_publish import publish_acknowledged
+from multilift_tools.live_publish import live_parser, publish_acknowledged
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog='multilift winch', description=__doc__.split('\n')[0])
+    parser = live_parser('winch', __doc__)
     parser.add_argument('uav', type=int, metavar='UAV', help='the UAV, from 1 (1: the leader)')
     parser.add_argument('rate', type=float, metavar='RATE',
                         help='reel rate [m/s]: positive pays out, negative hauls in, 0 stops')
-    parser.add_argument('--timeout', type=float, default=10.0, metavar='S',
-                        help='wall seconds to wait for the run (default 10)')
     return parser
 
 

@@ -208,7 +208,13 @@ def modal_analysis(params: FormationParams, equilibrium: Equilibrium,
 def scenario_modal_analysis(scenario: Scenario, **options: Any) -> ModalAnalysis:
     """modal_analysis of a scenario's formation at its static equilibrium (Eq. 2.73).
     ValueError (one line) for cables that stretch (`cable_model: elastic`): the linearisation
-    eliminates each cable's length (Eq. 2.71), so it has no rope's axial mode to give."""
+    eliminates each cable's length (Eq. 2.71), so it has no rope's axial mode to give; and for
+    heavy cables (`cable_model: chain`), whose inner nodes it does not linearise."""
+    if scenario.cable_model == 'chain':
+        raise ValueError('cable_model: chain: the modal analysis linearises massless cables '
+                         '(each a constraint on its UAV and the payload, Eq. 2.71) and not a '
+                         'chain\'s inner nodes; analyse the scenario with cable_model: rigid '
+                         'for its pendulum modes (the chain\'s own swing: docs/cables.md)')
     if not CABLE_MODELS[scenario.cable_model].KEEPS_LENGTH:
         raise ValueError(f'cable_model: {scenario.cable_model}: the modal analysis linearises '
                          'cables of fixed length (their lengths are the constraints it '

@@ -20,11 +20,12 @@ ropes: `physics.elastic_cables`), selected by these declarations; docs/cables.md
 """
 from __future__ import annotations
 
-from multilift_sim.cables import elastic, rigid, slack
+from multilift_sim.cables import chain, elastic, rigid, slack
 from multilift_sim.registry import Registry
 
 CABLE_MODELS = Registry(
     'cable model', ('NAME', 'NEEDS', 'RELEASE_LIMIT_DEG', 'KEEPS_LENGTH', 'SLACKENS',
-                    'REELS', 'parse_cable', 'parse_uav_cable', 'check'), (rigid, slack, elastic))
+                    'REELS', 'parse_cable', 'parse_uav_cable', 'check'),
+    (rigid, slack, elastic, chain))
 register, unregister, registered = (CABLE_MODELS.register, CABLE_MODELS.unregister,
                                     CABLE_MODELS.registered)

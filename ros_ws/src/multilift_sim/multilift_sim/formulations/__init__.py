@@ -56,6 +56,7 @@ FEATURES = {
     'attach_points': 'uavs[i].attach_point need',
     'slack': 'cable_model: slack needs',
     'elastic': 'cable_model: elastic needs',
+    'chain': 'cable_model: chain needs',
     'prescribed': 'a prescribed motion needs',
     'winch': 'a winch (uavs[i].winch) needs',
 }

@@ -11,7 +11,7 @@ from multilift_sim.slack import SlackCableModel
 
 NAME = 'baumgarte'
 SUPPORTS = frozenset({'wind', 'events', 'lagging_rotors', 'rigid_body', 'attach_points',
-                      'slack', 'elastic', 'prescribed', 'winch'})
+                      'slack', 'elastic', 'chain', 'prescribed', 'winch'})
 
 
 def make(params: FormationParams, cable_model: Any) -> FormationModel:

@@ -32,7 +32,8 @@ from multilift_sim.physics.layout import (
     CLEARANCE_UAV_UAV, CLEARANCE_UAV_WORLD, CLEARANCE_VALUE, OBSTACLE_BOUND, OBSTACLE_CENTER,
     OBSTACLE_GROUND, OBSTACLE_TYPE, POSITION, UAV_ATTACH, UAV_PAYLOAD_ATTACH, WORLD_GROUND,
     WORLD_PAYLOAD_RADIUS)
-from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, uav_attitude_slot,
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot,
+                                               rigid_payload_state, uav_attitude_slot,
                                                uav_slot)
 
 OBSTACLES = part_dispatch.declare(
@@ -140,7 +141,7 @@ def cable_ends(state, uavs, n, ends):
     """Each cable's ends into ends (n, 2, 3) [m], world: its UAV's attach point r_i + R_i a_i
     and its payload end (r_p, or r_p + R_p b_i on a rigid payload)."""
     p = payload_slot(n)
-    rigid = state.shape[0] > attitude_slot(n)
+    rigid = rigid_payload_state(state.shape[0], n)
     payload_rotation = quaternion_rotation(state, attitude_slot(n)) if rigid else np.eye(3)
     for i in range(n):
         for j in range(3):
@@ -169,7 +170,7 @@ def measure(world, obstacles, radii, uavs, state, t, clearance, contact):
     scratch = np.empty(1)
     p = payload_slot(n)
     payload_radius = world[WORLD_PAYLOAD_RADIUS]
-    rigid = state.shape[0] > attitude_slot(n)
+    rigid = rigid_payload_state(state.shape[0], n)
     touched = False
     ground = world[WORLD_GROUND]
     if not math.isnan(ground):

@@ -26,6 +26,7 @@ from multilift_sim.physics.free_motion import (add_cable_torque, air_velocity,  
                                               payload_pulled,
                                               rotational_compliance,
                                               uav_attach_motion, uav_free_motion)
+from multilift_sim.physics.chain_cables import chain_residuals, chain_solve
 from multilift_sim.physics.elastic_cables import elastic_solve
 from multilift_sim.physics.nullspace import nullspace_solve, project, translational_masses
 from multilift_sim.physics.attitude import normalize_quaternion
@@ -34,13 +35,15 @@ from multilift_sim.physics.rigid_payload import rigid_residuals, rigid_solve
 from multilift_sim.physics.winch import reeled_cable
 from multilift_sim.physics.layout import (
     BODY_ATTITUDE, BODY_RATES, CABLE_COLUMNS, CABLE_INV_DELTA, CABLE_MOMENT, CABLE_OFFSET,
-    CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_ELASTIC, FORMATION_GRAVITY,
-    FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
+    CABLE_RHS, CABLE_THRUST, FORMATION_BETA_SQ, FORMATION_CHAIN_LINKS, FORMATION_ELASTIC,
+    FORMATION_GRAVITY, FORMATION_NULL_SPACE, FORMATION_PAYLOAD_MASS,
     FORMATION_PRESCRIBED, FORMATION_PROJECTION_STEPS, FORMATION_PROJECTION_TOLERANCE,
-    FORMATION_TIME, FORMATION_TWO_ALPHA, FORMATION_WINCH, POSITION, UAV_LENGTH_SQ, UAV_MASS,
+    FORMATION_TIME, FORMATION_TWO_ALPHA, FORMATION_WINCH, NODE_STATE, POSITION, UAV_LENGTH_SQ,
+    UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
-from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rates_slot,
-                                               uav_attitude_slot, uav_slot)
+from multilift_sim.physics.state_slots import (chain_inner_nodes, payload_slot, rates_slot,
+                                               rigid_payload_state, uav_attitude_slot,
+                                               uav_slot)
 
 
 @jit
@@ -114,13 +117,16 @@ def solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables):
     if formation[FORMATION_ELASTIC] != 0.0:  # elastic ropes, no constraint (elastic_cables)
         elastic_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers)
         return
+    if formation[FORMATION_CHAIN_LINKS] != 0.0:  # heavy cables of rigid links (chain_cables)
+        chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers)
+        return
     if formation[FORMATION_NULL_SPACE] != 0.0:  # the `nullspace` formulation (every cable taut)
         nullspace_solve(x, wrenches, uavs, gusts, formation, acc, multipliers)
         return
     if formation[FORMATION_PRESCRIBED] != 0.0:  # driven UAVs (uavs[i].trajectory)
         prescribed_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
         return
-    if x.shape[0] > attitude_slot(uavs.shape[0]):
+    if rigid_payload_state(x.shape[0], uavs.shape[0]):
         # a rigid-body payload (its attitude block after the UAVs': physics.rigid_payload)
         rigid_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers, cables)
         return
@@ -232,7 +238,8 @@ def rk4_step(x, wrenches, uavs, gusts, formation, taut, h, out, multipliers, wor
         formation[FORMATION_TIME] = start + h
     for j in range(size):
         out[j] = x[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
-    for j in range(bodies, size, BODY_ATTITUDE):
+    # the quaternions: every attitude block's (not a chain's node blocks after them)
+    for j in range(bodies, size - NODE_STATE * n * chain_inner_nodes(size, n), BODY_ATTITUDE):
         normalize_quaternion(out, j)
 
 
@@ -244,7 +251,11 @@ def residuals(x, uavs, g, g_dot):
     n = uavs.shape[0]
     p = payload_slot(n)
     nq = rates_slot(n)
-    if x.shape[0] > attitude_slot(n):
+    inner = chain_inner_nodes(x.shape[0], n)
+    if inner > 0:  # a chain's worst link per cable (chain_cables), a point or rigid payload
+        chain_residuals(x, uavs, inner, g, g_dot)
+        return
+    if rigid_payload_state(x.shape[0], n):
         rigid_residuals(x, uavs, g, g_dot)
         return
     for i in range(n):

@@ -66,6 +66,44 @@ def attitude_slot(n_uavs: int) -> int:
     return 2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES) + BODY_ATTITUDE * n_uavs
 
 
+# a heavy cable's inner nodes (`cable_model: chain`, physics.chain_cables): each cable of N
+# links has N - 1 point masses between its UAV and the payload, node k (1 .. N - 1) from the
+# UAV; their blocks end the state (after the attitude blocks: the UAVs', a rigid payload's),
+# cable by cable, node by node, each its position [m] then its velocity [m/s], world (z up)
+NODE_POSITION = 0           # r_ik [m] (3 slots)
+NODE_VELOCITY = 3           # r_ik_dot [m/s] (3)
+NODE_STATE = 6              # a node's block
+
+
+def chain_node_slot(size: int, n_uavs: int, inner_nodes: int, i: int, k: int) -> int:
+    """Offset of cable i's node k (1 .. inner_nodes, from the UAV) in a state x of length
+    `size`, each cable holding `inner_nodes` = N - 1 inner nodes (`cable_model: chain`): the
+    node blocks end the state."""
+    return size - NODE_STATE * (inner_nodes * n_uavs - (inner_nodes * i + k - 1))
+
+
+def chain_inner_nodes(size: int, n_uavs: int) -> int:
+    """The inner nodes per cable (N - 1) a state of length `size` holds for n UAVs: 0 but for
+    a chain's state, a point payload's (a rigid payload's with its PAYLOAD_ATTITUDE = 7) plus
+    n (N - 1) node blocks of NODE_STATE = 6 (7 is 1 more than a multiple of 6: the two
+    cannot be confused)."""
+    extra = size - (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
+                    + BODY_ATTITUDE * n_uavs)
+    if extra % NODE_STATE == PAYLOAD_ATTITUDE % NODE_STATE:
+        extra -= PAYLOAD_ATTITUDE
+    if extra <= 0 or extra % (NODE_STATE * n_uavs) != 0:
+        return 0
+    return extra // (NODE_STATE * n_uavs)
+
+
+def rigid_payload_state(size: int, n_uavs: int) -> bool:
+    """Whether a state of length `size` for n UAVs holds a rigid payload's attitude block
+    (PAYLOAD_ATTITUDE = 7 after the UAVs' blocks, a chain's node blocks of 6 after it)."""
+    extra = size - (2 * (UAV_COORDINATES * n_uavs + PAYLOAD_COORDINATES)
+                    + BODY_ATTITUDE * n_uavs)
+    return extra > 0 and extra % NODE_STATE == PAYLOAD_ATTITUDE % NODE_STATE
+
+
 # -- the seed's generalised coordinates q_f (Eq. 2.41): the analysis' minimal coordinates -----
 # (multilift_sim.analysis: per UAV r_i [m] and ZYX eta_i [rad], then r_p [m]; a rigid payload's
 # rotation vector after them), which the state maps to and from (analysis.coordinates)
@@ -110,7 +148,10 @@ UAV_REEL_START = 21         # t_0 [s]
 UAV_REEL_LENGTH = 22        # l_0 [m]
 UAV_REEL_RATE = 23          # v_0 [m/s]
 UAV_REEL_TARGET = 24        # the rate it heads for [m/s] (positive pays out)
-UAV_COLUMNS = 25
+# its cable's inner nodes (`cable_model: chain`, physics.chain_cables; 0: none)
+UAV_NODE_MASS = 25          # each inner node's mass [kg]: the cable's mu l over N - 1 nodes
+UAV_NODE_DRAG = 26          # each node's quadratic drag 0.5 rho C_d d (l / N) [N s^2/m^2]
+UAV_COLUMNS = 27
 
 # -- a UAV's body wrench (one row per UAV; FormationModel.wrenches) ----------------------------
 WRENCH_THRUST = 0           # u_T [N], along the body z axis
@@ -174,7 +215,8 @@ FORMATION_TIME = 18         # with FORMATION_PRESCRIBED or FORMATION_WINCH: the 
 #                             drives and reels are evaluated at (the RK4 stage's; a period's
 #                             copy of these scalars holds it)
 FORMATION_WINCH = 19        # 1: some UAV carries a winch (physics.winch): cable lengths l_i(t)
-FORMATION_SCALARS = 20
+FORMATION_CHAIN_LINKS = 20  # N, the links of every cable (`cable_model: chain`); 0: no chain
+FORMATION_SCALARS = 21
 
 # -- the drive table of prescribed UAVs (physics.prescribed), after the formation's scalars
 # when FORMATION_PRESCRIBED: n slots (UAV i's at FORMATION_SCALARS + i: the offset of its drive
@@ -197,6 +239,19 @@ CABLE_MOMENT = 8            # k_i = a_i x R_i^T d_i [m^2], body FLU: the pull's 
 CABLE_PAYLOAD_MOMENT = 11   # c_i = b_i x R_p^T d_i [m^2], a rigid payload's frame: its moment
 #                             arm there (3; physics.rigid_payload)
 CABLE_COLUMNS = 14
+
+# -- a chain's solve scratch (`cable_model: chain`, physics.chain_cables): per cable, a row a
+# link k = 1 .. N (at k - 1) and a row a node j = 0 .. N - 1 (node 0 the UAV) ----------------
+CHAIN_LINK_OFFSET = 0       # d_k = r_k - r_(k-1) [m] (3 slots)
+CHAIN_LINK_DIAGONAL = 3     # the links' matrix A's diagonal entry, then the eliminated one
+CHAIN_LINK_UPPER = 4        # A[k, k + 1]
+CHAIN_LINK_U = 5            # the right-hand side, then u = A^-1 of it, then lambda_k [N/m]
+CHAIN_LINK_W = 6            # e_N, then w = A^-1 e_N
+CHAIN_LINK_COLUMNS = 7
+CHAIN_NODE_FREE = 0         # the node's acceleration without the links [m/s^2], gravity
+#                             excluded (3 slots)
+CHAIN_NODE_INV_MASS = 3     # 1 / its mass [1/kg]
+CHAIN_NODE_COLUMNS = 4
 
 # -- an RK4 step's scratch (rows of a (WORK_ROWS, len(x)) array) ---------------------------
 WORK_K1, WORK_K2, WORK_K3, WORK_K4 = 0, 1, 2, 3     # the stage derivatives (consecutive rows)

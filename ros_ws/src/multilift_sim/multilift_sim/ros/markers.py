@@ -76,7 +76,7 @@ class FormationMarkers:
         self.scene.update([u.position for u in snapshot.uavs], [u.euler for u in snapshot.uavs],
                           snapshot.payload_position, tensions, taut,
                           None if snapshot.payload_attitude is None
-                          else snapshot.payload_attitude[0])
+                          else snapshot.payload_attitude[0], snapshot.chain_points)
         for marker in self._all:
             marker.header.stamp = stamp
         for marker, spec in self._moving:

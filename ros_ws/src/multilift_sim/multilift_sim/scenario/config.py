@@ -314,7 +314,17 @@ class Scenario:
             drives=(tuple(u.trajectory for u in self.uavs) if self.prescribed else None),
             winches=(tuple(u.winch for u in self.uavs) if any(u.winch for u in self.uavs)
                      else None),
+            **self.chain_params(),
         )
+
+    def chain_params(self) -> dict[str, Any]:
+        """FormationParams' chain fields of `cable_model: chain` (cables.chain), else none."""
+        if self.cable_model != 'chain':
+            return {}
+        from multilift_sim.cables.chain import drag_per_length
+        return {'chain_links': self.cable['links'],
+                'cable_mass_per_length': self.cable['mass_per_length'],
+                'cable_drag_per_length': drag_per_length(self.cable)}
 
     def with_duration(self, duration: float) -> 'Scenario':
         """The same scenario flown for `duration` [s] (a `--duration` override); ScenarioError

@@ -16,13 +16,14 @@ import numpy as np
 from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import quaternion_norm_error
 from multilift_sim.physics.layout import POSITION, REEL_LENGTH, UAV_COORDINATES
-from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, uav_attitude_slot,
+from multilift_sim.physics.state_slots import (attitude_slot, chain_node_slot, payload_slot,
+                                               rigid_payload_state, uav_attitude_slot,
                                                uav_slot)
 from multilift_sim.statistics.layout import (
     CHECK_G, CHECK_G_DOT, CHECK_NON_FINITE, CHECK_OK, CHECK_QUATERNION, FORMATION_MAX_ABS,
     FORMATION_NORM_SUM, FORMATION_SAMPLES, PEAK_MAX, PEAK_SAMPLES, PEAK_SUM_SQ,
     QUATERNION_NORM_TOLERANCE, RUN_COMPRESSED_TIME, RUN_LEAST_THRUST_MARGIN, RUN_MAX_ABS_G,
-    RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_STRETCH,
+    RUN_MAX_ABS_G_DOT, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED, RUN_MAX_SAG, RUN_MAX_STRETCH,
     RUN_LONGEST_CABLE, RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME,
     RUN_SCALARS, RUN_SHORTEST_CABLE,
     RUN_SIMULATED_TIME, RUN_SLACK_TIME, RUN_SWING, RUN_UAV_COLUMNS, SWING_FROM, TRACKING_ERROR)
@@ -128,6 +129,31 @@ def run_add_ropes(run: np.ndarray, state: np.ndarray, lengths: np.ndarray,
 
 
 @jit
+def run_add_sag(run: np.ndarray, state: np.ndarray, n: int, inner: int) -> None:
+    """Heavy cables (cable_model: chain) at one tick: each cable's sag, the largest distance
+    [m] of its `inner` nodes from its chord r_i -> r_p in the state, raises its maximum
+    (RUN_MAX_SAG)."""
+    p = payload_slot(n)
+    for i in range(n):
+        r = uav_slot(i) + POSITION
+        cx, cy, cz = state[p] - state[r], state[p + 1] - state[r + 1], state[p + 2] - state[r + 2]
+        chord_sq = cx * cx + cy * cy + cz * cz
+        sag = 0.0
+        for k in range(1, inner + 1):
+            at = chain_node_slot(state.shape[0], n, inner, i, k)
+            ex, ey, ez = state[at] - state[r], state[at + 1] - state[r + 1], \
+                state[at + 2] - state[r + 2]
+            along = (ex * cx + ey * cy + ez * cz) / chord_sq if chord_sq > 0.0 else 0.0
+            off = math.sqrt((ex - along * cx) ** 2 + (ey - along * cy) ** 2
+                            + (ez - along * cz) ** 2)
+            if off > sag:
+                sag = off
+        block = RUN_SCALARS + RUN_UAV_COLUMNS * i
+        if sag > run[block + RUN_MAX_SAG]:
+            run[block + RUN_MAX_SAG] = sag
+
+
+@jit
 def run_add_reel(run: np.ndarray, reel: np.ndarray, lengths: np.ndarray) -> None:
     """Winches at one tick: each cable's reeled length (reel (n, REEL_COLUMNS), physics.winch)
     widens its range (RUN_SHORTEST_CABLE, RUN_LONGEST_CABLE); `lengths` (n,) [m] the start's,
@@ -228,7 +254,7 @@ def quaternion_fault(state: np.ndarray, n: int) -> int:
     for i in range(n):
         if quaternion_norm_error(state, uav_attitude_slot(n, i)) > QUATERNION_NORM_TOLERANCE:
             return i
-    if state.shape[0] > attitude_slot(n) and quaternion_norm_error(
+    if rigid_payload_state(state.shape[0], n) and quaternion_norm_error(
             state, attitude_slot(n)) > QUATERNION_NORM_TOLERANCE:
         return n
     return -1

@@ -18,7 +18,7 @@ from multilift_sim.statistics.layout import (
     FORMATION_MAX_ABS, FORMATION_NORM_SUM, FORMATION_SAMPLES, FORMATION_SIZE, PEAK_MAX,
     PEAK_SAMPLES, PEAK_SIZE, PEAK_SUM_SQ, RUN_COMPRESSED_TIME, RUN_MAX_ABS_G, RUN_MAX_ABS_G_DOT,
     RUN_LEAST_THRUST_MARGIN, RUN_LONGEST_CABLE, RUN_MAX_GUST_SPEED, RUN_MAX_ROTOR_SPEED,
-    RUN_MAX_STRETCH, RUN_SHORTEST_CABLE, RUN_ATTITUDE_ERROR_SQ, RUN_ATTITUDE_NEES,
+    RUN_MAX_SAG, RUN_MAX_STRETCH, RUN_SHORTEST_CABLE, RUN_ATTITUDE_ERROR_SQ, RUN_ATTITUDE_NEES,
     RUN_ESTIMATION_SAMPLES, RUN_PAYLOAD_NEES, RUN_PAYLOAD_POSITION_SQ, RUN_PAYLOAD_VELOCITY_SQ,
     RUN_POSITION_ERROR_SQ, RUN_POSITION_NEES,
     RUN_MAX_TENSION, RUN_MIN_TENSION, RUN_PEAK_TENSION, RUN_SATURATED_TIME, RUN_SCALARS,
@@ -190,7 +190,7 @@ class RunStatistics:
             run[RUN_MIN_TENSION] = math.inf
             run[RUN_MAX_TENSION] = -math.inf
             run[RUN_SCALARS + RUN_LEAST_THRUST_MARGIN:run_size(n_uavs):RUN_UAV_COLUMNS] = math.inf
-            for column in (RUN_MAX_STRETCH, RUN_PEAK_TENSION, RUN_LONGEST_CABLE):
+            for column in (RUN_MAX_STRETCH, RUN_PEAK_TENSION, RUN_LONGEST_CABLE, RUN_MAX_SAG):
                 run[RUN_SCALARS + column:run_size(n_uavs):RUN_UAV_COLUMNS] = -math.inf
             run[RUN_SCALARS + RUN_SHORTEST_CABLE:run_size(n_uavs):RUN_UAV_COLUMNS] = math.inf
         self.run = run
@@ -229,6 +229,14 @@ class RunStatistics:
         """Per UAV, the least share of its largest thrust its commands left, 1 - u_T / u_T,max
         (rotor effectiveness included; None before a command)."""
         return [v if math.isfinite(v) else None for v in self._per_uav(RUN_LEAST_THRUST_MARGIN)]
+
+    @property
+    def chain_figures(self) -> dict:
+        """Heavy cables' (cable_model: chain) per cable: {'max_sag': [m]} (an inner node's
+        largest distance from the chord UAV -> payload), at every control tick; {} in any
+        other run."""
+        sag = self._per_uav(RUN_MAX_SAG)
+        return {'max_sag': sag} if any(math.isfinite(v) for v in sag) else {}
 
     @property
     def rope_figures(self) -> dict:
@@ -321,7 +329,7 @@ class RunStatistics:
                 'max_payload_swing': self.swing.max,
                 'rms_payload_swing': self.swing.rms,
                 'swing_from': SWING_FROM,
-                'compressed_time': self.compressed_time, **self.rope_figures,
+                'compressed_time': self.compressed_time, **self.rope_figures, **self.chain_figures,
                 **self.reel_figures, **self.estimation_figures}
 
     @property

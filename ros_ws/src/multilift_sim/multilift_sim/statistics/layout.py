@@ -51,11 +51,14 @@ RUN_PEAK_TENSION = 5        # its rope's largest tension T_i [N] (cable_model: e
 RUN_SHORTEST_CABLE = 6      # its cable's shortest length l_i [m] reeled by its winch (+inf:
 #                             none yet, and in every run without winches)
 RUN_LONGEST_CABLE = 7       # its cable's longest length [m] (-inf)
-RUN_POSITION_ERROR_SQ = 8   # with an estimator: sum of |r_hat - r|^2 [m^2]
-RUN_ATTITUDE_ERROR_SQ = 9   # sum of |Log(q_hat^-1 q)|^2 [rad^2]
-RUN_POSITION_NEES = 10      # sum of its position NEES (3 dof)
-RUN_ATTITUDE_NEES = 11      # sum of its attitude NEES (3 dof)
-RUN_UAV_COLUMNS = 12
+RUN_MAX_SAG = 8             # its chain's largest sag [m]: an inner node's distance from the
+#                             chord UAV -> payload (cable_model: chain; -inf: none, and in
+#                             every other cable model's run)
+RUN_POSITION_ERROR_SQ = 9   # with an estimator: sum of |r_hat - r|^2 [m^2]
+RUN_ATTITUDE_ERROR_SQ = 10  # sum of |Log(q_hat^-1 q)|^2 [rad^2]
+RUN_POSITION_NEES = 11      # sum of its position NEES (3 dof)
+RUN_ATTITUDE_NEES = 12      # sum of its attitude NEES (3 dof)
+RUN_UAV_COLUMNS = 13
 
 
 def run_size(n_uavs: int) -> int:

@@ -11,6 +11,7 @@ markers (world frame, z up, metres):
 - ns `uav_heading`, id i, ARROW: the body x axis (front), 2 arm lengths long;
 - ns `cable`, id i, LINE_LIST of CABLE_SEGMENTS segments: UAV i's centre of mass to the
   payload, coloured by tension; solid while taut, dashed while slack (`cable_model: slack`);
+  a heavy cable (`cable_model: chain`) as its N links, UAV -> its inner nodes -> the payload;
 - ns `payload`, id 0, SPHERE: the payload, PAYLOAD_DIAMETER across; a rigid body
   (docs/rigid_payload.md) its shape at its pose: a CUBE of its size (box) or a CYLINDER of
   its length and radius, laid along its x axis (cylinder), and the cables end at its attach
@@ -182,6 +183,14 @@ def _cable_points(start: tuple[float, float, float], end: tuple[float, float, fl
     return points
 
 
+def _chain_points(start: tuple[float, float, float], nodes: Sequence[Sequence[float]],
+                  end: tuple[float, float, float]) -> list[tuple[float, float, float]]:
+    """The LINE_LIST points of a heavy cable: its N links, from `start` through its inner
+    `nodes` (N - 1, 3) [m] to `end`."""
+    path = [start] + [(float(p[0]), float(p[1]), float(p[2])) for p in nodes] + [end]
+    return [point for a, b in zip(path[:-1], path[1:]) for point in (a, b)]
+
+
 class FormationScene:
     """The marker specs of one scenario, in MarkerArray order: per UAV body, heading, cable;
     then the payload, the mission path and the gust zones. `update` rewrites the moving parts."""
@@ -201,10 +210,11 @@ class FormationScene:
             self.headings.append(MarkerSpec('uav_heading', i + 1, ARROW,
                                             scale=(2.0 * arm, 0.25 * arm, 0.25 * arm),
                                             color=_rgba(rgb)))
+            links = scenario.cable['links'] if scenario.cable_model == 'chain' else 0
             self.cables.append(MarkerSpec(
                 'cable', i + 1, LINE_LIST, scale=(CABLE_WIDTH, 0.0, 0.0),
                 color=_rgba(tension_color(0.0, self.reference_tension)),
-                points=[(0.0, 0.0, 0.0)] * (2 * CABLE_SEGMENTS)))
+                points=[(0.0, 0.0, 0.0)] * (2 * (links or CABLE_SEGMENTS))))
         payload = scenario.payload
         self.attach_points = payload.attach_points  # a rigid body's, payload frame [m]
         if payload.type == 'rigid_body' and payload.shape == 'box':
@@ -228,10 +238,12 @@ class FormationScene:
     def update(self, uav_positions: Sequence[Sequence[float]],
                uav_euler: Sequence[Sequence[float]], payload_position: Sequence[float],
                tensions: Sequence[float], taut: Sequence[bool] | None = None,
-               payload_orientation: Sequence[float] | None = None) -> list[MarkerSpec]:
+               payload_orientation: Sequence[float] | None = None,
+               chain_points: Sequence | None = None) -> list[MarkerSpec]:
         """Write one tick's formation into the specs (UAV positions [m] and ZYX Euler angles
         [rad], payload position [m], cable tensions [N], which cables are taut: None for
-        all; a rigid payload's orientation (x, y, z, w)); returns `specs`."""
+        all; a rigid payload's orientation (x, y, z, w); heavy cables' inner nodes (n, N - 1,
+        3) [m], world, or None); returns `specs`."""
         n = self.n_uavs
         if len(uav_positions) != n or len(tensions) != n:
             raise ValueError(f'formation_markers: scenario {self.scenario.name} has {n} UAVs, '
@@ -250,14 +262,19 @@ class FormationScene:
                     for b in self.attach_points]
         if taut is None:
             taut = [True] * n
-        for position, euler, tension, is_taut, end, body, heading, cable in zip(
+        for i, (position, euler, tension, is_taut, end, body, heading, cable) in enumerate(zip(
                 uav_positions, uav_euler, tensions, taut, ends, self.bodies, self.headings,
-                self.cables):
+                self.cables)):
             xyz = (float(position[0]), float(position[1]), float(position[2]))
             body.position[:] = xyz
             body.orientation[:] = quaternion(euler)
             heading.position[:] = xyz
             heading.orientation[:] = body.orientation
-            cable.points[:] = _cable_points(xyz, end, bool(is_taut))
+            points = (_cable_points(xyz, end, bool(is_taut)) if chain_points is None
+                      else _chain_points(xyz, chain_points[i], end))
+            if len(points) != len(cable.points):  # a chain's markers need its nodes
+                raise ValueError(f'formation_markers: cable {i + 1} has {len(cable.points)} '
+                                 f'points, got {len(points)}')
+            cable.points[:] = points
             cable.color[:3] = tension_color(float(tension), self.reference_tension)
         return self.specs

@@ -171,17 +171,18 @@ class SimulatorMessages:
         return self.markers_of(snap.t_ns, [u.position for u in snap.uavs],
                                [u.euler for u in snap.uavs], snap.payload_position, tension,
                                taut, None if snap.payload_attitude is None
-                               else snap.payload_attitude[0])
+                               else snap.payload_attitude[0], snap.chain_points)
 
     def markers_of(self, t_ns: int, positions: Sequence[Sequence[float]],
                    euler: Sequence[Sequence[float]], payload_position: Sequence[float],
                    tension: Sequence[float], taut: Sequence[bool],
-                   payload_orientation: Sequence[float] | None = None) -> Message:
+                   payload_orientation: Sequence[float] | None = None,
+                   chain_points: Sequence | None = None) -> Message:
         """`markers` from plain numbers: every UAV's position [m] and ZYX Euler angles [rad],
         the payload's position [m] (and a rigid one's orientation (x, y, z, w)), the cables'
-        tension [N] and which are taut."""
+        tension [N] and which are taut (and heavy cables' inner nodes (n, N - 1, 3) [m])."""
         self._scene.update(positions, euler, payload_position, tension, taut,
-                           payload_orientation)
+                           payload_orientation, chain_points)
         return MARKERS, self._markers.pack(t_ns)
 
 

@@ -18,7 +18,6 @@ import numpy as np
 from multilift_control.controllers.followers import virtual_constraints
 from multilift_control.laws import jit
 from multilift_control.laws import layout as slots
-from multilift_control.laws.follower import formation_terms
 from multilift_sim.scenario import Scenario
 
 NAME = 'heading'
@@ -53,10 +52,8 @@ def turned_targets(rows, targets, turn):
     return turned
 
 
-@jit
-def shared(constants, masses, rows, targets, states, vectors):
-    """Nothing shared: each follower turns the targets itself, then its terms."""
-    return 0.0
+# each follower turns the targets itself, then its terms
+shared = virtual_constraints.nothing_shared
 
 
 @jit
@@ -64,12 +61,11 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
            targets, law_p, law_q, terms, speeds, saturated, setpoint, errors, rates):
     """Follower `index`'s tick at t [s]: the targets turned by the leader's heading since its
     start (states[0]'s yaw), then the seed follower's answer to them
-    (`virtual_constraints.answer`, which writes speeds, saturated, setpoint, errors and rates);
-    returns the collective thrust asked [N]."""
+    (`virtual_constraints.answer_moved`: it writes speeds, saturated, setpoint, errors and
+    rates); returns the collective thrust asked [N]."""
     turn = states[0, slots.UAV_EULER + 2] - constants[slots.HEADING_LEADER_START_YAW]
     turn = math.atan2(math.sin(turn), math.cos(turn))
     kept = turned_targets(rows, targets, turn)
-    own_terms = formation_terms(constants, masses, rows, kept, states, vectors)
-    return virtual_constraints.answer(constants, memory, cascade, mixer, index, t, states,
-                                      vectors, masses, rows, kept, law_p, law_q, own_terms,
-                                      speeds, saturated, setpoint, errors, rates)
+    return virtual_constraints.answer_moved(constants, memory, cascade, mixer, index, t,
+                                            states, vectors, masses, rows, kept, law_p, law_q,
+                                            speeds, saturated, setpoint, errors, rates)

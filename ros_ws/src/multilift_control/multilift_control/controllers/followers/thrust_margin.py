@@ -17,7 +17,6 @@ import numpy as np
 from multilift_control.controllers.followers import virtual_constraints
 from multilift_control.laws import jit
 from multilift_control.laws import layout as slots
-from multilift_control.laws.follower import formation_terms
 from multilift_control.laws.reorganize import allocate, reorganize
 from multilift_sim.scenario import Scenario
 from multilift_sim.start import formation_start
@@ -64,10 +63,8 @@ def arrays(scenario: Scenario, index: int
     return mode_arrays(scenario, index, slots.REORGANIZE_GRADIENT)
 
 
-@jit
-def shared(constants, masses, rows, targets, states, vectors):
-    """Nothing shared: each follower steps its own copy of the shift, then its terms."""
-    return 0.0
+# each follower steps its own copy of the shift, then its terms
+shared = virtual_constraints.nothing_shared
 
 
 @jit
@@ -75,13 +72,12 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
            targets, law_p, law_q, terms, speeds, saturated, setpoint, errors, rates):
     """Follower `index`'s tick at t [s]: the formation's step (`laws.reorganize.reorganize`, or
     `allocate` in REORGANIZE_ALLOCATE mode), then the seed follower's answer to the moved
-    targets (`virtual_constraints.answer`, which writes speeds, saturated, setpoint, errors and
-    rates); returns the collective thrust asked [N]."""
+    targets (`virtual_constraints.answer_moved`: it writes speeds, saturated, setpoint, errors
+    and rates); returns the collective thrust asked [N]."""
     if constants[slots.REORGANIZE_MODE] == slots.REORGANIZE_ALLOCATE:
         kept = allocate(constants, memory, t, masses, rows, targets, vectors)
     else:
         kept = reorganize(constants, memory, t, masses, rows, targets, vectors)
-    own_terms = formation_terms(constants, masses, rows, kept, states, vectors)
-    return virtual_constraints.answer(constants, memory, cascade, mixer, index, t, states,
-                                      vectors, masses, rows, kept, law_p, law_q, own_terms,
-                                      speeds, saturated, setpoint, errors, rates)
+    return virtual_constraints.answer_moved(constants, memory, cascade, mixer, index, t,
+                                            states, vectors, masses, rows, kept, law_p, law_q,
+                                            speeds, saturated, setpoint, errors, rates)

@@ -53,3 +53,20 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
         errors[k] = own_errors[k]
         rates[k] = own_rates[k]
     return thrust
+
+
+@jit
+def answer_moved(constants, memory, cascade, mixer, index, t, states, vectors, masses, rows,
+                 moved, law_p, law_q, speeds, saturated, setpoint, errors, rates):
+    """`answer` to targets `moved` (m,) [m or m^2] other than the formation's (a follower part
+    that moves them: heading, thrust_margin): their terms (`formation_terms`) first."""
+    terms = formation_terms(constants, masses, rows, moved, states, vectors)
+    return answer(constants, memory, cascade, mixer, index, t, states, vectors, masses, rows,
+                  moved, law_p, law_q, terms, speeds, saturated, setpoint, errors, rates)
+
+
+@jit
+def nothing_shared(constants, masses, rows, targets, states, vectors):
+    """The `shared` of a part whose followers move the targets themselves (`answer_moved`
+    computes their terms): nothing, 0.0."""
+    return 0.0

@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""What heavy cables cost (`cable_model: chain`, issue 32 item 7): the simulator's advance per
+control tick (the physics of a 10 ms tick: its RK4 steps and their sub-steps, the check, the
+statistics) of `twin_lift` on rigid cables against `twin_lift_chain` (30 links a cable, 2
+sub-steps) and the same chains of 10 and 60 links, each with the sub-steps the validation asks
+for; the rotors held at their hover speeds (no controller), CPU time per tick, the best of
+three passes; then the real-time factor of a whole `scripts/multilift run twin_lift_chain
+--headless` (the process's wall time, start-up included, and the summary's own).
+
+Run: scripts/setup && source scripts/env.sh && python benchmarks/chain_cables.py
+     [--seconds 30] [--runs 3]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+from pathlib import Path
+
+os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
+
+import yaml  # noqa: E402 - after the BLAS setting
+
+from multilift_sim import scenario as scenario_io  # noqa: E402
+from multilift_sim.cables import chain  # noqa: E402
+from multilift_sim.scenario.files import resolve  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from elastic_cables import tick_cost, whole_run  # noqa: E402
+
+
+def variant(name: str, seconds: float, links: int | None = None):
+    """Scenario `name` flown `seconds` [s]; with `links` its chains of that many links, at the
+    sub-steps the validation asks for."""
+    data = yaml.safe_load(resolve(name).read_text())
+    data['simulation']['duration'] = seconds
+    if links is not None:
+        data['cable']['links'] = links
+        data['simulation']['substeps'] = 1
+        try:
+            scenario_io.loads(yaml.safe_dump(data))
+        except scenario_io.ScenarioError as exc:
+            needed = re.search(r'substeps >= (\d+)', str(exc))
+            data['simulation']['substeps'] = int(needed.group(1))
+    return scenario_io.loads(yaml.safe_dump(data))
+
+
+def omega_h(scenario) -> float:
+    """The chains' fastest transverse mode's bound times the RK4 step [-] (0: no chain)."""
+    if scenario.cable_model != 'chain':
+        return 0.0
+    sim, keys = scenario.simulation, scenario.cable
+    rate = chain.chain_rate([u.cable_length for u in scenario.uavs], keys['links'],
+                            keys['mass_per_length'], scenario.payload.mass, sim.gravity)
+    return rate / (sim.physics_rate * sim.substeps)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    parser.add_argument('--seconds', type=float, default=30.0)
+    parser.add_argument('--runs', type=int, default=3)
+    args = parser.parse_args()
+    cases = [('twin_lift (rigid)', variant('twin_lift', args.seconds)),
+             ('twin_lift_chain (30 links)', variant('twin_lift_chain', args.seconds))]
+    cases += [(f'twin_lift_chain at {links} links',
+               variant('twin_lift_chain', args.seconds, links)) for links in (10, 60)]
+    print(f'advance per control tick (100 Hz), {args.seconds:g} s at hover, CPU [us]:')
+    rigid = None
+    for label, scenario in cases:
+        cost = tick_cost(scenario)
+        rigid = rigid or cost
+        sim = scenario.simulation
+        print(f'  {label:30s} {cost:7.1f} us  ({cost / rigid:5.2f}x rigid)  physics '
+              f'{sim.physics_rate:g} Hz x {sim.substeps} sub-steps, omega h = '
+              f'{omega_h(scenario):.2f}', flush=True)
+    print('scripts/multilift run twin_lift_chain --headless (120 s):')
+    for _ in range(args.runs):
+        wall, rtf, summary = whole_run('twin_lift_chain')
+        print(f'  {wall:.2f} s wall, {rtf:.0f}x real time whole ({summary:.0f}x in its '
+              'summary)', flush=True)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

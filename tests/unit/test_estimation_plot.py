@@ -45,5 +45,8 @@ def test_the_foxglove_layout_shows_each_estimate_beside_the_truth_only_with_an_e
         paths = [s['value'] for s in config[f'Plot!estimate{i}']['paths']]
         assert paths == [f'/uav{i}/{topic}.pose.pose.position.{axis}'
                          for topic in ('estimate', 'odom') for axis in 'xyz']
-    assert not any(key.startswith('Plot!estimate')
+    paths = [s['value'] for s in config['Plot!payload_estimate']['paths']]
+    assert paths == [f'{topic}.pose.pose.position.{axis}'
+                     for topic in ('/payload/estimate', '/payload/odom') for axis in 'xyz']
+    assert not any(key.startswith(('Plot!estimate', 'Plot!payload_estimate'))
                    for key in layout(scenario_io.load('twin_lift'))['configById'])

@@ -189,3 +189,26 @@ def test_bad_input_is_one_line(sections, message):
     with pytest.raises(scenario_io.ScenarioError, match=message) as error:
         _realistic(1.0, **sections)
     assert '\n' not in str(error.value)
+
+
+def test_a_learner_observes_the_payload_s_estimate_and_is_rewarded_on_its_truth():
+    """With `payload_estimator:` the observation's payload rows are the estimate's (as the
+    policy node reads them from /formation/snapshot), the reward's error the truth's."""
+    import gymnasium
+    import multilift_learning  # noqa: F401 - registers the environments
+    from multilift_learning.observations import observation_names
+    env = gymnasium.make('multilift/Hover-v0', scenario='twin_lift_realistic',
+                         duration=2.0).unwrapped
+    env.reset(seed=0)
+    for _ in range(50):
+        observation, _, _, _, info = env.step(env.expert_action())
+    batch = env.batch
+    estimate, _ = batch.engine.payload_estimates()
+    target, _ = batch.targets.at(batch.engine.t)
+    names = observation_names(batch.n)
+    x = names.index('payload.position_error.x')
+    observed = observation[x:x + 3]
+    truth = batch.layout.payload_position(batch.engine.state)[0]
+    assert np.allclose(observed, (estimate[0] - target[0]).astype(np.float32), atol=1e-6)
+    assert not np.allclose(observed, (truth - target[0]).astype(np.float32), atol=1e-6)
+    assert info['payload_error'] == pytest.approx(float(np.linalg.norm(truth - target[0])))

@@ -208,11 +208,20 @@ class FormationBatch:
     # ----------------------------------------------------------------------- what they see
     def observe(self) -> tuple[np.ndarray, dict]:
         """Observations (B, size) float32 of the engine's formations, and the pieces the
-        reward and the ends use (float64)."""
+        reward and the ends use (float64). With an estimator the UAVs' rows are their
+        estimates (`engine.measured`) and with `payload_estimator:` the payload's too; the
+        reward and the ends read the true payload."""
         state = self.engine.state
-        return self.observation_of(self.engine.measured(), self.layout.payload_position(state),
-                                   self.layout.payload_velocity(state), self.tension,
-                                   self.engine.t)
+        truth = self.layout.payload_position(state), self.layout.payload_velocity(state)
+        estimate = self.engine.payload_estimates()
+        observation, seen = self.observation_of(
+            self.engine.measured(), *(truth if estimate is None else estimate), self.tension,
+            self.engine.t)
+        if estimate is not None:  # observed: the estimate; the reward and the ends: the truth
+            target, target_velocity = self.targets.at(self.engine.t)
+            seen.update(position_error=truth[0] - target,
+                        velocity_error=truth[1] - target_velocity, payload=truth[0].copy())
+        return observation, seen
 
     def observation_of(self, measured: np.ndarray, payload: np.ndarray,
                        payload_velocity: np.ndarray, tension: np.ndarray,

@@ -10,6 +10,7 @@ from multilift_control.engine import tick as compiled
 from multilift_control.engine.arrays import (FINISHED, RUNNING, FormationArrays, FormationMemory,
                                              TickRecord, batch_arrays, empty_record)
 from multilift_control.laws.layout import REFERENCE_SIZE, UAV_STATE_SIZE
+from multilift_sim.estimators.published import ESTIMATE_LINEAR, ESTIMATE_POSITION
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario
 from multilift_sim.physics.layout import STATUS_CONTACT
@@ -175,6 +176,17 @@ class Engine:
     def positions(self) -> np.ndarray:
         """UAV positions (B, n, 3) [m], world."""
         return StateLayout(self.n_uavs).uav_positions(self.memory.state)
+
+    def payload_estimates(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Every formation's payload estimate at its current tick (`payload_estimator:`):
+        (positions, velocities) (B, 3) [m, m/s], world, as /payload/estimate publishes them
+        (the estimator runs in `measured`, which is called first); None without one."""
+        memory = self.memory.payload_estimator_memory
+        if not memory.shape[1]:
+            return None
+        self.measured()
+        return (memory[:, 0, ESTIMATE_POSITION:ESTIMATE_POSITION + 3].copy(),
+                memory[:, 0, ESTIMATE_LINEAR:ESTIMATE_LINEAR + 3].copy())
 
     @property
     def payload_positions(self) -> np.ndarray:

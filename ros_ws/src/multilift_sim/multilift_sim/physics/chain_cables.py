@@ -52,6 +52,7 @@ from multilift_sim.physics.layout import (BODY_RATES, CHAIN_LINK_COLUMNS, CHAIN_
 from multilift_sim.physics.attitude import quaternion_rotation
 from multilift_sim.physics.chain_payload import (payload_ends, payload_moment,
                                                  rigid_payload_acceleration)
+from multilift_sim.physics.symmetric_solve import symmetric_solve3
 from multilift_sim.physics.state_slots import (attitude_slot, chain_node_slot, payload_slot,
                                                rates_slot, rigid_payload_state,
                                                uav_attitude_slot, uav_slot)
@@ -237,17 +238,8 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         rigid_payload_acceleration(x, formation, np.array([drag_ax, drag_ay, drag_az]),
                                    last_links, payload_moments, acc, turn)
         ap_x, ap_y, ap_z = turn[0], turn[1], turn[2]
-    else:  # a_p = S^-1 b by the adjugate of the symmetric 3 x 3 S (gravity excluded)
-        c00 = s11 * s22 - s12 * s12
-        c01 = s02 * s12 - s01 * s22
-        c02 = s01 * s12 - s02 * s11
-        c11 = s00 * s22 - s02 * s02
-        c12 = s01 * s02 - s00 * s12
-        c22 = s00 * s11 - s01 * s01
-        inv_det = 1.0 / (s00 * c00 + s01 * c01 + s02 * c02)
-        ap_x = (c00 * b0 + c01 * b1 + c02 * b2) * inv_det
-        ap_y = (c01 * b0 + c11 * b1 + c12 * b2) * inv_det
-        ap_z = (c02 * b0 + c12 * b1 + c22 * b2) * inv_det
+    else:  # a_p = S^-1 b (gravity excluded)
+        ap_x, ap_y, ap_z = symmetric_solve3(s00, s01, s02, s11, s12, s22, b0, b1, b2)
     acc[p], acc[p + 1], acc[p + 2] = ap_x, ap_y, ap_z - gravity
     for i in range(n):
         lk = link_rows[i]

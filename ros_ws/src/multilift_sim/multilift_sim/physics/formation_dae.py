@@ -41,6 +41,7 @@ from multilift_sim.physics.layout import (
     FORMATION_TIME, FORMATION_TWO_ALPHA, FORMATION_WINCH, NODE_STATE, POSITION, UAV_LENGTH_SQ,
     UAV_MASS,
     WORK_ACC, WORK_K1, WORK_K2, WORK_K3, WORK_K4, WORK_MULTIPLIERS, WORK_ROWS, WORK_STAGE)
+from multilift_sim.physics.symmetric_solve import symmetric_solve3
 from multilift_sim.physics.state_slots import (chain_inner_nodes, payload_slot, rates_slot,
                                                rigid_payload_state, uav_attitude_slot,
                                                uav_slot)
@@ -77,17 +78,7 @@ def cable_multipliers(cables, payload_mass, taut, out):
         sb0 += dx * weighted_rhs
         sb1 += dy * weighted_rhs
         sb2 += dz * weighted_rhs
-    # y = S^-1 sb by the adjugate of the symmetric 3 x 3 S
-    c00 = s11 * s22 - s12 * s12
-    c01 = s02 * s12 - s01 * s22
-    c02 = s01 * s12 - s02 * s11
-    c11 = s00 * s22 - s02 * s02
-    c12 = s01 * s02 - s00 * s12
-    c22 = s00 * s11 - s01 * s01
-    inv_det = 1.0 / (s00 * c00 + s01 * c01 + s02 * c02)
-    y0 = (c00 * sb0 + c01 * sb1 + c02 * sb2) * inv_det
-    y1 = (c01 * sb0 + c11 * sb1 + c12 * sb2) * inv_det
-    y2 = (c02 * sb0 + c12 * sb1 + c22 * sb2) * inv_det
+    y0, y1, y2 = symmetric_solve3(s00, s01, s02, s11, s12, s22, sb0, sb1, sb2)  # S^-1 sb
     for i in range(n):
         if taut[i]:
             out[i] = (cables[i, CABLE_RHS] - cables[i, CABLE_OFFSET] * y0

@@ -5,7 +5,8 @@ following `world`) beside plots, every series against its message's header stamp
 cable's tension, every UAV's rotor speeds (as many as its frame type has), the leader's position
 against its mission reference, every UAV's attitude set-point, and every follower's formation
 (virtual-constraint) errors, where UAVs carry winches each one's cable length, and with an
-estimator each UAV's estimated position beside its true one. A scenario
+estimator each UAV's estimated position beside its true one (and the payload's with a
+`payload_estimator:`). A scenario
 with `events:` has, under the 3D panel, the messages
 of /formation/events as they happen (docs/events.md).
 """
@@ -14,7 +15,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from multilift_sim.topics import EVENTS
+from multilift_sim.topics import EVENTS, PAYLOAD_ESTIMATE, PAYLOAD_ODOM
 
 COLORS = ['#4e98e2', '#f5774d', '#61cbff', '#b87fd6', '#71c26a', '#f7df71', '#e96d9f',
           '#9b9b9b']
@@ -109,6 +110,13 @@ def layout(scenario) -> dict:
                     for j, (topic, label) in enumerate((('estimate', 'estimate'),
                                                         ('odom', 'truth')))
                     for k, axis in enumerate('xyz')])
+    if scenario.payload_estimator is not None:  # the payload's estimate beside the truth
+        plots['Plot!payload_estimate'] = _plot(
+            'payload position [m]: estimate (/payload/estimate) and truth (/payload/odom)', [
+                _series(f'{topic}.pose.pose.position.{axis}', f'{label} {axis}', k + 3 * j)
+                for j, (topic, label) in enumerate(((PAYLOAD_ESTIMATE, 'estimate'),
+                                                    (PAYLOAD_ODOM, 'truth')))
+                for k, axis in enumerate('xyz')])
     frames = ['world', 'payload'] + [f'uav{i}/base_link' for i in range(1, n + 1)]
     config = {'3D!multilift': _three_d(frames), **plots}
     scene: str | dict = '3D!multilift'

@@ -27,7 +27,7 @@ from multilift_sim.cables import chain  # noqa: E402
 from multilift_sim.scenario.files import resolve  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from elastic_cables import tick_cost, whole_run  # noqa: E402
+from elastic_cables import report  # noqa: E402
 
 
 def variant(name: str, seconds: float, links: int | None = None):
@@ -65,20 +65,7 @@ def main() -> None:
              ('twin_lift_chain (30 links)', variant('twin_lift_chain', args.seconds))]
     cases += [(f'twin_lift_chain at {links} links',
                variant('twin_lift_chain', args.seconds, links)) for links in (10, 60)]
-    print(f'advance per control tick (100 Hz), {args.seconds:g} s at hover, CPU [us]:')
-    rigid = None
-    for label, scenario in cases:
-        cost = tick_cost(scenario)
-        rigid = rigid or cost
-        sim = scenario.simulation
-        print(f'  {label:30s} {cost:7.1f} us  ({cost / rigid:5.2f}x rigid)  physics '
-              f'{sim.physics_rate:g} Hz x {sim.substeps} sub-steps, omega h = '
-              f'{omega_h(scenario):.2f}', flush=True)
-    print('scripts/multilift run twin_lift_chain --headless (120 s):')
-    for _ in range(args.runs):
-        wall, rtf, summary = whole_run('twin_lift_chain')
-        print(f'  {wall:.2f} s wall, {rtf:.0f}x real time whole ({summary:.0f}x in its '
-              'summary)', flush=True)
+    report(cases, args.seconds, omega_h, 'twin_lift_chain', args.runs)
 
 
 if __name__ == '__main__':

@@ -100,6 +100,27 @@ def whole_run(name: str) -> tuple[float, float, float]:
     return wall, float(simulated) / wall, summary
 
 
+def report(cases, seconds: float, stepping, name: str, runs: int) -> None:
+    """Print each case's cost per tick (the first's the rigid reference) with its physics
+    rate, sub-steps and `stepping(scenario)` (its omega h), then `runs` whole headless runs of
+    scenario `name`: what benchmarks/elastic_cables.py and chain_cables.py report alike."""
+    print(f'advance per control tick (100 Hz), {seconds:g} s at hover, CPU [us]:')
+    width = max(len(label) for label, _ in cases)
+    rigid = None
+    for label, scenario in cases:
+        cost = tick_cost(scenario)
+        rigid = rigid or cost
+        sim = scenario.simulation
+        print(f'  {label:{width}s} {cost:7.1f} us  ({cost / rigid:5.2f}x rigid)  physics '
+              f'{sim.physics_rate:g} Hz x {sim.substeps} sub-steps, omega h = '
+              f'{stepping(scenario):.2f}', flush=True)
+    print(f'scripts/multilift run {name} --headless (120 s):')
+    for _ in range(runs):
+        wall, rtf, summary = whole_run(name)
+        print(f'  {wall:.2f} s wall, {rtf:.0f}x real time whole ({summary:.0f}x in its '
+              'summary)', flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--seconds', type=float, default=30.0)
@@ -111,20 +132,7 @@ def main() -> None:
                variant('twin_lift_elastic', args.seconds, ea)) for ea in (1.5e6, 1.5e7)]
     cases += [(f'{name} with winches reeling', reeling(name, args.seconds))
               for name in ('twin_lift', 'twin_lift_elastic')]
-    print(f'advance per control tick (100 Hz), {args.seconds:g} s at hover, CPU [us]:')
-    rigid = None
-    for label, scenario in cases:
-        cost = tick_cost(scenario)
-        rigid = rigid or cost
-        sim = scenario.simulation
-        print(f'  {label:34s} {cost:7.1f} us  ({cost / rigid:4.2f}x rigid)  physics '
-              f'{sim.physics_rate:g} Hz x {sim.substeps} sub-steps, omega h = '
-              f'{omega_h(scenario):.2f}', flush=True)
-    print('scripts/multilift run twin_lift_elastic --headless (120 s):')
-    for _ in range(args.runs):
-        wall, rtf, summary = whole_run('twin_lift_elastic')
-        print(f'  {wall:.2f} s wall, {rtf:.0f}x real time whole ({summary:.0f}x in its '
-              'summary)', flush=True)
+    report(cases, args.seconds, omega_h, 'twin_lift_elastic', args.runs)
     wall, rtf, summary = whole_run('twin_lift')
     print(f'  twin_lift (rigid) for comparison: {wall:.2f} s wall, {rtf:.0f}x whole '
           f'({summary:.0f}x)')

@@ -56,8 +56,9 @@ def reeling(scenario_name: str, seconds: float):
     data = yaml.safe_load(resolve(scenario_name).read_text())
     data['simulation']['duration'] = seconds
     for uav in data['uavs']:
-        uav['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5, 'min_length': 2.0,
-                        'max_length': 20.0}
+        # it only pays out: the stop at the cable's length (the rope's stiffest, as stepped)
+        uav['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5,
+                        'min_length': data['cable_length'], 'max_length': 20.0}
     data['events'] = [{'time': 0.0, 'type': 'winch_rate', 'uav': i + 1, 'rate': 0.1}
                       for i in range(len(data['uavs']))]
     return scenario_io.loads(yaml.safe_dump(data))

@@ -14,36 +14,15 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 from pathlib import Path
 
 os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
 
-import yaml  # noqa: E402 - after the BLAS setting
-
-from multilift_sim import scenario as scenario_io  # noqa: E402
-from multilift_sim.cables import chain  # noqa: E402
-from multilift_sim.scenario.files import resolve  # noqa: E402
+from multilift_sim.cables import chain  # noqa: E402 - after the BLAS setting
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from elastic_cables import report  # noqa: E402
-
-
-def variant(name: str, seconds: float, links: int | None = None):
-    """Scenario `name` flown `seconds` [s]; with `links` its chains of that many links, at the
-    sub-steps the validation asks for."""
-    data = yaml.safe_load(resolve(name).read_text())
-    data['simulation']['duration'] = seconds
-    if links is not None:
-        data['cable']['links'] = links
-        data['simulation']['substeps'] = 1
-        try:
-            scenario_io.loads(yaml.safe_dump(data))
-        except scenario_io.ScenarioError as exc:
-            needed = re.search(r'substeps >= (\d+)', str(exc))
-            data['simulation']['substeps'] = int(needed.group(1))
-    return scenario_io.loads(yaml.safe_dump(data))
+from elastic_cables import report, variant  # noqa: E402
 
 
 def omega_h(scenario) -> float:
@@ -64,7 +43,7 @@ def main() -> None:
     cases = [('twin_lift (rigid)', variant('twin_lift', args.seconds)),
              ('twin_lift_chain (30 links)', variant('twin_lift_chain', args.seconds))]
     cases += [(f'twin_lift_chain at {links} links',
-               variant('twin_lift_chain', args.seconds, links)) for links in (10, 60)]
+               variant('twin_lift_chain', args.seconds, {'links': links})) for links in (10, 60)]
     report(cases, args.seconds, omega_h, 'twin_lift_chain', args.runs)
 
 

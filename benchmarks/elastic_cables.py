@@ -34,13 +34,14 @@ from multilift_sim.simulation import FormationSimulator  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def variant(name: str, seconds: float, axial_stiffness: float | None = None):
-    """Scenario `name` flown `seconds` [s]; with axial_stiffness EA [N] its ropes changed to
-    it, at the sub-steps the validation asks for."""
+def variant(name: str, seconds: float, cable: dict | None = None):
+    """Scenario `name` flown `seconds` [s]; with `cable` those keys of its `cable:` section
+    changed (an elastic rope's axial_stiffness, a chain's links), at the sub-steps the
+    validation asks for (the number its one-line refusal names)."""
     data = yaml.safe_load(resolve(name).read_text())
     data['simulation']['duration'] = seconds
-    if axial_stiffness is not None:
-        data['cable']['axial_stiffness'] = axial_stiffness
+    if cable is not None:
+        data['cable'].update(cable)
         data['simulation']['substeps'] = 1
         try:
             scenario_io.loads(yaml.safe_dump(data))
@@ -130,7 +131,8 @@ def main() -> None:
     cases = [('twin_lift (rigid)', variant('twin_lift', args.seconds)),
              ('twin_lift_elastic (EA 1.5e5 N)', variant('twin_lift_elastic', args.seconds))]
     cases += [(f'twin_lift_elastic at EA {ea:.2g} N',
-               variant('twin_lift_elastic', args.seconds, ea)) for ea in (1.5e6, 1.5e7)]
+               variant('twin_lift_elastic', args.seconds, {'axial_stiffness': ea}))
+              for ea in (1.5e6, 1.5e7)]
     cases += [(f'{name} with winches reeling', reeling(name, args.seconds))
               for name in ('twin_lift', 'twin_lift_elastic')]
     report(cases, args.seconds, omega_h, 'twin_lift_elastic', args.runs)

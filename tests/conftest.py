@@ -28,6 +28,23 @@ import pytest
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
 SCENARIOS = ROOT / 'scenarios'
+
+
+def realistic_scenario(duration: float, **sections):
+    """twin_lift_realistic flown `duration` [s], each of `sections` (a top-level key) set to
+    its value, or removed where it is None (the estimation tests' variants)."""
+    import yaml
+    from multilift_sim import scenario as scenario_io
+    data = yaml.safe_load((SCENARIOS / 'twin_lift_realistic.yaml').read_text())
+    data['simulation']['duration'] = duration
+    for name, value in sections.items():
+        if value is None:
+            data.pop(name, None)
+        else:
+            data[name] = value
+    return scenario_io.loads(yaml.safe_dump(data))
+
+
 LAYERS = {'unit': 'no ROS graph, no processes (tests/unit/)',
           'ros': 'starts processes or talks to a ROS graph (tests/ros/)'}
 T = TypeVar('T')

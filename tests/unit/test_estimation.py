@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
+from conftest import realistic_scenario as _realistic
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
 from multilift_sim.estimators import ekf, error_state, published
@@ -145,17 +146,6 @@ def test_motion_capture_delivers_samples_latency_ticks_late_and_the_first_at_onc
             arrivals[tick] = (memory[TAKEN], memory[OUTPUT])
     # taken at 0 (at once), 2, 4, 6, (8 lost), 10 arriving 3 ticks later, each its tick's x
     assert arrivals == {0: (0, 0.0), 5: (2, 2.0), 7: (4, 4.0), 9: (6, 6.0), 13: (10, 10.0)}
-
-
-def _realistic(duration: float, **sections) -> scenario_io.Scenario:
-    data = yaml.safe_load((ROOT / 'scenarios' / 'twin_lift_realistic.yaml').read_text())
-    data['simulation']['duration'] = duration
-    for name, value in sections.items():
-        if value is None:
-            data.pop(name, None)
-        else:
-            data[name] = value
-    return scenario_io.loads(yaml.safe_dump(data))
 
 
 @pytest.mark.parametrize('sections,message', [

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import yaml
 
+from conftest import realistic_scenario as _realistic
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
 from multilift_sim.estimators import published
@@ -25,17 +26,6 @@ from multilift_sim.sensors import cable_sensor
 from multilift_sim.statistics import estimation
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def _realistic(duration: float, **sections) -> scenario_io.Scenario:
-    data = yaml.safe_load((ROOT / 'scenarios' / 'twin_lift_realistic.yaml').read_text())
-    data['simulation']['duration'] = duration
-    for name, value in sections.items():
-        if value is None:
-            data.pop(name, None)
-        else:
-            data[name] = value
-    return scenario_io.loads(yaml.safe_dump(data))
 
 
 def test_gimbal_angles_of_known_directions_and_back():

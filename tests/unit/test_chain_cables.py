@@ -164,13 +164,3 @@ def test_engine_and_simulator_fly_a_chain_twin_lift_alike():
     engine, simulator = fly(s), run_headless(s)
     np.testing.assert_array_equal(engine.engine.state[0], simulator.simulator.state)
     assert engine.engine.memory.status[0] == 1  # finished
-
-
-def test_what_a_chain_cannot_carry_is_one_line():
-    """A winch is refused with chains, one line."""
-    winch = yaml.safe_load(_chain())
-    winch['uavs'][0]['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5,
-                                 'min_length': 2.0, 'max_length': 15.0}
-    with pytest.raises(scenario_io.ScenarioError) as caught:
-        scenario_io.loads(yaml.safe_dump(winch))
-    assert 'not cable_model: chain' in str(caught.value) and '\n' not in str(caught.value)

@@ -20,7 +20,9 @@ NEEDS = frozenset({'chain'})
 RELEASE_LIMIT_DEG = 90.0
 KEEPS_LENGTH = True   # each link is the seed's constraint (per link); the start hangs at l_i
 SLACKENS = False      # (a chain folds by itself: its links keep their lengths)
-REELS = False         # a winch on a chain (its links' lengths reeled): not modelled
+# a winch reels every link alike (l_i(t) / N), the nodes keep their masses and drag
+# (physics.chain_cables; docs/cables.md)
+REELS = True
 
 CHAIN_KEYS = ('links', 'mass_per_length', 'drag_coefficient', 'diameter')
 AIR_DENSITY = 1.225   # rho [kg/m^3], the ISA's at sea level
@@ -53,32 +55,39 @@ def drag_per_length(keys: dict[str, Any]) -> float:
 
 
 def check(scenario: Any) -> str | None:
-    """A point or rigid payload (the UAVs' attach points too), no UAV prescribed (no winch:
-    REELS), the chains' transverse waves stepped at omega h <= ELASTIC_OMEGA_H
-    (`chain_stepping`)."""
+    """A point or rigid payload (the UAVs' attach points too), no UAV prescribed, the chains'
+    transverse waves stepped at omega h <= ELASTIC_OMEGA_H (`chain_stepping`) at their
+    fastest: a winch's chain reeled in to its min_length."""
     if scenario.prescribed:
         return ('cable_model: chain is not for a formation with prescribed UAVs '
                 '(uavs[i].trajectory)')
     keys, sim = scenario.cable, scenario.simulation
     lengths = [u.cable_length for u in scenario.uavs]
+    shortest = [u.winch.min_length if u.winch else u.cable_length for u in scenario.uavs]
     return chain_stepping(lengths, keys['links'], keys['mass_per_length'],
-                          scenario.payload.mass, sim.gravity, sim.physics_rate, sim.substeps)
+                          scenario.payload.mass, sim.gravity, sim.physics_rate, sim.substeps,
+                          shortest)
 
 
 def chain_rate(lengths, links: int, mass_per_length: float, payload_mass: float,
-               gravity: float) -> float:
+               gravity: float, shortest=None) -> float:
     """A bound on the chains' fastest transverse mode [rad/s]: a string of N masses under
     tension T has its highest mode at 2 sqrt(T / mu) / s (s = l / N its link), T bounded by
-    the whole weight (payload and cables) on one cable."""
+    the whole weight (payload and cables) on one cable. A chain reeled in from l to l_s
+    (`shortest` [m], each cable's; default `lengths`) keeps its nodes' masses on links l_s / N:
+    mu l / l_s per metre, so 2 sqrt(T / mu) N / sqrt(l l_s)."""
     tension = (payload_mass + mass_per_length * sum(lengths)) * gravity
-    return 2.0 * math.sqrt(tension / mass_per_length) / (min(lengths) / links)
+    shortest = lengths if shortest is None else shortest
+    span = min(math.sqrt(length * short) for length, short in zip(lengths, shortest))
+    return 2.0 * math.sqrt(tension / mass_per_length) / (span / links)
 
 
 def chain_stepping(lengths, links: int, mass_per_length: float, payload_mass: float,
-                   gravity: float, physics_rate: float, substeps: int) -> str | None:
+                   gravity: float, physics_rate: float, substeps: int,
+                   shortest=None) -> str | None:
     """One line naming the sub-steps or rate needed unless the chains' transverse waves are
-    stepped at omega h <= ELASTIC_OMEGA_H (None then)."""
-    rate = chain_rate(lengths, links, mass_per_length, payload_mass, gravity)
+    stepped at omega h <= ELASTIC_OMEGA_H (None then; `shortest` as `chain_rate`'s)."""
+    rate = chain_rate(lengths, links, mass_per_length, payload_mass, gravity, shortest)
     omega_h = rate / (physics_rate * substeps)
     if omega_h <= ELASTIC_OMEGA_H:
         return None

@@ -47,12 +47,14 @@ from multilift_sim.physics.layout import (BODY_RATES, CHAIN_LINK_COLUMNS, CHAIN_
                                           FORMATION_CHAIN_LINKS,
                                           FORMATION_GRAVITY, FORMATION_PAYLOAD_MASS,
                                           FORMATION_TWO_ALPHA, FORMATION_WIND, NODE_POSITION,
-                                          NODE_VELOCITY, POSITION, UAV_LENGTH_SQ, UAV_MASS,
+                                          NODE_VELOCITY, POSITION, REEL_LENGTH, REEL_RATE,
+                                          UAV_MASS,
                                           UAV_NODE_DRAG, UAV_NODE_MASS)
 from multilift_sim.physics.attitude import quaternion_rotation
 from multilift_sim.physics.chain_payload import (payload_ends, payload_moment,
                                                  rigid_payload_acceleration)
 from multilift_sim.physics.symmetric_solve import symmetric_solve3
+from multilift_sim.physics.winch import reeled_cable
 from multilift_sim.physics.state_slots import (attitude_slot, chain_node_slot, payload_slot,
                                                rates_slot, rigid_payload_state,
                                                uav_attitude_slot, uav_slot)
@@ -156,7 +158,12 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                                                              + rel_z * rel_z)
                 fx, fy, fz = scale * rel_x, scale * rel_y, scale * rel_z
             put3(nd[k], CHAIN_NODE_FREE, fx, fy, fz)
-        link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)   # s_i^2
+        # s_i^2 and a reeled length's terms of g_dot and g_ddot (s_i s_i_dot, s_i_dot^2 +
+        # s_i s_i_ddot; 0 without a winch): each link is l_i(t) / N (physics.winch)
+        length_sq, reel_rate, reel_acc = reeled_cable(uavs, formation, i)
+        per_link = links * links
+        link_sq, link_rate, link_acc = (length_sq / per_link, reel_rate / per_link,
+                                        reel_acc / per_link)
         for k in range(1, links + 1):  # link k's row: d_k, A's entries, its right-hand side
             r0, v0 = node_point(x, n, inner, i, k - 1, p, nq)
             r1, v1 = node_point(x, n, inner, i, k, p, nq)
@@ -179,9 +186,10 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                 k0, k1, k2 = cable_moment_arm(uavs, i, rotation, dx, dy, dz)
                 put3(moments[i], 0, k0, k1, k2)
                 row[CHAIN_LINK_DIAGONAL] += 2.0 * rotational_compliance(uavs, i, k0, k1, k2)
-            # d_k . (a_k - a_(k-1)) = -|dv_k|^2 - alpha_f g_dot_k - beta_f^2 g_k / 2 (Eq. 2.59)
-            target = (-(dvx * dvx + dvy * dvy + dvz * dvz)
-                      - two_alpha * (dx * dvx + dy * dvy + dz * dvz)
+            # d_k . (a_k - a_(k-1)) = -|dv_k|^2 + s_dot^2 + s s_ddot - alpha_f g_dot_k
+            # - beta_f^2 g_k / 2 (Eq. 2.59; g_dot_k / 2 = d_k . dv_k - s s_dot)
+            target = (-(dvx * dvx + dvy * dvy + dvz * dvz - link_acc)
+                      - two_alpha * (dx * dvx + dy * dvy + dz * dvz - link_rate)
                       - 0.5 * beta_sq * (offset_sq - link_sq))
             free_x, free_y, free_z = (-nd[k - 1, CHAIN_NODE_FREE], -nd[k - 1, CHAIN_NODE_FREE + 1],
                                       -nd[k - 1, CHAIN_NODE_FREE + 2])
@@ -279,10 +287,12 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
 
 
 @jit
-def chain_residuals(x, uavs, inner, g, g_dot):
+def chain_residuals(x, uavs, inner, length_sq, length_rate, g, g_dot):
     """Each cable's worst link (the largest |g_ik|) at state x: its g_ik = |d_ik|^2 - s_i^2
-    [m^2] into g (n,) and the largest |g_dot_ik| = |2 d_ik . (v_ik - v_i(k-1))| [m^2/s], signed,
-    into g_dot (n,) (`inner` = N - 1 inner nodes per cable)."""
+    [m^2] into g (n,) and the largest |g_dot_ik| = |2 d_ik . (v_ik - v_i(k-1)) - 2 s_i s_i_dot|
+    [m^2/s], signed, into g_dot (n,) (`inner` = N - 1 inner nodes per cable; s_i = l_i / N from
+    each cable's l_i^2 `length_sq` (n,) [m^2] and l_i l_i_dot `length_rate` (n,) [m^2/s]: a
+    reel's, or the constant lengths' and 0)."""
     n = uavs.shape[0]
     links = inner + 1
     p = payload_slot(n)
@@ -293,7 +303,8 @@ def chain_residuals(x, uavs, inner, g, g_dot):
     if rigid:  # the last links end at the payload's attach points
         payload_ends(x, uavs, quaternion_rotation(x, attitude_slot(n)), ends)
     for i in range(n):
-        link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)
+        per_link = links * links
+        link_sq, link_rate = length_sq[i] / per_link, length_rate[i] / per_link
         worst = worst_rate = 0.0
         off_centre = attached_off_centre(uavs, i)
         if off_centre:  # node 0 the attach point r_i + R_i a_i
@@ -310,9 +321,17 @@ def chain_residuals(x, uavs, inner, g, g_dot):
                 dx, dy, dz = dx + ends[i, 0, 0], dy + ends[i, 0, 1], dz + ends[i, 0, 2]
                 dvx, dvy, dvz = dvx + ends[i, 1, 0], dvy + ends[i, 1, 1], dvz + ends[i, 1, 2]
             value = dx * dx + dy * dy + dz * dz - link_sq
-            rate = 2.0 * (dx * dvx + dy * dvy + dz * dvz)
+            rate = 2.0 * (dx * dvx + dy * dvy + dz * dvz - link_rate)
             if abs(value) >= abs(worst):
                 worst = value
             if abs(rate) >= abs(worst_rate):
                 worst_rate = rate
         g[i], g_dot[i] = worst, worst_rate
+
+
+@jit
+def reeled_chain_residuals(x, uavs, inner, reel, g, g_dot):
+    """`chain_residuals` at state x against reeled cables: each link l_i / N with l_i and
+    l_i_dot the reels' (`reel` (n, REEL_COLUMNS), physics.winch)."""
+    lengths, rates = reel[:, REEL_LENGTH], reel[:, REEL_RATE]
+    chain_residuals(x, uavs, inner, lengths * lengths, lengths * rates, g, g_dot)

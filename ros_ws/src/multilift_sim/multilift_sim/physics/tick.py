@@ -36,6 +36,7 @@ from multilift_sim.physics.prescribed import prescribe_state
 from multilift_sim.estimators.estimation import estimated_states
 from multilift_sim.payload_estimators.estimation import estimated_payload
 from multilift_sim.physics.cable_sensing import cable_truths
+from multilift_sim.physics.chain_cables import reeled_chain_residuals
 from multilift_sim.physics.winch import period_uavs, reel_end
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.estimation import run_add_estimation
@@ -199,6 +200,9 @@ def advance(a, m, b, speeds, saturated, tension):
     if formation[FORMATION_WINCH] != 0.0:  # the reels at the new tick, g, g_dot of the
         # reeled lengths there
         reel_end(uavs, m.reel[b], (m.tick[b] + 1) * a.period_ns[b] * 1e-9, g, g_dot)
+        if formation[FORMATION_CHAIN_LINKS] != 0.0:  # the worst links against l_i(t) / N
+            reeled_chain_residuals(state, uavs, int(formation[FORMATION_CHAIN_LINKS]) - 1,
+                                   m.reel[b], g, g_dot)
         run_add_reel(m.run[b], m.reel[b], a.cable_lengths[b])
     if a.slack[b]:
         run_add_slack(m.run[b], m.taut[b], period)

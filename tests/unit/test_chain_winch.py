@@ -130,3 +130,32 @@ def test_a_chain_s_stepping_is_checked_at_the_winch_s_shortest_length():
     with pytest.raises(scenario_io.ScenarioError, match='^[^\n]*$') as error:
         scenario_io.loads(yaml.safe_dump(data))
     assert 'simulation.substeps' in str(error.value)
+
+
+def test_a_learner_reels_heavy_cables_through_its_actions():
+    """Hover-v0 on twin_lift_chain with winches and `winch_actions=True`: the expert flies the
+    chains without a termination, and a reel action of 1 on uav1 pays its chain out at the
+    winch's 0.5 m/s after the 1 s ramp (the trapezoid of the acceleration limit), to 0.01 m."""
+    import gymnasium
+
+    import multilift_learning  # noqa: F401 - registers the environments
+    from multilift_sim.physics.layout import REEL_LENGTH
+    data = yaml.safe_load((SCENARIOS / 'twin_lift_chain.yaml').read_text())
+    for u in data['uavs']:
+        u['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5, 'min_length': 8.0,
+                      'max_length': 15.0}
+    s = scenario_io.loads(yaml.safe_dump(data))
+    env = gymnasium.make('multilift/Hover-v0', scenario=s, duration=4.0,
+                         winch_actions=True).unwrapped
+    env.reset(seed=0)
+    size = env.batch.uav_action_size
+    start = env.batch.engine.memory.reel[0, 0, REEL_LENGTH]
+    ticks = 300
+    for _ in range(ticks):
+        action = env.expert_action().copy()
+        action[size - 1] = 1.0
+        observation, _, terminated, truncated, info = env.step(action)
+        assert not terminated and np.all(np.isfinite(observation)), info
+    paid = 0.5 * ticks * 0.01 - 0.5 * 0.5 / (2 * 0.5)
+    assert env.batch.engine.memory.reel[0, 0, REEL_LENGTH] - start == pytest.approx(paid,
+                                                                                  abs=0.01)

@@ -12,7 +12,7 @@ import pytest
 
 from multilift_sim import kernels
 from multilift_sim.formation_params import StateLayout
-from multilift_sim.physics.layout import REEL_COLUMNS
+from multilift_sim.physics.layout import REEL_COLUMNS, UAV_COLUMNS
 from multilift_sim.statistics import (FormationErrorStatistics, RunStatistics,
                                       TrackingStatistics, accumulators, figures, swing)
 from multilift_sim.statistics.layout import (CHECK_QUATERNION, CHECK_G, CHECK_G_DOT,
@@ -137,8 +137,9 @@ def test_the_accumulators_compiled_and_uncompiled_agree(n):
         _same(accumulators.run_add_tensions, run, tension)
         _same(accumulators.run_add_ropes, run, rng.normal(size=StateLayout(n).size),
               rng.uniform(0.5, 2.0, n), tension)
-        _same(accumulators.run_add_sag, run, rng.normal(size=StateLayout(n, chain_nodes=4).size),
-              n, 4)
+        _same(accumulators.run_add_chains, run,
+              rng.normal(size=StateLayout(n, chain_nodes=4).size),
+              rng.normal(size=(n, UAV_COLUMNS)), 4, rng.uniform(0.5, 2.0, n), tension)
         _same(accumulators.run_add_reel, run, rng.uniform(0.5, 2.0, (n, REEL_COLUMNS)),
               rng.uniform(0.5, 2.0, n))
         _same(accumulators.run_add_slack, run, rng.random(n) < 0.5, 0.01)

@@ -148,8 +148,8 @@ def run_add_chains(run: np.ndarray, state: np.ndarray, uavs: np.ndarray, inner: 
         for k in range(1, inner + 1):
             ex, ey, ez = path[k, 0] - path[0, 0], path[k, 1] - path[0, 1], path[k, 2] - path[0, 2]
             along = (ex * cx + ey * cy + ez * cz) / chord_sq if chord_sq > 0.0 else 0.0
-            off = math.sqrt((ex - along * cx) ** 2 + (ey - along * cy) ** 2
-                            + (ez - along * cz) ** 2)
+            ox, oy, oz = ex - along * cx, ey - along * cy, ez - along * cz
+            off = math.sqrt(ox * ox + oy * oy + oz * oz)
             if off > sag:
                 sag = off
         block = RUN_SCALARS + RUN_UAV_COLUMNS * i

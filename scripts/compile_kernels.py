@@ -1,13 +1,18 @@
 """Compile the kernels into numba's on-disk cache (multilift_sim.kernels: how start-up stays
-low), a stage per call, so scripts/setup runs independent stages in parallel processes on the
-machine's two cores (a kernel one stage compiled is loaded from the cache by the next):
+low), a stage per call, so scripts/setup runs them in two lanes of processes on the machine's
+two cores (a kernel one stage compiled is loaded from the cache by a later one; numba
+optimises each compiled function with every function it calls, so what a kernel calls should
+be in the cache before it is compiled, or the two lanes compile it twice):
 
-- `physics`: the physics' tick (multilift_sim.physics.tick) as the simulator node steps it
-  (rigid and slack cables, a rigid payload, events and sensors, a prescribed UAV's start);
-- `laws`: every controller's compiled laws as the controller nodes call them (the runtimes);
-- `engine`: the engine's tick over B formations (`run --headless`, sweeps), after the two;
+- `advance`: the physics' tick (multilift_sim.physics.tick) as the simulator node steps it:
+  its start, its advance (rigid and slack cables, a rigid payload, events, a prescribed UAV's
+  start) and the tension at a tick; in one lane, beside
+- `measure`: the physics' measure (sensors, estimators) as the simulator node calls it,
+- `laws`: every controller's compiled laws as the controller nodes call them (the runtimes),
+- `engine_start`: the engine's start (its physics' start from the cache `advance` filled);
+- then `engine`: the engine's tick over B formations (`run --headless`, sweeps), beside
 - `learning`: the engine's calls the learning environments make (answers, commanded ticks,
-  references, attitude commands, their own attitude-rate loop), after the first two;
+  references, attitude commands, their own attitude-rate loop);
 - `rest`: the simulator's messages and a run of every kind, tick by tick (mostly loads).
 
 Run by scripts/setup with the workspace's environment (scripts/env.sh), MULTILIFT_KERNEL=jit.
@@ -18,6 +23,7 @@ import dataclasses
 import os
 import sys
 
+import numpy as np
 import yaml
 
 from multilift_sim import kernels, scenario  # NUMBA_CACHE_DIR: the folder of these sources
@@ -44,17 +50,35 @@ def _every_kind() -> scenario.Scenario:
     return scenario.loads(yaml.safe_dump(data))
 
 
-def physics() -> None:
+def _physics_scenarios() -> tuple[scenario.Scenario, ...]:
+    """The scenarios whose ticks reach every compiled path of the physics."""
+    return (_short('twin_lift'), _short('twin_lift', 'slack'), _short('box_lift'),
+            _every_kind(), _short('prescribed_swing'))  # its start: prescribe_state
+
+
+def advance() -> None:
     from multilift_sim.simulation import FormationSimulator
-    for short in (_short('twin_lift'), _short('twin_lift', 'slack'), _short('box_lift'),
-                  _every_kind(), _short('prescribed_swing')):  # its start: prescribe_state
-        sim = FormationSimulator(short)
+    for short in _physics_scenarios():
+        sim = FormationSimulator(short)  # its start (physics.tick.start), compiled
         speeds = [list(range(1400, 1400 + u.vehicle.n_rotors)) for u in short.uavs]
         flags = [[False] * u.vehicle.n_rotors for u in short.uavs]
         for _ in range(3):
-            sim.snapshot()
             sim.advance(speeds, flags)
         sim.cable_state(speeds)
+
+
+def measure() -> None:
+    from multilift_sim.physics import tick
+    from multilift_sim.physics.layout import MEASURED_COLUMNS
+    from multilift_sim.simulation import FormationSimulator
+    compiled = kernels.runnable(tick.measure, 'jit')
+    for short in _physics_scenarios():
+        # the simulator uncompiled (the `advance` stage compiles it), its measure compiled,
+        # called as FormationSimulator.snapshot calls it
+        os.environ[kernels.VARIABLE] = 'python'
+        sim = FormationSimulator(short)
+        os.environ[kernels.VARIABLE] = 'jit'
+        compiled(sim.arrays, sim.memory, 0, np.empty((sim.n, MEASURED_COLUMNS)))
 
 
 def laws() -> None:
@@ -68,10 +92,17 @@ def laws() -> None:
         answer_tick(formation_runtimes(short), 0, uav_states(snapshot))
 
 
+def engine_start() -> None:
+    from multilift_control.engine import Engine
+    Engine(_short('twin_lift'))  # engine.tick.start and tell_controllers
+
+
 def engine() -> None:
     from multilift_control.engine import Engine
     for short in (_short('twin_lift'), _every_kind()):
-        Engine(short).step(5)
+        engine = Engine(short)
+        engine.step(5)
+        engine.measured()
 
 
 def learning() -> None:
@@ -107,8 +138,8 @@ def rest() -> None:
     Engine(obstacles).step(5)
 
 
-STAGES = {'physics': physics, 'laws': laws, 'engine': engine, 'learning': learning,
-          'rest': rest}
+STAGES = {'advance': advance, 'measure': measure, 'laws': laws, 'engine_start': engine_start,
+          'engine': engine, 'learning': learning, 'rest': rest}
 
 if __name__ == '__main__':
     for stage in sys.argv[1:]:

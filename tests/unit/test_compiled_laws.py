@@ -204,7 +204,6 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
             check(constraints.row_residual, rows, targets, r, k)
             check(constraints.row_rate, rows, r, v, k)
             g, _ = check(constraints.residual, rows, targets, r)
-            check(constraints.rates, rows, r, v)
             check(constraints.jacobian, rows, r)
             check(constraints.jacobian_rate_product, rows, v)
             check(constraints.rows_of, rows, f.index)

@@ -145,9 +145,9 @@ class VirtualConstraints:
         self.rows[:, ROW_FIRST] = self.pairs[:, 0]
         self.rows[:, ROW_SECOND] = self.pairs[:, 1]
         self.rows[:, ROW_AXIS] = self.axes if self.linear else ROW_DISTANCE
-        (self._residual, self._jacobian, self._rates, self._jacobian_rate_product,
+        (self._residual, self._jacobian, self._row_rate, self._jacobian_rate_product,
          self._free_follower_motions) = map(laws.runnable, (
-            rows_laws.residual, rows_laws.jacobian, rows_laws.rates,
+            rows_laws.residual, rows_laws.jacobian, rows_laws.row_rate,
             rows_laws.jacobian_rate_product, rows_laws.free_follower_motions))
         # one-time queries of a formation's set-up (a follower's rows, the linear rows'
         # constant Jacobian): the laws' own source run uncompiled, the same numbers without
@@ -196,8 +196,10 @@ class VirtualConstraints:
         return jac
 
     def rate(self, r: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """g_vc_dot = J_vc r_f_dot (m,): [m/s] or [m^2/s]."""
-        return self._rates(self.rows, self._check(r), self._check(v, 'v'))
+        """g_vc_dot = J_vc r_f_dot (m,): [m/s] or [m^2/s], row by row as the followers' laws
+        take it (`laws.constraints.row_rate`)."""
+        r, v = self._check(r), self._check(v, 'v')
+        return np.array([self._row_rate(self.rows, r, v, k) for k in range(self.m)])
 
     def jacobian_rate_product(self, r: np.ndarray, v: np.ndarray) -> np.ndarray:
         """J_vc_dot r_f_dot (m,): zero for linear rows, 2 |v_i - v_j|^2 for distance rows

@@ -16,9 +16,9 @@ from multilift_sim.topics import PAYLOAD_ODOM, ROTOR_CMD, uav_topic
 from multilift_tools.bagdata import Run, rotor_limits
 from multilift_tools.metrics import comparison_rows, common_end, until
 from multilift_tools.plot_style import (AXES_XYZ, SATURATION_GREY, WORLD, Parser,
-                                        finish_time_axes, formation_row_labels, legend,
-                                        load_bag, parse_args, plot_context, plt, save_figure,
-                                        uav_color)
+                                        finish_time_axes, finish_time_plot, formation_row_labels,
+                                        legend, load_bag, parse_args, plot_context, plt,
+                                        save_figure, uav_color)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -112,10 +112,9 @@ def fig_compare_leader_rotors(runs: Sequence[Run], labels: Sequence[str],
         ax.axhspan(w_max, max(top, w_max) + margin, color=SATURATION_GREY, zorder=0,
                    label=f'saturation ω ≥ ω_max = {w_max:g} rad/s')
         ax.set_ylim(bottom - margin, max(top, w_max) + margin)
-    legend(ax, loc='lower left', ncols=2)
-    ax.set_ylabel('leader rotor speed ω [rad/s]')
-    ax.set_title(f'leader (UAV 1) rotor speeds: {labels[0]} vs {labels[1]}', fontsize='medium')
-    finish_time_axes([ax])
+    finish_time_plot(ax, 'leader rotor speed ω [rad/s]',
+                     f'leader (UAV 1) rotor speeds: {labels[0]} vs {labels[1]}',
+                     loc='lower left', ncols=2)
     return fig
 
 

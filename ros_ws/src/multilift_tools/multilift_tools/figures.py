@@ -23,8 +23,8 @@ from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_ERROR, FORMATION_
 from multilift_tools.bagdata import Run, RunDataError
 from multilift_tools.metrics import interp_rows
 from multilift_tools.plot_style import (AXES_XYZ, PAYLOAD_COLOR, WORLD, Context, Parser,
-                                        finish_time_axes, formation_row_labels, legend,
-                                        mark_events, parse_and_load, plot_context, plt,
+                                        finish_time_axes, finish_time_plot, formation_row_labels,
+                                        legend, mark_events, parse_and_load, plot_context, plt,
                                         save_figure, shade_flags, uav_color, uav_label,
                                         uav_width)
 from multilift_tools.plots.obstacles import fig_clearance, lacks_world
@@ -170,11 +170,8 @@ def fig_tensions(ctx: Context) -> Figure:
     if lo < 0:
         ax.axhspan(min(lo * 1.1, -0.05), 0.0, color='tab:red', alpha=0.08,
                    label='T < 0: compression (rigid-rod model; a real cable goes slack)')
-    ax.set_ylabel('cable tension [N]')
-    ax.set_title(f'{run.label}: cable tensions, {lo:.2f} .. {tension.max():.2f} N',
-                 fontsize='medium')
-    legend(ax, loc='best')
-    finish_time_axes([ax])
+    finish_time_plot(ax, 'cable tension [N]',
+                     f'{run.label}: cable tensions, {lo:.2f} .. {tension.max():.2f} N', loc='best')
     return fig
 
 
@@ -188,11 +185,9 @@ def fig_leader_tracking(ctx: Context) -> Figure:
         ax.plot(run.t, err[:, k], lw=1.0, label=f'{AXES_XYZ[k]}')
     norm = np.linalg.norm(err, axis=1)
     ax.plot(run.t, norm, color='black', lw=1.2, label='|r_1 - r_ref|')
-    ax.set_ylabel('leader tracking error $r_1 - r_{ref}$ [m]')
-    ax.set_title(f'{run.label}: leader tracking ({WORLD}); max {norm.max():.3f} m, '
-                 f'rms {np.sqrt(np.mean(norm ** 2)):.3f} m', fontsize='medium')
-    legend(ax, loc='best', ncols=4)
-    finish_time_axes([ax])
+    finish_time_plot(ax, 'leader tracking error $r_1 - r_{ref}$ [m]',
+                     f'{run.label}: leader tracking ({WORLD}); max {norm.max():.3f} m, '
+                     f'rms {np.sqrt(np.mean(norm ** 2)):.3f} m', loc='best', ncols=4)
     return fig
 
 

@@ -66,6 +66,15 @@ def finish_time_axes(axes: Sequence[Axes]) -> None:
     axes[-1].set_xlabel(TIME_LABEL)
 
 
+def finish_time_plot(ax: Axes, ylabel: str, title: str, **legend_options: Any) -> None:
+    """A one-axes figure against time finished: its y label, its title (medium), the legend
+    (`legend`, with legend_options) and `finish_time_axes`."""
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize='medium')
+    legend(ax, **legend_options)
+    finish_time_axes([ax])
+
+
 def mark_events(axes: Sequence[Axes], events: Sequence[tuple[float, str]]) -> None:
     """A dashed line at each event's time [s] on every time axes, its description written
     along the line on the first."""

@@ -135,7 +135,7 @@ def advance_formation(a, m, b, speeds, saturated, tension):
         tell_controllers(a, m, b, first)
 
 
-@jit
+@jit(inline=True)  # into run_ticks, its one caller: numba optimises the whole tick once
 def formation_tick(a, m, b, states, speeds, saturated, setpoints, thrust, reference, errors,
                    rates, tension):
     """One control tick of formation b: measure (`measure`), answer, hold the speeds over the

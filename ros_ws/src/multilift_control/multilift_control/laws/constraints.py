@@ -46,15 +46,6 @@ def residual(rows, targets, positions):
 
 
 @jit
-def rates(rows, positions, velocities):
-    """g_vc_dot = J_vc r_f_dot (m,) [m/s or m^2/s]."""
-    out = np.empty(rows.shape[0])
-    for k in range(rows.shape[0]):
-        out[k] = row_rate(rows, positions, velocities, k)
-    return out
-
-
-@jit
 def jacobian(rows, positions):
     """J_vc = d g_vc / d r_f (m, 3n): +-1 at the row's axis for a linear row (constant,
     Eq. 3.7), +-2 (r_i - r_j) for a distance row."""

@@ -1,7 +1,7 @@
 """Estimators as registered parts (issue 33 item 2; docs/estimation.md): one module per
 estimator, `ESTIMATORS` the registry (name -> module) that the scenario's `estimator:` (its
 `model`; `none` or absent: no estimator), the run's arrays (`estimators.arrays`) and the
-physics' tick (`physics.tick.measure`, through `estimation.estimated_states` and the
+physics' tick (`physics.tick.measure`, through `estimation.estimated` and the
 dispatcher generated from it) read.
 
 An estimator runs on each UAV after its sensors (`multilift_sim.sensors`: those an estimator

@@ -1,4 +1,4 @@
-"""A run's estimator as the compiled tick reads it (`estimation.estimated_states`): its index,
+"""A run's estimator as the compiled tick reads it (`estimators.estimation.estimated`): its index,
 constants row and every UAV's memory at the start, built once before the run from the
 scenario's `estimator:`. No numba, no ROS. Without one, none (E = 0)."""
 from __future__ import annotations

@@ -2,7 +2,7 @@
 estimator, `PAYLOAD_ESTIMATORS` the registry (name -> module) that the scenario's
 `payload_estimator:` (its `model`; `none` or absent: none), the run's arrays
 (`payload_estimators.arrays`) and the physics' tick (`physics.tick.measure`, through
-`estimation.estimated_payload` and the dispatcher generated from it) read.
+`estimators.estimation.estimated` and the dispatcher generated from it) read.
 
 A payload estimator runs after the UAVs' estimator (`multilift_sim.estimators`) and estimates
 the payload's position and velocity from what the UAVs know: their estimates and their
@@ -27,7 +27,7 @@ NONE = 'none'  # `payload_estimator: none` (or no section): the controllers read
 
 
 def _changed() -> None:
-    from multilift_sim.payload_estimators import estimation  # numba's side
+    from multilift_sim.estimators import estimation  # numba's side
     estimation.PAYLOAD_ESTIMATORS_DISPATCH.refresh()
 
 

@@ -1,4 +1,4 @@
-"""A run's payload estimator as the compiled tick reads it (`estimation.estimated_payload`):
+"""A run's payload estimator as the compiled tick reads it (`estimators.estimation.estimated`):
 its index, constants row and memory at the start, built once before the run from the
 scenario's `payload_estimator:`. No numba, no ROS. Without one, none (P = 0)."""
 from __future__ import annotations

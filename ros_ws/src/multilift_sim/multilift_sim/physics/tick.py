@@ -33,8 +33,7 @@ from multilift_sim.physics.state_slots import (attitude_slot, payload_slot, rate
                                                uav_attitude_slot)
 from multilift_sim.physics.measurement import measured_states
 from multilift_sim.physics.prescribed import prescribe_state
-from multilift_sim.estimators.estimation import estimated_states
-from multilift_sim.payload_estimators.estimation import estimated_payload
+from multilift_sim.estimators.estimation import estimated
 from multilift_sim.physics.cable_sensing import cable_truths
 from multilift_sim.physics.chain_cables import reeled_chain_residuals
 from multilift_sim.physics.winch import period_uavs, reel_end
@@ -249,9 +248,9 @@ def measure(a, m, b, states):
     (n, MEASURED_COLUMNS): the measured states (seed Eq. 2.7), with `sensors:` as its sensor
     models deliver them from the truth (the measured states and the cables', `physics.
     cable_sensing.cable_truths`; `sensors.sensing.sensed_states`), with `estimator:` as it
-    estimates them (`estimators.estimation.estimated_states`), then with `payload_estimator:`
-    the payload's estimate into its memory (`payload_estimators.estimation
-    .estimated_payload`); the same result however often it is called at one tick."""
+    estimates them, then with `payload_estimator:` the payload's estimate into its memory
+    (both `estimators.estimation.estimated`); the same result however often it is called at
+    one tick."""
     measured_states(m.state[b], states.shape[0], states)
     if a.sensor_models.shape[1]:
         truth = np.empty((states.shape[0], SENSED_COLUMNS))
@@ -259,13 +258,11 @@ def measure(a, m, b, states):
         cable_truths(m.state[b], a.uavs[b], m.cable_tension[b], truth)
         sensed_states(a.sensor_models[b], a.sensor_constants[b], a.sensor_draws[b],
                       m.sensor_memory[b], m.tick[b], truth, states)
-    if a.estimator_models.shape[1]:  # the estimate from the sensors (estimators.estimation)
-        estimated_states(a.estimator_models[b], a.estimator_constants[b], m.sensor_memory[b],
-                         m.estimator_memory[b], m.tick[b], states)
-    if a.payload_estimator_models.shape[1]:
-        estimated_payload(a.payload_estimator_models[b], a.payload_estimator_constants[b],
-                          m.sensor_memory[b], m.estimator_memory[b],
-                          m.payload_estimator_memory[b], m.tick[b])
+    if a.estimator_models.shape[1] or a.payload_estimator_models.shape[1]:
+        estimated(a.estimator_models[b], a.estimator_constants[b],
+                  a.payload_estimator_models[b], a.payload_estimator_constants[b],
+                  m.sensor_memory[b], m.estimator_memory[b], m.payload_estimator_memory[b],
+                  m.tick[b], states)
 
 
 @jit

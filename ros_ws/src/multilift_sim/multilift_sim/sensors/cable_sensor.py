@@ -29,8 +29,8 @@ from multilift_sim.physics.cable_sensing import gimbal_angles
 from multilift_sim.physics.layout import (MEASURED_EULER, SENSED_CABLE_DIRECTION,
                                           SENSED_CABLE_TENSION)
 from multilift_sim.physics.measurement import euler_rotation
-from multilift_sim.sensors.outputs import (OUTPUT, DelayedSettings, delayed_protocol,
-                                          delayed_sample, read_dropout)
+from multilift_sim.sensors.outputs import (DelayedSettings, delayed_protocol, delayed_sample,
+                                          deliver, read_dropout)
 
 NAME = 'cable_sensor'
 UNITS = {'encoder_noise': 'rad', 'load_cell_noise': 'N', 'latency': 's', 'dropout': '',
@@ -103,5 +103,4 @@ def measure(constants, draws, memory, tick, truth, received):
     memory[line + OUTPUT_TENSION] = truth[SENSED_CABLE_TENSION]
     if sample < 0:
         return
-    for j in range(OUTPUT_COLUMNS):
-        memory[OUTPUT + j] = memory[source + j] + draws[sample, j]
+    deliver(memory, source, 0, draws, sample, 0, OUTPUT_COLUMNS)

@@ -19,8 +19,8 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.layout import MEASURED_POSITION, MEASURED_VELOCITY
-from multilift_sim.sensors.outputs import (OUTPUT, DelayedSettings, delayed_protocol,
-                                          delayed_sample, read_dropout)
+from multilift_sim.sensors.outputs import (DelayedSettings, delayed_protocol, delayed_sample,
+                                          deliver, keep_truth, read_dropout)
 
 NAME = 'gnss'
 UNITS = {'horizontal_position_noise': 'm', 'vertical_position_noise': 'm',
@@ -84,9 +84,7 @@ def measure(constants, draws, memory, tick, truth, received):
                                           OUTPUT_COLUMNS)
     if line < 0:
         return
-    for j in range(3):
-        memory[line + OUTPUT_POSITION + j] = truth[MEASURED_POSITION + j]
-        memory[line + OUTPUT_VELOCITY + j] = truth[MEASURED_VELOCITY + j]
+    keep_truth(memory, line, OUTPUT_POSITION, truth, MEASURED_POSITION, 3)
+    keep_truth(memory, line, OUTPUT_VELOCITY, truth, MEASURED_VELOCITY, 3)
     if sample >= 0:
-        for j in range(OUTPUT_COLUMNS):
-            memory[OUTPUT + j] = memory[source + j] + draws[sample, DRAW_ERROR + j]
+        deliver(memory, source, 0, draws, sample, DRAW_ERROR, OUTPUT_COLUMNS)

@@ -24,7 +24,7 @@ from multilift_sim.physics.attitude import rotation_quaternion, quaternion_produ
 from multilift_sim.physics.layout import MEASURED_EULER, MEASURED_POSITION
 from multilift_sim.physics.measurement import euler_quaternion
 from multilift_sim.sensors.outputs import (OUTPUT, DelayedSettings, delayed_protocol,
-                                          delayed_sample, read_dropout)
+                                          delayed_sample, deliver, keep_truth, read_dropout)
 
 NAME = 'mocap'
 UNITS = {'position_noise': 'm', 'attitude_noise': 'rad', 'latency': 's', 'dropout': '',
@@ -87,17 +87,14 @@ def measure(constants, draws, memory, tick, truth, received):
                                           OUTPUT_COLUMNS)
     if line < 0:
         return
-    for j in range(3):
-        memory[line + OUTPUT_POSITION + j] = truth[MEASURED_POSITION + j]
+    keep_truth(memory, line, OUTPUT_POSITION, truth, MEASURED_POSITION, 3)
     x, y, z, w = euler_quaternion(truth[MEASURED_EULER], truth[MEASURED_EULER + 1],
                                   truth[MEASURED_EULER + 2])
     q = line + OUTPUT_QUATERNION
     memory[q], memory[q + 1], memory[q + 2], memory[q + 3] = w, x, y, z
     if sample < 0:
         return
-    for j in range(3):
-        memory[OUTPUT + OUTPUT_POSITION + j] = (memory[source + OUTPUT_POSITION + j]
-                                                + draws[sample, DRAW_POSITION + j])
+    deliver(memory, source, OUTPUT_POSITION, draws, sample, DRAW_POSITION, 3)
     e0, e1, e2, e3 = rotation_quaternion(draws[sample, DRAW_ATTITUDE],
                                          draws[sample, DRAW_ATTITUDE + 1],
                                          draws[sample, DRAW_ATTITUDE + 2])

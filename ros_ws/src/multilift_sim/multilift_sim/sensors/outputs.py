@@ -6,7 +6,8 @@ receive alone (they read the estimate, or the state without an estimator).
 A sensor whose samples arrive late (`mocap`, `gnss`, `cable_sensor`) keeps, after its output,
 the tick it measured last and a delay line of its truths (`delayed_memory`); `delayed_sample`
 decides, at a tick, which row takes the truth and which sample (if any) arrives: the one place
-that logic is written."""
+that logic is written; `keep_truth` writes slots of the truth into that row and `deliver` the
+arrived sample's slots plus their drawn errors into the output."""
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -98,3 +99,20 @@ def delayed_sample(constants, delivered, memory, tick, output_columns):
     memory[ARRIVED] = tick
     memory[TAKEN] = taken
     return line, last_tick + 1 + (taken % slots) * output_columns, sample
+
+
+@jit
+def keep_truth(memory, line, slot, truth, first, count):
+    """truth[first:first + count] into the delay line's row `line` (`delayed_sample`'s
+    memory index) at its output slot `slot`."""
+    for j in range(count):
+        memory[line + slot + j] = truth[first + j]
+
+
+@jit
+def deliver(memory, source, slot, draws, sample, first, count):
+    """The arrived sample's output slots slot .. slot + count - 1 (its delay line row
+    `source`, `delayed_sample`'s) plus its errors draws[sample, first:first + count] (in the
+    output's units) into the output."""
+    for j in range(count):
+        memory[OUTPUT + slot + j] = memory[source + slot + j] + draws[sample, first + j]

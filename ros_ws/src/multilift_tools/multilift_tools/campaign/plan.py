@@ -46,8 +46,8 @@ class Campaign:
         return [a.key for a in self.grid] + [s.key for s in self.samples]
 
     def edits(self, run: RunSpec) -> list[tuple[str, tuple, Any]]:
-        paths = {a.key: a.path for a in self.grid} | {s.key: s.path for s in self.samples}
-        return [(key, paths[key], value) for key, value in run.params.items()]
+        edited = {a.key: a for a in (*self.grid, *self.samples)}
+        return [edited[key].edit(value) for key, value in run.params.items()]
 
     def metadata(self) -> dict:
         """What the table's Parquet metadata says of the campaign (plot-sweep reads it)."""
@@ -84,13 +84,12 @@ def build_campaign(source: str, base: dict, grid: list[GridAxis], samples: list[
         raise SweepError(f'--seed: {seed} must be in [0, 2^63)')
     points = list(itertools.product(*[a.values for a in grid]))
     for combo in points:
-        edits = [(a.key, a.path, v) for a, v in zip(grid, combo)]
-        _check(source, base, edits)
+        _check(source, base, [a.edit(v) for a, v in zip(grid, combo)])
     for spec in samples:
         first_error = None
         for value in spec.candidates():
             try:
-                _check(source, base, [(spec.key, spec.path, value)])
+                _check(source, base, [spec.edit(value)])
                 break
             except (SweepError, scenario_io.ScenarioError) as exc:
                 first_error = first_error or exc

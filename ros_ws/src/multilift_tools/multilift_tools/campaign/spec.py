@@ -67,19 +67,27 @@ def parse_value(text: str) -> Any:
 
 
 @dataclass(frozen=True)
-class GridAxis:
-    """One --set: a key and its values."""
+class EditedKey:
+    """A scenario key a campaign edits, as given ('uavs[1].mass') and as the path into the
+    scenario's YAML data that `apply_edit` follows (('uavs', 1, 'mass'))."""
     key: str
     path: tuple
+
+    def edit(self, value: Any) -> tuple[str, tuple, Any]:
+        """The edit (key, path, value) that sets this key to `value` (`apply_edit`)."""
+        return self.key, self.path, value
+
+
+@dataclass(frozen=True)
+class GridAxis(EditedKey):
+    """One --set: a key and its values."""
     values: tuple
 
 
 @dataclass(frozen=True)
-class SampleSpec:
+class SampleSpec(EditedKey):
     """One --sample: a key and its distribution (uniform(a, b), normal(mu, sigma) or
     choice(v1, ...)), in the units of the key."""
-    key: str
-    path: tuple
     kind: str
     args: tuple
 

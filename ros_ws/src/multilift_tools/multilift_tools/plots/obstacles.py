@@ -16,7 +16,7 @@ from multilift_sim.obstacles import OBSTACLE_TYPES
 from multilift_sim.topics import PAYLOAD_ODOM
 from multilift_tools.bagdata import Run, RunDataError
 from multilift_tools.metrics import interp_rows
-from multilift_tools.plot_style import Context, finish_time_axes, legend, plt
+from multilift_tools.plot_style import Context, finish_time_plot, plt
 from multilift_tools.plots.scene import body_polylines
 
 if TYPE_CHECKING:
@@ -126,9 +126,7 @@ def fig_clearance(ctx: Context) -> Figure:
             least = np.nanmin(values)
             ax.plot(t, values, lw=1.1, label=f'{label}: least {least:.3f} m')
     ax.axhline(0.0, color='tab:red', lw=0.9, label='contact (clearance 0)')
-    ax.set_ylabel('least clearance [m]')
-    ax.set_title(f'{run.label}: clearance of each kind (at the recorded ticks)',
-                 fontsize='medium')
-    legend(ax, loc='upper right')
-    finish_time_axes([ax])
+    finish_time_plot(ax, 'least clearance [m]',
+                     f'{run.label}: clearance of each kind (at the recorded ticks)',
+                     loc='upper right')
     return fig

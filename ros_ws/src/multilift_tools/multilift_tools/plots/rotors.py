@@ -13,9 +13,9 @@ import numpy as np
 
 from multilift_sim.topics import ATTITUDE_SETPOINT, ROTOR_CMD, uav_topic
 from multilift_tools.bagdata import Run, rotor_limits
-from multilift_tools.plot_style import (SATURATION_GREY, Context, finish_time_axes, legend,
-                                        plt, shade_flags, uav_color, uav_label, uav_width,
-                                        value_span, vehicle_of)
+from multilift_tools.plot_style import (SATURATION_GREY, Context, finish_time_axes,
+                                        finish_time_plot, legend, plt, shade_flags, uav_color,
+                                        uav_label, uav_width, value_span, vehicle_of)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -53,10 +53,8 @@ def fig_thrust(ctx: Context) -> Figure:
     if max_thrust and np.allclose(max_thrust, max_thrust[0]):
         ax.axhline(max_thrust[0], color='tab:red', lw=1.0, ls='-.',
                    label=f'max thrust {max_thrust[0]:.2f} N (all rotors at ω_max)')
-    ax.set_ylabel('thrust along body z [N]')
-    ax.set_title(f'{run.label}: collective thrust per UAV', fontsize='medium')
-    legend(ax, loc='best', ncols=2)
-    finish_time_axes([ax])
+    finish_time_plot(ax, 'thrust along body z [N]', f'{run.label}: collective thrust per UAV',
+                     loc='best', ncols=2)
     return fig
 
 
@@ -141,10 +139,9 @@ def fig_thrust_margins(ctx: Context) -> Figure:
                 label=f'{uav_label(i)}: least {margin.min():.1f} %')
     ax.axhline(0.0, color='tab:red', lw=1.0, ls='-.',
                label='no thrust left (every rotor at ω_max)')
-    ax.set_ylabel('thrust margin $1 - u_T / u_{T,max}$ [%]')
-    ax.set_title(f'{run.label}: the share of each UAV\'s largest thrust left', fontsize='medium')
-    legend(ax, loc='best', ncols=2)
-    finish_time_axes([ax])
+    finish_time_plot(ax, 'thrust margin $1 - u_T / u_{T,max}$ [%]',
+                     f'{run.label}: the share of each UAV\'s largest thrust left',
+                     loc='best', ncols=2)
     return fig
 
 

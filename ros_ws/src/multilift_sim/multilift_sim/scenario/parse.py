@@ -365,3 +365,4 @@ def _check_feasible(scenario: Scenario) -> None:
         except ValueError as exc:
             raise ScenarioError(f'{scenario.source}: formation: {exc}') from None
         reorganize.check_start(scenario.source, f, uavs)
+        reorganize.check_payload(scenario)

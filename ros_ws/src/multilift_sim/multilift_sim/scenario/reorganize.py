@@ -114,3 +114,12 @@ def check_start_places(scenario) -> None:
     if why is not None:
         raise ScenarioError(f'{scenario.source}: formation.start_places: hangs a point payload '
                             f'on rigid or slack cables from the UAVs\' centres, not {why}')
+
+
+def check_payload(scenario) -> None:
+    """`cable_forces` allocates a point payload's cables (its triangle of forces meets at one
+    point): a rigid-body payload is refused."""
+    f = scenario.formation
+    if f is not None and f.reorganize == 'cable_forces' and scenario.payload.type == 'rigid_body':
+        raise ScenarioError(f'{scenario.source}: formation.reorganize: \'cable_forces\' allocates '
+                            'a point payload\'s cables, not a rigid body\'s')

@@ -141,8 +141,8 @@ def pendulum(links: int = 10, payload_mass: float = 5.0, mass_per_length: float 
 
 
 def free_fall_energy(links: int = 10, mass_per_length: float = 0.1, length: float = 2.5,
-                     physics_rate: float = 400.0, attach_point=None
-                     ) -> tuple[float, float, float, float]:
+                     physics_rate: float = 400.0, attach_point=None, stiffness: float = 0.0,
+                     substeps: int = 1) -> tuple[float, float, float, float]:
     """single_lift's UAV and payload on a chain of `links` links, rotors off, no drag, no
     gusts, the payload thrown sideways at 1 m/s, the nodes at rest (every link's g_dot 0): in
     free fall the payload drags the chain into a fold and whirls about the UAV for 5 s. Returns
@@ -150,10 +150,13 @@ def free_fall_energy(links: int = 10, mass_per_length: float = 0.1, length: floa
     UAV, the payload, each node), the throw's energy m_p v^2 / 2 [J], the shortest distance
     UAV -> payload [m] (below l: folded), the run's max |g| [m^2]). With `attach_point` [m],
     body FLU, the cable holds the UAV there (the payload starting l below it): the chain
-    turns the UAV too (its rotational energy 1/2 omega . J omega counted)."""
+    turns the UAV too (its rotational energy 1/2 omega . J omega counted). With `stiffness`
+    [N/m] (the whole cable's k, `substeps` RK4 steps a physics step) the links are elastic:
+    their energy N k / 2 stretch^2 counted (the UAV's centre holding the chain)."""
     data = yaml.safe_load(resolve('single_lift').read_text())
     data.update(cable_model='chain', cable_length=length,
-                cable={'links': links, 'mass_per_length': mass_per_length})
+                cable={'links': links, 'mass_per_length': mass_per_length,
+                       **({'stiffness': stiffness} if stiffness else {})})
     for u in data['uavs']:
         u.pop('cable_length', None)
         if attach_point is not None:
@@ -164,7 +167,7 @@ def free_fall_energy(links: int = 10, mass_per_length: float = 0.1, length: floa
                                                attach_point[2] - length]
     data['control'].update(mode='constant_rotor_speed', constant_rotor_speed=1.0)
     data['simulation'].update(duration=5.0, physics_rate=physics_rate, control_rate=100.0,
-                              substeps=1)
+                              substeps=substeps)
     data.pop('gusts', None)
     s = scenario_io.loads(yaml.safe_dump(data))
     sim = FormationSimulator(s)
@@ -184,6 +187,11 @@ def free_fall_energy(links: int = 10, mass_per_length: float = 0.1, length: floa
         rates = layout.uav_body_rates(x)[0]
         energy += 0.5 * rates @ (inertia * rates)
         nodes, speeds = layout.chain_positions(x)[0], layout.chain_velocities(x)[0]
+        if stiffness:
+            places = np.vstack([bodies[0][1], nodes, bodies[1][1]])
+            stretch = np.maximum(np.linalg.norm(np.diff(places, axis=0), axis=1)
+                                 - length / links, 0.0)
+            energy += 0.5 * links * stiffness * stretch @ stretch
         energies.append(energy + 0.5 * node * (speeds * speeds).sum()
                         + node * G * nodes[:, 2].sum())
         reach.append(float(np.linalg.norm(layout.payload_position(x)
@@ -241,6 +249,46 @@ def beam_energy(links: int = 10, mass_per_length: float = 0.05,
             max(rates), sim.stats.max_abs_constraint)
 
 
+def elastic_bounce(links: int = 10, stiffness: float = 2000.0, payload_mass: float = 2.0,
+                   mass_per_length: float = 0.02, length: float = 2.5, duration: float = 4.0,
+                   substeps: int = 20) -> tuple[float, float]:
+    """A payload on an elastic chain (`cable.stiffness` k [N/m], the whole cable's: each link
+    N k) under a held UAV, no damping, no drag: started at its static stretch (each link
+    stretched by the weight below it over N k) and pushed down at 0.3 of the stretch's speed
+    at omega_1, it bounces along the chain. Returns (its measured omega [rad/s], the lowest
+    omega of the discrete chain's stiffness and mass matrices (the N - 1 nodes and the payload,
+    the UAV fixed) [rad/s])."""
+    s, sim, speeds = held('single_lift', links, mass_per_length, payload_mass, duration,
+                          length, substeps=substeps, stiffness=stiffness)
+    layout = StateLayout(1, chain_nodes=links - 1)
+    node = mass_per_length * length / (links - 1)
+    link_k, rest = links * stiffness, length / links
+    masses = np.r_[np.full(links - 1, node), payload_mass]   # node 1 .. N (N the payload)
+    carried = G * np.cumsum(masses[::-1])[::-1]                # link k holds nodes k .. N
+    stiffness_matrix = (np.diag(np.r_[2.0 * np.ones(links - 1), 1.0])
+                        - np.diag(np.ones(links - 1), 1) - np.diag(np.ones(links - 1), -1))
+    omegas = np.sqrt(np.linalg.eigvals(link_k * stiffness_matrix / masses[:, None]).real)
+    expected = float(omegas.min())
+    x = sim.state
+    top = layout.uav_positions(x)[0]
+    depth = np.cumsum(rest + carried / link_k)                 # node k below the UAV [m]
+    layout.chain_positions(x)[0] = top - np.outer(depth[:-1], [0.0, 0.0, 1.0])
+    layout.payload_position(x)[:] = top - [0.0, 0.0, depth[-1]]
+    layout.chain_velocities(x)[0] = 0.0
+    push = 0.3 * (carried[-1] / link_k) * expected
+    layout.payload_velocity(x)[:] = [0.0, 0.0, -push]
+    sim.state = x
+    heights = []
+
+    def each(x):
+        heights.append(layout.payload_position(x)[2])
+
+    fly(sim, speeds, each)
+    z = np.array(heights)
+    period, _ = period_of(z - z.mean(), 1.0 / s.simulation.control_period)
+    return 2.0 * math.pi / period, expected
+
+
 def main() -> None:
     print('hanging chain, L = 2.5 m, mu = 0.1 kg/m: omega measured / continuous - 1')
     for links in (10, 25, 40):
@@ -267,6 +315,15 @@ def main() -> None:
           f'{reach:.3f} m of its 2.5 m, max |g| {worst:.1e} m^2')
     print(f'heavy payload (5 kg on 25 g of chain, 10 links): period {period:.5f} s against '
           f'{expected:.5f} s ({period / expected - 1:+.2e}, {count} crossings)')
+    measured, expected = elastic_bounce()
+    print(f'elastic links (10 of k = 20 kN/m, 2 kg payload, 50 g of chain): bounce at '
+          f'{measured:.4f} rad/s against the discrete chain\'s {expected:.4f} rad/s '
+          f'({measured / expected - 1:+.1e})')
+    for substeps in (14, 28):
+        drift, throw, reach, _ = free_fall_energy(stiffness=5000.0, substeps=substeps)
+        print(f'the whirl on elastic links (k = 5 kN/m, {substeps} sub-steps at 400 Hz): '
+              f'energy kept to {drift:.2e} J ({drift / throw:.1e} of the throw\'s), folded to '
+              f'{reach:.3f} m')
 
 
 if __name__ == '__main__':

@@ -1,6 +1,7 @@
 """Winches through ROS (issue 32 item 3, docs/cables.md): a twin-lift whose winches pay out
 flies through ROS as headless, both bags carrying /uav{i}/cable_length; a live run
-(`run --live`) reels at the rate `multilift winch` sends, which the bag records; bad
+(`run --live`) reels at the rate `multilift winch` sends, from the tick it arrives in or, stamped
+(`--at T`), from the tick of its stamp, which the bag records; bad
 arguments are exit 2, a winch command without a run exit 1."""
 from __future__ import annotations
 
@@ -51,23 +52,36 @@ def test_a_live_reel_rate_is_reeled_and_recorded(ros_env, tmp_path):
     bag = tmp_path / 'bag'
     with started_run([str(path), '--live', '--realtime', '--duration', '12', '--bag', str(bag)],
                      ros_env) as (run, work):
-        sent = subprocess.run([MULTILIFT, 'winch', '1', '0.4', '--timeout', '60'],
-                              env=ros_env, capture_output=True, text=True, timeout=120)
-        assert sent.returncode == 0, sent.stderr
+        # at once, and stamped for t = 9 s (sent together: the stamp, not the arrival, counts)
+        sent = [subprocess.Popen([MULTILIFT, 'winch', '1', *args, '--timeout', '60'],
+                                 env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 text=True) for args in (['0.4'], ['-0.4', '--at', '9'])]
+        for tool in sent:
+            _, tool_err = tool.communicate(timeout=120)
+            assert tool.returncode == 0, tool_err
         log = work / 'sim_node.log'
         wait_for(lambda: 'uav1 winch commanded to 0.4 m/s' in log.read_text(), 60,
                  'the simulator reeling')
+        wait_for(lambda: 'uav1 winch commanded to -0.4 m/s at t = 9.000 s' in log.read_text(),
+                 60, 'the simulator queueing the stamped rate for its tick')
         _, err = run.communicate(timeout=300)
     assert run.returncode == 0, err[-2000:]
     lengths = _lengths(bag, 1)
     assert lengths[0] == 2.5 and lengths[-1] > 2.5 + 0.2   # it paid out
     assert np.abs(np.diff(lengths)).max() <= 0.4 * 0.01 + 1e-12   # within the commanded rate
+    # the period from tick 900 (t = 9 s) is the first to brake at 0.5 m/s^2: its mean rate
+    # 0.4 - 0.5 x 0.01 / 2, the period before it still at 0.4 m/s
+    rates = np.diff(lengths) / 0.01
+    assert abs(rates[899] - 0.4) < 1e-9 and abs(rates[900] - 0.3975) < 1e-9
     [command] = raw_messages(bag)['/uav1/winch_cmd']
     assert struct.unpack_from('<d', command, 4)[0] == 0.4
+    [stamped] = raw_messages(bag)['/uav1/winch_cmd_stamped']
+    assert struct.unpack_from('<iI', stamped, 4) == (9, 0)
 
 
 def test_bad_winch_arguments_are_exit_2_and_no_run_exit_1(ros_env):
-    for args in (['1', 'nan'], ['0', '0.3'], ['1', '0.3', '--timeout', '0']):
+    for args in (['1', 'nan'], ['0', '0.3'], ['1', '0.3', '--timeout', '0'],
+                 ['1', '0.3', '--at', '-1']):
         out = subprocess.run([MULTILIFT, 'winch', *args], capture_output=True, text=True,
                              timeout=60, env=ros_env)
         assert out.returncode == 2 and out.stderr.startswith('error: winch:'), out.stderr

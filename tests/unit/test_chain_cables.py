@@ -9,6 +9,7 @@ import pytest
 import yaml
 
 from conftest import SCENARIOS
+from multilift_control.headless import run_headless
 from multilift_sim import kernels
 from multilift_sim import scenario as scenario_io
 from multilift_sim.formation_params import StateLayout
@@ -97,7 +98,7 @@ def test_the_chain_s_nodes_are_the_layout_s_slots_and_start_on_the_rigid_line():
     ({'links': 2.5}, 'cable.links: 2.5 must be an integer >= 2'),
     ({'mass_per_length': -0.015}, 'cable.mass_per_length: -0.015 must be > 0'),
     ({'diameter': -0.004}, 'cable.diameter: -0.004 must be >= 0'),
-    ({'stiffness': 100.0}, 'cable.stiffness'),
+    ({'bend_stiffness': 100.0}, 'cable.bend_stiffness'),
 ])
 def test_bad_chain_keys_are_one_line(cable, says):
     with pytest.raises(scenario_io.ScenarioError) as caught:
@@ -166,11 +167,77 @@ def test_engine_and_simulator_fly_a_chain_twin_lift_alike():
     assert engine.engine.memory.status[0] == 1  # finished
 
 
-def test_what_a_chain_cannot_carry_is_one_line():
-    """A winch is refused with chains, one line."""
-    winch = yaml.safe_load(_chain())
-    winch['uavs'][0]['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5,
-                                 'min_length': 2.0, 'max_length': 15.0}
-    with pytest.raises(scenario_io.ScenarioError) as caught:
-        scenario_io.loads(yaml.safe_dump(winch))
-    assert 'not cable_model: chain' in str(caught.value) and '\n' not in str(caught.value)
+@pytest.mark.parametrize('cable,message', [
+    ({'damping': 2.0}, 'needs stiffness [N/m] or axial_stiffness [N] (elastic links)'),
+    ({'stiffness': -5.0}, 'stiffness: -5.0 must be > 0'),
+    ({'axial_stiffness': 1.5e5}, 'simulation.substeps: 2 steps the chain cables at omega h'),
+])
+def test_bad_elastic_links_are_one_line(cable, message):
+    """Elastic links take the rope's keys; damping alone, a negative stiffness and a stepping
+    too coarse for the links' axial waves (2 mm Dyneema's EA on 30 links: thousands of rad/s)
+    are refused in one line."""
+    with pytest.raises(scenario_io.ScenarioError, match='^[^\n]*$') as caught:
+        scenario_io.loads(_chain(**cable))
+    assert message in str(caught.value)
+
+
+def test_elastic_links_compiled_equal_their_uncompiled_source_reeled(monkeypatch):
+    """A single lift on 5 elastic links (EA 2 kN) whose winch pays out 0.4 m/s: the compiled
+    tick and its uncompiled source within 1e-9 m over 1.2 s; the chain longer than its
+    reeled length (stretched by the payload)."""
+    data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
+    data.update(cable_model='chain', cable={'links': 5, 'mass_per_length': 0.1,
+                                            'axial_stiffness': 2e3})
+    data['uavs'][0]['winch'] = {'rate_limit': 0.5, 'acceleration_limit': 0.5,
+                                'min_length': 1.0, 'max_length': 6.0}
+    data['events'] = [{'time': 0.2, 'type': 'winch_rate', 'uav': 1, 'rate': 0.4}]
+    data['simulation'].update(duration=1.2, substeps=8)
+    s = scenario_io.loads(yaml.safe_dump(data))
+    states = {}
+    for kernel in ('auto', 'python'):
+        monkeypatch.setenv('MULTILIFT_KERNEL', kernel)
+        states[kernel] = run_headless(s).simulator.state
+    assert np.abs(states['auto'] - states['python']).max() < 1e-9
+    layout = StateLayout(1, chain_nodes=4)
+    x = states['auto']
+    places = np.vstack([layout.uav_positions(x)[:1], layout.chain_positions(x)[0],
+                        layout.payload_position(x)[None]])
+    assert np.linalg.norm(np.diff(places, axis=0), axis=1).sum() > 2.5 + 0.2
+
+
+def test_a_chain_s_path_starts_at_its_hold_on_the_uav_and_ends_at_the_beam():
+    """`cable_paths` (the sag's and stretch's path): on beam_lift's chains held 0.1, 0.05,
+    -0.1 m off each UAV's centre, each path starts at r_i + R_i a_i and ends at r_p + R_p b_i
+    (worked out here from the state's quaternions), its inner nodes between; compiled equal to
+    its uncompiled source."""
+    from multilift_sim.physics.chain_cables import cable_paths
+    data = yaml.safe_load((SCENARIOS / 'beam_lift.yaml').read_text())
+    data.update(cable_model='chain', cable={'links': 6, 'mass_per_length': 0.05})
+    attach = np.array([0.1, 0.05, -0.1])
+    for u in data['uavs']:
+        u['attach_point'] = attach.tolist()
+    s = scenario_io.loads(yaml.safe_dump(data))
+    sim = FormationSimulator(s)
+    hover = [np.full(4, 1900.0), np.full(4, 1890.0)]
+    for _ in range(20):
+        sim.advance(hover, [np.zeros(4, bool)] * 2)
+    x = sim.state
+    state = StateLayout(2, True, chain_nodes=5)
+    paths = cable_paths(x, sim.arrays.uavs[0], 5)
+    np.testing.assert_array_equal(paths, kernels.uncompiled(cable_paths)(
+        x, sim.arrays.uavs[0], 5))
+    beam = _rotation(state.payload_quaternion(x))
+    for i in range(2):
+        uav = _rotation(state.uav_quaternions(x)[i])
+        assert np.allclose(paths[i, 0], state.uav_positions(x)[i] + uav @ attach, atol=1e-12)
+        end = state.payload_position(x) + beam @ np.array(s.payload.attach_points[i])
+        assert np.allclose(paths[i, -1], end, atol=1e-12)
+        np.testing.assert_array_equal(paths[i, 1:-1], state.chain_positions(x)[i])
+
+
+def _rotation(q) -> np.ndarray:
+    """R of the unit quaternion q = (w, x, y, z) (the state's order)."""
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])

@@ -179,3 +179,17 @@ def test_obstacles_are_drawn_at_their_size_and_yaw():
     assert all(t.type == Marker.CYLINDER and t.scale == pytest.approx((0.16, 0.16, 3.0))
                for t in trees)
     assert obstacle_specs(scenario_io.load('twin_lift')) == []  # no world: nothing drawn
+
+
+def test_a_cable_held_off_the_uav_s_centre_is_drawn_from_its_hold(twin):
+    """twin_lift's cables held 0.1, 0.05, -0.1 m off each UAV's centre (body FLU): each cable
+    marker starts at r_i + R_i a_i, R_i the snapshot's attitude (tilted), not at r_i."""
+    scenario, snapshot = twin
+    attach = np.array([0.1, 0.05, -0.1])
+    held = dataclasses.replace(scenario, uavs=tuple(
+        dataclasses.replace(u, attach_point=tuple(attach)) for u in scenario.uavs))
+    markers = by_key(formation_markers(snapshot, [4.0, 5.0], held, 0))
+    for i, uav in enumerate(snapshot.uavs, start=1):
+        start = xyz(markers[('cable', i)].points[0])
+        assert np.allclose(start, uav.position + uav.rotation @ attach, atol=1e-9)
+        assert np.linalg.norm(start - uav.position) > 0.1

@@ -137,7 +137,8 @@ def test_a_reel_rate_for_a_uav_without_a_winch_and_unsupported_models_are_refuse
         scenario_io.loads(yaml.safe_dump(data))
     data['events'] = []
     for key, value, message in (
-            ('cable_model', 'slack', 'reels rigid or elastic cables, not cable_model: slack'),
+            ('cable_model', 'slack',
+             'reels rigid, elastic or chain cables, not cable_model: slack'),
             ('simulation', dict(data['simulation'], integrator='nullspace'),
              'uavs[i].winch needs simulation.integrator: baumgarte')):
         with pytest.raises(scenario_io.ScenarioError, match='^[^\n]*$') as error:
@@ -147,9 +148,10 @@ def test_a_reel_rate_for_a_uav_without_a_winch_and_unsupported_models_are_refuse
 
 def test_a_reeled_run_compiled_equals_its_uncompiled_source(monkeypatch):
     """The winch's arithmetic compiled and run by Python (MULTILIFT_KERNEL=python): within
-    1e-9 m over a second of paying out, the elastic rope's too."""
+    1e-9 m over a second of paying out, the elastic rope's and a chain's too."""
     events = [{'time': 0.2, 'type': 'winch_rate', 'uav': 1, 'rate': 0.4}]
-    for cable in ({}, {'cable_model': 'elastic', 'cable': {'axial_stiffness': 2e4}}):
+    for cable in ({}, {'cable_model': 'elastic', 'cable': {'axial_stiffness': 2e4}},
+                  {'cable_model': 'chain', 'cable': {'links': 5, 'mass_per_length': 0.1}}):
         s = _single_lift(events, 1.2)
         if cable:
             data = yaml.safe_load((SCENARIOS / 'single_lift.yaml').read_text())
@@ -162,7 +164,7 @@ def test_a_reeled_run_compiled_equals_its_uncompiled_source(monkeypatch):
         monkeypatch.setenv('MULTILIFT_KERNEL', 'python')
         python = run_headless(s).simulator.state
         assert np.abs(compiled - python).max() < 1e-9
-        layout = StateLayout(1)
+        layout = StateLayout(1, chain_nodes=cable.get('cable', {}).get('links', 1) - 1)
         stretch = np.linalg.norm(layout.payload_position(compiled)
                                  - layout.uav_positions(compiled)[0])
         assert stretch > s.uavs[0].cable_length + 0.2    # paid out 0.24 m (a 0.8 s ramp)
@@ -230,3 +232,24 @@ def test_a_rigid_beam_is_lowered_on_its_reeled_cables():
     # 2 m for vertical cables; a cable leaning h off its end drops sqrt(l_1^2 - h^2) -
     # sqrt(l_0^2 - h^2), more (beam_lift's UAVs stand outside its ends: 2.07 m)
     assert 2.0 <= below(run.engine.state[0]) - below(start) < 2.2
+
+
+def test_a_stamped_reel_rate_takes_effect_at_the_first_tick_of_its_stamp():
+    """`command_winch(..., at_ns)` (a live /uav{i}/winch_cmd_stamped): a stamp of 0.505 s
+    sent at t = 0.1 s reels from tick 51 (the first at or after it), none before; a stamp
+    already past acts at once; a UAV without a winch is a ValueError."""
+    s = _single_lift([], 1.0)
+    taken, lengths = [], []
+
+    def each(sim, *_):
+        if sim.tick == 10:
+            taken.append(sim.command_winch(0, 0.4, at_ns=505_000_000))
+            taken.append(sim.command_winch(0, 0.0, at_ns=50_000_000))
+            with pytest.raises(ValueError, match='uav2 has no winch'):
+                sim.command_winch(1, 0.4)
+        lengths.append(sim.memory.reel[0, 0, REEL_LENGTH])
+    run_headless(s, on_tick=each)
+    assert taken == [51, 10]
+    lengths = np.array(lengths)   # lengths[k]: at tick k, the period from tick 51 reels
+    assert np.all(lengths[:52] == 2.5)
+    assert lengths[52] - 2.5 == pytest.approx(0.5 * 0.5 * 0.01 ** 2, rel=1e-9)

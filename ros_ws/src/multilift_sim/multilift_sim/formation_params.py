@@ -317,7 +317,8 @@ def constant_arrays(params: FormationParams) -> tuple[np.ndarray, np.ndarray, np
     formation[FORMATION_PROJECTION_TOLERANCE] = 0.0
     formation[FORMATION_SUBSTEPS] = float(params.substeps)   # RK4 steps per physics step
     elastic = params.cable_stiffness is not None
-    formation[FORMATION_ELASTIC] = 1.0 if elastic else 0.0
+    # (a chain's elastic links are its own: chain_cables reads their stiffness and damping)
+    formation[FORMATION_ELASTIC] = 1.0 if elastic and not params.chain_links else 0.0
     uavs[:, UAV_CABLE_STIFFNESS] = params.cable_stiffness if elastic else 0.0
     uavs[:, UAV_CABLE_DAMPING] = (params.cable_damping or 0.0) if elastic else 0.0
     formation[FORMATION_PAYLOAD_INERTIA:FORMATION_PAYLOAD_INERTIA + 3] = (

@@ -143,6 +143,9 @@ class FormationSimulator:
         self.steps_per_tick = sim.physics_steps_per_tick
         self.dt = 1.0 / sim.physics_rate  # the physics step [s]
         self._rotor_counts = [u.vehicle.n_rotors for u in scenario.uavs]
+        # live reel rates stamped for a later tick: (tick [-], arrival, UAV from 0, rate)
+        self._winch_queue: list[tuple[int, int, int, float]] = []
+        self._winch_arrivals = 0
         # the tension of the last integration (at the tick it started from)
         self.last_tension: np.ndarray | None = None
         self._tension = np.zeros((1, self.n))
@@ -268,22 +271,34 @@ class FormationSimulator:
         (`physics.tick.advance`: a silent controller's commands held, the events of the new
         tick applied, Algorithm 1's check; SimulationStopped when it stops the run)."""
         speeds, flags = self._command_arrays(rotor_speeds, saturated)
+        while self._winch_queue and self._winch_queue[0][0] <= self.tick:
+            _, _, uav, rate = self._winch_queue.pop(0)
+            self.memory.reel[0, uav, REEL_COMMAND] = rate
         first = int(self.memory.next_event[0])
         self._advance(self.arrays, self.memory, 0, speeds, flags, self._tension[0])
         self.last_tension = self._tension[0].copy()
         self.happened = range(first, int(self.memory.next_event[0]))
         self._raise_if_stopped()
 
-    def command_winch(self, uav: int, rate: float) -> None:
+    def command_winch(self, uav: int, rate: float, at_ns: int | None = None) -> int:
         """UAV `uav`'s (from 0) winch commanded to reel at `rate` [m/s] (positive pays out) from
-        the period of the current tick on (a live /uav{i}/winch_cmd; physics.winch keeps it
-        within the winch's limits and stops); ValueError for a UAV without a winch or a rate
+        the period of the first tick at or after `at_ns` [ns] of simulated time on (a live
+        /uav{i}/winch_cmd_stamped), or of the current tick (None, or a time already past: a
+        live /uav{i}/winch_cmd); physics.winch keeps it within the winch's limits and stops.
+        Returns the tick it takes effect at; ValueError for a UAV without a winch or a rate
         that is not finite."""
         if uav + 1 not in self.scenario.winches:
             raise ValueError(f'uav{uav + 1} has no winch')
         if not math.isfinite(rate):
             raise ValueError(f'a reel rate must be finite, got {rate!r}')
-        self.memory.reel[0, uav, REEL_COMMAND] = rate
+        tick = self.tick if at_ns is None else max(self.tick, -(-at_ns // self.period_ns))
+        if tick == self.tick:
+            self.memory.reel[0, uav, REEL_COMMAND] = rate
+            return tick
+        self._winch_arrivals += 1
+        self._winch_queue.append((tick, self._winch_arrivals, uav, rate))
+        self._winch_queue.sort()
+        return tick
 
     def idle_commands(self) -> tuple[list[np.ndarray], list[np.ndarray]]:
         """(rotor speeds [rad/s], saturation flags) of 0 for every UAV: what a formation whose

@@ -132,7 +132,8 @@ def physics_fields(scenario: Scenario, model: Formulation | None = None) -> tupl
         period_ns=int(round(1e9 / sim.control_rate)), tick_count=sim.tick_count,
         # (cables that stretch are no constraints: Algorithm 1's check of g does not apply)
         tolerances=(np.array([sim.constraint_tolerance, sim.constraint_rate_tolerance])
-                    if cables.KEEPS_LENGTH else np.full(2, math.inf)),
+                    if cables.KEEPS_LENGTH and not any(u.cable_stiffness for u in scenario.uavs)
+                    else np.full(2, math.inf)),
         swing_every=swing_sampling(n), reach=cable_reach(scenario),
         **dict(zip(('world', 'obstacles', 'uav_radii'), world_arrays(scenario))))
     clearance = np.zeros((CLEARANCE_KINDS, CLEARANCE_COLUMNS))

@@ -25,6 +25,7 @@ TF_TYPE = 'tf2_msgs/msg/TFMessage'
 POSE_STAMPED_TYPE = 'geometry_msgs/msg/PoseStamped'
 PATH_TYPE = 'nav_msgs/msg/Path'
 FLOAT64_TYPE = 'std_msgs/msg/Float64'
+WINCH_COMMAND_TYPE = 'multilift_msgs/msg/WinchCommand'
 
 # topics of the whole run
 CLOCK = '/clock'                        # simulated time, the simulator only
@@ -51,12 +52,13 @@ REFERENCE = 'reference'                 # the mission reference (the leader only
 FORMATION_ERROR = 'formation_error'     # follower i's rows of g_vc (followers only)
 CABLE_LENGTH = 'cable_length'           # UAV i's cable length [m] (a UAV with a winch)
 WINCH_CMD = 'winch_cmd'                 # a live reel rate for UAV i's winch [m/s] (run --live)
+WINCH_CMD_STAMPED = 'winch_cmd_stamped'  # the same from its stamp's tick (simulated time)
 
 UAV_TYPES = {ODOM: ODOMETRY_TYPE, MEASURED_ODOM: ODOMETRY_TYPE, ESTIMATE: ODOMETRY_TYPE,
              ROTOR_CMD: ROTOR_COMMAND_TYPE,
              ATTITUDE_SETPOINT: ATTITUDE_SETPOINT_TYPE, REFERENCE: TRACKING_REFERENCE_TYPE,
              FORMATION_ERROR: FORMATION_ERROR_TYPE, CABLE_LENGTH: FLOAT64_TYPE,
-             WINCH_CMD: FLOAT64_TYPE}
+             WINCH_CMD: FLOAT64_TYPE, WINCH_CMD_STAMPED: WINCH_COMMAND_TYPE}
 RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
              PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
@@ -118,7 +120,8 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
     /uav{i}/measured_odom; with `wind` (Scenario.has_wind), /formation/wind; without
     `commands` (every UAV prescribed) not even the rotor commands; with `live` (`run --live`),
     /formation/goal and /formation/path; for each UAV of `winches` (from 1: those with a
-    winch) /uav{i}/cable_length, and with `live` /uav{i}/winch_cmd; with `estimates` (an
+    winch) /uav{i}/cable_length, and with `live` /uav{i}/winch_cmd and
+    /uav{i}/winch_cmd_stamped; with `estimates` (an
     estimator, docs/estimation.md) every /uav{i}/estimate; with `payload_estimate` (a payload
     estimator) /payload/estimate."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
@@ -137,8 +140,9 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
         if i > 1 and controllers:
             topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
         if i in winches:
-            topics += [(uav_topic(i, leaf), FLOAT64_TYPE)
-                       for leaf in ((CABLE_LENGTH, WINCH_CMD) if live else (CABLE_LENGTH,))]
+            topics += [(uav_topic(i, leaf), UAV_TYPES[leaf])
+                       for leaf in ((CABLE_LENGTH, WINCH_CMD, WINCH_CMD_STAMPED) if live
+                                    else (CABLE_LENGTH,))]
     return topics
 
 

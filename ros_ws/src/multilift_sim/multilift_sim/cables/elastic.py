@@ -26,12 +26,12 @@ ELASTIC_OMEGA_H = 0.5
 
 def parse_cable(top: Any) -> dict[str, Any]:
     """The `cable:` section's keys (`top` the scenario's reading.Section)."""
-    return _rope_keys(top.section('cable', {}), None)
+    return rope_keys(top.section('cable', {}), None)
 
 
 def parse_uav_cable(u: Any, length: float, base: dict[str, Any]) -> tuple[float, float]:
     """UAV i's cable's (k [N/m], c [N s/m]) from its `cable:` over `base`."""
-    keys = _rope_keys(u.section('cable', {}), base)
+    keys = rope_keys(u.section('cable', {}), base)
     if keys['stiffness'] is None and keys['axial_stiffness'] is None:
         raise u.fail('cable', u.data.get('cable', {}), 'needs stiffness [N/m] or '
                      'axial_stiffness [N] (cable_model: elastic), here or in cable:')
@@ -55,7 +55,7 @@ def check(scenario: Any) -> str | None:
                          sim.physics_rate, sim.substeps)
 
 
-def _rope_keys(sec: Any, base: dict[str, Any] | None) -> dict[str, Any]:
+def rope_keys(sec: Any, base: dict[str, Any] | None) -> dict[str, Any]:
     if sec.has('stiffness') and sec.has('axial_stiffness'):
         raise sec.fail('axial_stiffness', sec.data['axial_stiffness'],
                        'goes without stiffness: give one of them')

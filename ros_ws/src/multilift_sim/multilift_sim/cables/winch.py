@@ -47,7 +47,8 @@ def check(scenario: Any) -> str | None:
     if not any(u.winch for u in scenario.uavs):
         return None
     if not CABLE_MODELS[scenario.cable_model].REELS:
-        reeled = ' or '.join(name for name, model in CABLE_MODELS.items() if model.REELS)
+        *some, last = [name for name, model in CABLE_MODELS.items() if model.REELS]
+        reeled = f'{", ".join(some)} or {last}' if some else last
         return f'uavs[].winch reels {reeled} cables, not cable_model: {scenario.cable_model}'
     if scenario.prescribed:
         return 'uavs[].winch is not for a formation with prescribed UAVs (uavs[i].trajectory)'

@@ -27,7 +27,13 @@ payload's m_p a_p = m_p a_p_free - 2 sum_i lambda_iN d_iN is the 3 x 3 system
 complement on the payload's acceleration): O(n N) a solve. Gravity is common to every body
 and cancels in the links' equations; it is added at the end.
 
-Links are rods: a link's multiplier may go negative (it pushes: a chain folding fast, or
+Elastic links (the cable's UAV_CABLE_STIFFNESS k > 0, cables.chain): each link a rope
+segment N k l_i(0) / l_i(t) stiff and N c l_i(0) / l_i(t) damped (`elastic_cables.rope_tension`:
+it pulls only when longer than s_i, never pushes), so each multiplier is known,
+lambda_ik = T_ik / (2 |d_ik|), with w_i = 0: no solve; the payload's 3 x 3 (or 6 x 6) system
+then carries the pulls alone.
+
+Rigid links are rods: a link's multiplier may go negative (it pushes: a chain folding fast, or
 whipped), which a real rope cannot; the chain keeps it (rods, not a rope) and the run's
 `compressed_time` figure reports it for the top link (the tension the tick reports).
 """
@@ -47,12 +53,16 @@ from multilift_sim.physics.layout import (BODY_RATES, CHAIN_LINK_COLUMNS, CHAIN_
                                           FORMATION_CHAIN_LINKS,
                                           FORMATION_GRAVITY, FORMATION_PAYLOAD_MASS,
                                           FORMATION_TWO_ALPHA, FORMATION_WIND, NODE_POSITION,
-                                          NODE_VELOCITY, POSITION, UAV_LENGTH_SQ, UAV_MASS,
-                                          UAV_NODE_DRAG, UAV_NODE_MASS)
+                                          NODE_VELOCITY, POSITION, REEL_LENGTH, REEL_RATE,
+                                          UAV_CABLE_DAMPING, UAV_CABLE_STIFFNESS,
+                                          UAV_LENGTH_SQ, UAV_MASS, UAV_NODE_DRAG,
+                                          UAV_NODE_MASS)
 from multilift_sim.physics.attitude import quaternion_rotation
+from multilift_sim.physics.elastic_cables import rope_tension
 from multilift_sim.physics.chain_payload import (payload_ends, payload_moment,
                                                  rigid_payload_acceleration)
 from multilift_sim.physics.symmetric_solve import symmetric_solve3
+from multilift_sim.physics.winch import reeled_cable
 from multilift_sim.physics.state_slots import (attitude_slot, chain_node_slot, payload_slot,
                                                rates_slot, rigid_payload_state,
                                                uav_attitude_slot, uav_slot)
@@ -125,6 +135,7 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
         payload_rotation = quaternion_rotation(x, attitude_slot(n))
         payload_ends(x, uavs, payload_rotation, ends)
     thrusts = np.empty((n, 3))
+    top = np.zeros(n)   # an elastic top link's T_i / l_i [N/m]
     rotation = np.empty((3, 3))
     payload_mass = formation[FORMATION_PAYLOAD_MASS]
     # the Schur complement S a_p = rhs on the payload's acceleration (gravity excluded)
@@ -156,7 +167,23 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                                                              + rel_z * rel_z)
                 fx, fy, fz = scale * rel_x, scale * rel_y, scale * rel_z
             put3(nd[k], CHAIN_NODE_FREE, fx, fy, fz)
-        link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)   # s_i^2
+        # s_i^2 and a reeled length's terms of g_dot and g_ddot (s_i s_i_dot, s_i_dot^2 +
+        # s_i s_i_ddot; 0 without a winch): each link is l_i(t) / N (physics.winch)
+        length_sq, reel_rate, reel_acc = reeled_cable(uavs, formation, i)
+        per_link = links * links
+        link_sq, link_rate, link_acc = (length_sq / per_link, reel_rate / per_link,
+                                        reel_acc / per_link)
+        # elastic links (the cable's k, c at its length l_0 = l_i(0)): each N k l_0 / l_i(t)
+        # stiff and N c l_0 / l_i(t) damped about its rest length s_i, stretching at
+        # d_hat . dv - s_i_dot (0: rigid links, held by their multipliers)
+        stretchy = uavs[i, UAV_CABLE_STIFFNESS] > 0.0
+        rest = link_stiffness = link_damping = rest_rate = top_tension = 0.0
+        if stretchy:
+            rest = math.sqrt(link_sq)
+            scale = math.sqrt(uavs[i, UAV_LENGTH_SQ] / length_sq) * links
+            link_stiffness = uavs[i, UAV_CABLE_STIFFNESS] * scale
+            link_damping = uavs[i, UAV_CABLE_DAMPING] * scale
+            rest_rate = link_rate / rest
         for k in range(1, links + 1):  # link k's row: d_k, A's entries, its right-hand side
             r0, v0 = node_point(x, n, inner, i, k - 1, p, nq)
             r1, v1 = node_point(x, n, inner, i, k, p, nq)
@@ -172,6 +199,17 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
             row = lk[k - 1]
             put3(row, CHAIN_LINK_OFFSET, dx, dy, dz)
             offset_sq = dx * dx + dy * dy + dz * dz
+            if stretchy:  # its pull 2 lambda d = T d_hat, lambda = T / (2 |d|), known
+                tension, span = rope_tension(link_stiffness, link_damping, rest, dx, dy, dz,
+                                             dvx, dvy, dvz, rest_rate)
+                row[CHAIN_LINK_U] = 0.5 * tension / span if tension > 0.0 else 0.0
+                row[CHAIN_LINK_W] = 0.0
+                if k == 1:
+                    top_tension = tension
+                if k == 1 and off_centre:  # the pull's moment arm on the UAV
+                    k0, k1, k2 = cable_moment_arm(uavs, i, rotation, dx, dy, dz)
+                    put3(moments[i], 0, k0, k1, k2)
+                continue
             upper_inv = nd[k - 1, CHAIN_NODE_INV_MASS]
             lower_inv = nd[k, CHAIN_NODE_INV_MASS] if k < links else 0.0
             row[CHAIN_LINK_DIAGONAL] = 2.0 * offset_sq * (upper_inv + lower_inv)
@@ -179,9 +217,10 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                 k0, k1, k2 = cable_moment_arm(uavs, i, rotation, dx, dy, dz)
                 put3(moments[i], 0, k0, k1, k2)
                 row[CHAIN_LINK_DIAGONAL] += 2.0 * rotational_compliance(uavs, i, k0, k1, k2)
-            # d_k . (a_k - a_(k-1)) = -|dv_k|^2 - alpha_f g_dot_k - beta_f^2 g_k / 2 (Eq. 2.59)
-            target = (-(dvx * dvx + dvy * dvy + dvz * dvz)
-                      - two_alpha * (dx * dvx + dy * dvy + dz * dvz)
+            # d_k . (a_k - a_(k-1)) = -|dv_k|^2 + s_dot^2 + s s_ddot - alpha_f g_dot_k
+            # - beta_f^2 g_k / 2 (Eq. 2.59; g_dot_k / 2 = d_k . dv_k - s s_dot)
+            target = (-(dvx * dvx + dvy * dvy + dvz * dvz - link_acc)
+                      - two_alpha * (dx * dvx + dy * dvy + dz * dvz - link_rate)
                       - 0.5 * beta_sq * (offset_sq - link_sq))
             free_x, free_y, free_z = (-nd[k - 1, CHAIN_NODE_FREE], -nd[k - 1, CHAIN_NODE_FREE + 1],
                                       -nd[k - 1, CHAIN_NODE_FREE + 2])
@@ -201,16 +240,19 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                     above[CHAIN_LINK_OFFSET] * dx + above[CHAIN_LINK_OFFSET + 1] * dy
                     + above[CHAIN_LINK_OFFSET + 2] * dz)
         lk[links - 1, CHAIN_LINK_UPPER] = 0.0
+        if stretchy:  # every link's multiplier known
+            top[i] = top_tension / math.sqrt(length_sq)
         # Thomas' algorithm on A (symmetric positive definite), two right-hand sides
-        for k in range(1, links):
+        for k in range(1 if not stretchy else links, links):
             factor = lk[k - 1, CHAIN_LINK_UPPER] / lk[k - 1, CHAIN_LINK_DIAGONAL]
             lk[k, CHAIN_LINK_DIAGONAL] -= factor * lk[k - 1, CHAIN_LINK_UPPER]
             lk[k, CHAIN_LINK_U] -= factor * lk[k - 1, CHAIN_LINK_U]
             lk[k, CHAIN_LINK_W] -= factor * lk[k - 1, CHAIN_LINK_W]
         last = links - 1
-        lk[last, CHAIN_LINK_U] /= lk[last, CHAIN_LINK_DIAGONAL]
-        lk[last, CHAIN_LINK_W] /= lk[last, CHAIN_LINK_DIAGONAL]
-        for k in range(links - 2, -1, -1):
+        if not stretchy:
+            lk[last, CHAIN_LINK_U] /= lk[last, CHAIN_LINK_DIAGONAL]
+            lk[last, CHAIN_LINK_W] /= lk[last, CHAIN_LINK_DIAGONAL]
+        for k in range(links - 2 if not stretchy else -1, -1, -1):
             row, below = lk[k], lk[k + 1]
             row[CHAIN_LINK_U] = (row[CHAIN_LINK_U] - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_U]) \
                 / row[CHAIN_LINK_DIAGONAL]
@@ -250,7 +292,9 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                  + payload_moments[i, 1] * turn[4] + payload_moments[i, 2] * turn[5])
         for k in range(links):  # lambda_k = u_k + (d_N . a_p) w_k, into CHAIN_LINK_U
             lk[k, CHAIN_LINK_U] += along * lk[k, CHAIN_LINK_W]
-        multipliers[i] = lk[0, CHAIN_LINK_U] / links   # T_i / (2 l_i) = 2 s_i lambda_1 / (2 l_i)
+        # T_i / (2 l_i) = 2 s_i lambda_1 / (2 l_i); an elastic top link's T_i / (2 l_i)
+        multipliers[i] = (0.5 * top[i] if uavs[i, UAV_CABLE_STIFFNESS] > 0.0
+                          else lk[0, CHAIN_LINK_U] / links)
         for j in range(links):  # node j: its free acceleration + 2 / m_j (lambda_(j+1) d_(j+1)
             # - lambda_j d_j) - g e_z (node 0 the UAV, whose block is q's)
             pull = 2.0 * nd[j, CHAIN_NODE_INV_MASS]
@@ -279,10 +323,12 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
 
 
 @jit
-def chain_residuals(x, uavs, inner, g, g_dot):
+def chain_residuals(x, uavs, inner, length_sq, length_rate, g, g_dot):
     """Each cable's worst link (the largest |g_ik|) at state x: its g_ik = |d_ik|^2 - s_i^2
-    [m^2] into g (n,) and the largest |g_dot_ik| = |2 d_ik . (v_ik - v_i(k-1))| [m^2/s], signed,
-    into g_dot (n,) (`inner` = N - 1 inner nodes per cable)."""
+    [m^2] into g (n,) and the largest |g_dot_ik| = |2 d_ik . (v_ik - v_i(k-1)) - 2 s_i s_i_dot|
+    [m^2/s], signed, into g_dot (n,) (`inner` = N - 1 inner nodes per cable; s_i = l_i / N from
+    each cable's l_i^2 `length_sq` (n,) [m^2] and l_i l_i_dot `length_rate` (n,) [m^2/s]: a
+    reel's, or the constant lengths' and 0)."""
     n = uavs.shape[0]
     links = inner + 1
     p = payload_slot(n)
@@ -293,7 +339,8 @@ def chain_residuals(x, uavs, inner, g, g_dot):
     if rigid:  # the last links end at the payload's attach points
         payload_ends(x, uavs, quaternion_rotation(x, attitude_slot(n)), ends)
     for i in range(n):
-        link_sq = uavs[i, UAV_LENGTH_SQ] / (links * links)
+        per_link = links * links
+        link_sq, link_rate = length_sq[i] / per_link, length_rate[i] / per_link
         worst = worst_rate = 0.0
         off_centre = attached_off_centre(uavs, i)
         if off_centre:  # node 0 the attach point r_i + R_i a_i
@@ -310,9 +357,41 @@ def chain_residuals(x, uavs, inner, g, g_dot):
                 dx, dy, dz = dx + ends[i, 0, 0], dy + ends[i, 0, 1], dz + ends[i, 0, 2]
                 dvx, dvy, dvz = dvx + ends[i, 1, 0], dvy + ends[i, 1, 1], dvz + ends[i, 1, 2]
             value = dx * dx + dy * dy + dz * dz - link_sq
-            rate = 2.0 * (dx * dvx + dy * dvy + dz * dvz)
+            rate = 2.0 * (dx * dvx + dy * dvy + dz * dvz - link_rate)
             if abs(value) >= abs(worst):
                 worst = value
             if abs(rate) >= abs(worst_rate):
                 worst_rate = rate
         g[i], g_dot[i] = worst, worst_rate
+
+
+@jit
+def reeled_chain_residuals(x, uavs, inner, reel, g, g_dot):
+    """`chain_residuals` at state x against reeled cables: each link l_i / N with l_i and
+    l_i_dot the reels' (`reel` (n, REEL_COLUMNS), physics.winch)."""
+    lengths, rates = reel[:, REEL_LENGTH], reel[:, REEL_RATE]
+    chain_residuals(x, uavs, inner, lengths * lengths, lengths * rates, g, g_dot)
+
+
+@jit
+def cable_paths(x, uavs, inner):
+    """Each cable's N + 1 points [m], world, at state x (n, N + 1, 3): where it holds its UAV
+    (r_i + R_i a_i), its `inner` nodes, where it holds the payload (r_p, or a rigid one's
+    r_p + R_p b_i)."""
+    n = uavs.shape[0]
+    p = payload_slot(n)
+    nq = rates_slot(n)
+    paths = np.empty((n, inner + 2, 3))
+    ends = np.zeros((n, 3, 3))
+    if rigid_payload_state(x.shape[0], n):
+        payload_ends(x, uavs, quaternion_rotation(x, attitude_slot(n)), ends)
+    attach = np.zeros((3, 3))
+    for i in range(n):
+        for k in range(inner + 2):
+            r, _ = node_point(x, n, inner, i, k, p, nq)
+            put3(paths[i, k], 0, x[r], x[r + 1], x[r + 2])
+        if attached_off_centre(uavs, i):
+            uav_attach_motion(x, i, np.zeros((n, 4)), uavs, attach)
+            paths[i, 0] += attach[0]
+        paths[i, inner + 1] += ends[i, 0]
+    return paths

@@ -244,7 +244,7 @@ def residuals(x, uavs, g, g_dot):
     nq = rates_slot(n)
     inner = chain_inner_nodes(x.shape[0], n)
     if inner > 0:  # a chain's worst link per cable (chain_cables), a point or rigid payload
-        chain_residuals(x, uavs, inner, g, g_dot)
+        chain_residuals(x, uavs, inner, uavs[:, UAV_LENGTH_SQ].copy(), np.zeros(n), g, g_dot)
         return
     if rigid_payload_state(x.shape[0], n):
         rigid_residuals(x, uavs, g, g_dot)

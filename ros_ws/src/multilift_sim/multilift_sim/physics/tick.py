@@ -36,12 +36,13 @@ from multilift_sim.physics.prescribed import prescribe_state
 from multilift_sim.estimators.estimation import estimated_states
 from multilift_sim.payload_estimators.estimation import estimated_payload
 from multilift_sim.physics.cable_sensing import cable_truths
+from multilift_sim.physics.chain_cables import reeled_chain_residuals
 from multilift_sim.physics.winch import period_uavs, reel_end
 from multilift_sim.sensors.sensing import sensed_states
 from multilift_sim.statistics.estimation import run_add_estimation
 from multilift_sim.statistics.accumulators import (quaternion_fault, run_add_commands,
                                                    run_add_compression, run_add_gust_speed,
-                                                   run_add_reel, run_add_ropes, run_add_sag,
+                                                   run_add_chains, run_add_reel, run_add_ropes,
                                                    run_add_slack,
                                                    run_add_tensions,
                                                    run_add_thrust_margin, run_check)
@@ -194,11 +195,17 @@ def advance(a, m, b, speeds, saturated, tension):
     run_add_compression(m.run[b], tension, period)
     if formation[FORMATION_ELASTIC] != 0.0:  # each rope's stretch and tension at the tick
         run_add_ropes(m.run[b], m.state[b], m.reel[b, :, REEL_LENGTH], tension)
-    if formation[FORMATION_CHAIN_LINKS] != 0.0:  # each chain's sag at the tick
-        run_add_sag(m.run[b], m.state[b], n, int(formation[FORMATION_CHAIN_LINKS]) - 1)
+    if formation[FORMATION_CHAIN_LINKS] != 0.0:  # each chain's sag (elastic: stretch) at the
+        # tick
+        run_add_chains(m.run[b], m.state[b], a.uavs[b],
+                       int(formation[FORMATION_CHAIN_LINKS]) - 1, m.reel[b, :, REEL_LENGTH],
+                       tension)
     if formation[FORMATION_WINCH] != 0.0:  # the reels at the new tick, g, g_dot of the
         # reeled lengths there
         reel_end(uavs, m.reel[b], (m.tick[b] + 1) * a.period_ns[b] * 1e-9, g, g_dot)
+        if formation[FORMATION_CHAIN_LINKS] != 0.0:  # the worst links against l_i(t) / N
+            reeled_chain_residuals(state, uavs, int(formation[FORMATION_CHAIN_LINKS]) - 1,
+                                   m.reel[b], g, g_dot)
         run_add_reel(m.run[b], m.reel[b], a.cable_lengths[b])
     if a.slack[b]:
         run_add_slack(m.run[b], m.taut[b], period)

@@ -24,7 +24,8 @@ from typing import NoReturn
 
 import numpy as np
 from geometry_msgs.msg import Vector3Stamped
-from multilift_msgs.msg import FormationEvent, FormationSnapshot, FormationState, RotorCommand
+from multilift_msgs.msg import (FormationEvent, FormationSnapshot, FormationState, RotorCommand,
+                                WinchCommand)
 from nav_msgs.msg import Odometry
 from rclpy.node import Node, NodeNameNonExistentError
 from rclpy.qos import DurabilityPolicy, QoSProfile
@@ -42,7 +43,8 @@ from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
                                   FORMATION_STATE, MARKER_DECIMATION, MARKERS, MEASURED_ODOM,
                                   ODOM, PAYLOAD_ESTIMATE, PAYLOAD_GUST, PAYLOAD_ODOM, ROTOR_CMD,
-                                  TF, WIND, WINCH_CMD, parse_external, state_topics, uav_topic)
+                                  TF, WIND, WINCH_CMD, WINCH_CMD_STAMPED, parse_external,
+                                  state_topics, uav_topic)
 from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, TickCables
 from multilift_sim.schedules import run_seeds
 from multilift_sim.wire.tick_messages import SimulatorMessages
@@ -130,23 +132,34 @@ class SimNode(Node):
         # live reel rates (`run --live`) for each UAV with a winch, from the next period on
         self.winch_subs = [self.create_subscription(
             Float64, uav_topic(i, WINCH_CMD), lambda msg, i=i: self._on_winch(i, msg),
-            WINCH_QOS) for i in (scenario.winches if live else ())]
+            WINCH_QOS) for i in (scenario.winches if live else ())] + [
+            self.create_subscription(WinchCommand, uav_topic(i, WINCH_CMD_STAMPED),
+                                     lambda msg, i=i: self._on_winch(i, msg), WINCH_QOS)
+            for i in (scenario.winches if live else ())]
 
     def _on_command(self, index: int, msg: RotorCommand) -> None:
         if ns_from_stamp(msg.header.stamp) == self.sim.t_ns:
             self.commands[index] = msg
 
-    def _on_winch(self, index: int, msg: Float64) -> None:
+    def _on_winch(self, index: int, msg: Float64 | WinchCommand) -> None:
         """/uav{index}/winch_cmd: its winch reels at msg.data [m/s] from the period of the
-        tick being answered on (Float64 carries no stamp); a rate that is no number is logged
-        and ignored."""
+        tick being answered on (Float64 carries no stamp); /uav{index}/winch_cmd_stamped: at
+        msg.rate from the first tick at or after msg.header.stamp (simulated time; a stamp
+        already past: the tick being answered). A rate that is no number is logged and
+        ignored."""
+        stamped = isinstance(msg, WinchCommand)
+        rate = float(msg.rate if stamped else msg.data)
+        at_ns = ns_from_stamp(msg.header.stamp) if stamped else None
         try:
-            self.sim.command_winch(index - 1, float(msg.data))
+            tick = self.sim.command_winch(index - 1, rate, at_ns)
         except ValueError as error:
-            self.get_logger().warning(f'{uav_topic(index, WINCH_CMD)} ignored: {error}')
+            leaf = WINCH_CMD_STAMPED if stamped else WINCH_CMD
+            self.get_logger().warning(f'{uav_topic(index, leaf)} ignored: {error}')
             return
-        self.get_logger().info(f'uav{index} winch commanded to {msg.data:g} m/s at t = '
-                               f'{self.sim.t:.3f} s')
+        late = '' if at_ns is None or at_ns >= self.sim.t_ns else \
+            f' ({(self.sim.t_ns - at_ns) * 1e-9:.3f} s after its stamp)'
+        self.get_logger().info(f'uav{index} winch commanded to {rate:g} m/s at t = '
+                               f'{tick * self.sim.period_ns * 1e-9:.3f} s{late}')
 
     _external_ready_since: float | None = None
 

@@ -15,8 +15,10 @@ import numpy as np
 
 from multilift_sim.kernels import jit
 from multilift_sim.physics.attitude import quaternion_norm_error
-from multilift_sim.physics.layout import POSITION, REEL_LENGTH, UAV_COORDINATES
-from multilift_sim.physics.state_slots import (attitude_slot, chain_node_slot, payload_slot,
+from multilift_sim.physics.chain_cables import cable_paths
+from multilift_sim.physics.layout import (POSITION, REEL_LENGTH, UAV_CABLE_STIFFNESS,
+                                          UAV_COORDINATES)
+from multilift_sim.physics.state_slots import (attitude_slot, payload_slot,
                                                rigid_payload_state, uav_attitude_slot,
                                                uav_slot)
 from multilift_sim.statistics.layout import (
@@ -129,20 +131,22 @@ def run_add_ropes(run: np.ndarray, state: np.ndarray, lengths: np.ndarray,
 
 
 @jit
-def run_add_sag(run: np.ndarray, state: np.ndarray, n: int, inner: int) -> None:
+def run_add_chains(run: np.ndarray, state: np.ndarray, uavs: np.ndarray, inner: int,
+                   lengths: np.ndarray, tension: np.ndarray) -> None:
     """Heavy cables (cable_model: chain) at one tick: each cable's sag, the largest distance
-    [m] of its `inner` nodes from its chord r_i -> r_p in the state, raises its maximum
-    (RUN_MAX_SAG)."""
-    p = payload_slot(n)
-    for i in range(n):
-        r = uav_slot(i) + POSITION
-        cx, cy, cz = state[p] - state[r], state[p + 1] - state[r + 1], state[p + 2] - state[r + 2]
+    [m] of its `inner` nodes from its chord (from where it holds its UAV to where it holds the
+    payload, `chain_cables.cable_paths`), raises its maximum (RUN_MAX_SAG); with elastic links
+    (UAV_CABLE_STIFFNESS > 0) its stretch, the links' summed lengths less its rest length
+    `lengths` (n,) [m], and its top link's tension `tension` (n,) [N] raise theirs
+    (RUN_MAX_STRETCH, RUN_PEAK_TENSION)."""
+    paths = cable_paths(state, uavs, inner)
+    for i in range(paths.shape[0]):
+        path = paths[i]
+        cx, cy, cz = path[-1, 0] - path[0, 0], path[-1, 1] - path[0, 1], path[-1, 2] - path[0, 2]
         chord_sq = cx * cx + cy * cy + cz * cz
         sag = 0.0
         for k in range(1, inner + 1):
-            at = chain_node_slot(state.shape[0], n, inner, i, k)
-            ex, ey, ez = state[at] - state[r], state[at + 1] - state[r + 1], \
-                state[at + 2] - state[r + 2]
+            ex, ey, ez = path[k, 0] - path[0, 0], path[k, 1] - path[0, 1], path[k, 2] - path[0, 2]
             along = (ex * cx + ey * cy + ez * cz) / chord_sq if chord_sq > 0.0 else 0.0
             off = math.sqrt((ex - along * cx) ** 2 + (ey - along * cy) ** 2
                             + (ez - along * cz) ** 2)
@@ -151,6 +155,16 @@ def run_add_sag(run: np.ndarray, state: np.ndarray, n: int, inner: int) -> None:
         block = RUN_SCALARS + RUN_UAV_COLUMNS * i
         if sag > run[block + RUN_MAX_SAG]:
             run[block + RUN_MAX_SAG] = sag
+        if uavs[i, UAV_CABLE_STIFFNESS] > 0.0:
+            span = 0.0
+            for k in range(inner + 1):
+                dx, dy, dz = (path[k + 1, 0] - path[k, 0], path[k + 1, 1] - path[k, 1],
+                              path[k + 1, 2] - path[k, 2])
+                span += math.sqrt(dx * dx + dy * dy + dz * dz)
+            if span - lengths[i] > run[block + RUN_MAX_STRETCH]:
+                run[block + RUN_MAX_STRETCH] = span - lengths[i]
+            if tension[i] > run[block + RUN_PEAK_TENSION]:
+                run[block + RUN_PEAK_TENSION] = tension[i]
 
 
 @jit

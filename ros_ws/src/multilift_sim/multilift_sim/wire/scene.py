@@ -217,6 +217,9 @@ class FormationScene:
                 points=[(0.0, 0.0, 0.0)] * (2 * (links or CABLE_SEGMENTS))))
         payload = scenario.payload
         self.attach_points = payload.attach_points  # a rigid body's, payload frame [m]
+        # where each cable holds its UAV, body FLU [m] (None: every cable at its UAV's centre)
+        self.uav_attach = ([tuple(u.attach_point) for u in scenario.uavs]
+                           if any(any(u.attach_point) for u in scenario.uavs) else None)
         if payload.type == 'rigid_body' and payload.shape == 'box':
             self.payload = MarkerSpec('payload', 0, CUBE, scale=tuple(payload.size),
                                       color=_rgba(_PAYLOAD))
@@ -270,8 +273,10 @@ class FormationScene:
             body.orientation[:] = quaternion(euler)
             heading.position[:] = xyz
             heading.orientation[:] = body.orientation
-            points = (_cable_points(xyz, end, bool(is_taut)) if chain_points is None
-                      else _chain_points(xyz, chain_points[i], end))
+            top = xyz if self.uav_attach is None else tuple(  # the cable's hold on the UAV
+                p + r for p, r in zip(xyz, _rotate(body.orientation, self.uav_attach[i])))
+            points = (_cable_points(top, end, bool(is_taut)) if chain_points is None
+                      else _chain_points(top, chain_points[i], end))
             if len(points) != len(cable.points):  # a chain's markers need its nodes
                 raise ValueError(f'formation_markers: cable {i + 1} has {len(cable.points)} '
                                  f'points, got {len(points)}')

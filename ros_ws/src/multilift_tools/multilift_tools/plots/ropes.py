@@ -20,7 +20,11 @@ if TYPE_CHECKING:
 def lacks_ropes(run: Run) -> list[str]:
     """Why the bag has no rope figure: its run's summary gives no rope stretch (a run on
     cables that do not stretch, or a bag without summary.json)."""
-    if run.summary.get('sim', {}).get('max_stretch'):
+    sim = run.summary.get('sim', {})
+    if sim.get('max_sag'):  # a chain's g is its worst link's, not a rope's stretch
+        return ['elastic links of a chain (their max_stretch is in the summary; the stretch '
+                'plot reads a rope\'s from g)']
+    if sim.get('max_stretch'):
         return []
     return ['no elastic ropes (the summary gives no max_stretch: cable_model is not elastic)']
 

@@ -20,7 +20,7 @@ def test_the_study_shows_the_reorganising_formation_carrying_the_weak_uav(tmp_pa
     rows = study['rows']
     fixed, moving = rows['v3_mixed']['none'], rows['v3_mixed']['thrust_margin']
     assert fixed['saturated_time'][2] > 60.0                     # UAV 3 saturates for long
-    assert moving['saturated_time'][2] < 0.1 * fixed['saturated_time'][2]
+    assert moving['saturated_time'][2] == 0.0        # started at its hover places (item 1)
     assert moving['least_thrust_margin_after'][2] > fixed['least_thrust_margin_after'][2] + 0.02
     spacing = scenario_io.load('v3_mixed').formation.min_spacing
     assert moving['least_uav_distance'] >= spacing               # within its horizontal bound

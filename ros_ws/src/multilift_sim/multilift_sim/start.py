@@ -11,8 +11,8 @@ import numpy as np
 
 from multilift_sim.cables import CABLE_MODELS
 from multilift_sim.dynamics import initial_state_single_lift
-from multilift_sim.formation_geometry import (hanging_payload, nominal_positions,
-                                              swing_about_uav_axis)
+from multilift_sim.formation_geometry import (hanging_payload, lowest_reached,
+                                              nominal_positions, swing_about_uav_axis)
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import Scenario
 
@@ -145,8 +145,19 @@ def hanging_start(scenario: Scenario) -> np.ndarray:
 
 
 def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
-    """(UAV positions (n, 3), payload position) at t = 0, world [m]."""
+    """(UAV positions (n, 3), payload position) at t = 0, world [m]: the geometry's places,
+    or with `formation.start_places` the followers there, level with the leader, and the point
+    payload where it hangs at rest from them (`lowest_reached`: the statics of Eq. 2.73 at
+    hover, every taut cable at its length)."""
     f = scenario.formation
+    if f.start_places:
+        leader = np.asarray(scenario.uavs[0].position, dtype=float)
+        uavs = np.tile(leader, (scenario.n_uavs, 1))
+        uavs[1:, :2] += np.asarray(f.start_places, dtype=float)
+        payload = lowest_reached(uavs, start_lengths(scenario), np.array([0.0, 0.0, -1.0]))
+        if payload is None:
+            raise ValueError('formation.start_places: the cables cannot all reach one point')
+        return uavs, payload
     uavs = nominal_positions(f.geometry, scenario.n_uavs, scenario.uavs[0].position, f.offsets,
                              f.distance, f.half_angle)
     return hanging_payload(uavs, start_lengths(scenario), scenario.payload.attach_points,

@@ -37,11 +37,14 @@ AFTER = 10.0   # [s] the least margins after the start (v3_mixed hovers 10 s, re
 
 
 def variant(name: str, mode: str) -> scenario_io.Scenario:
-    """Scenario `name` with `formation.reorganize: mode` (its other formation keys kept);
+    """Scenario `name` with `formation.reorganize: mode` (its other formation keys kept but
+    `start_places` in a mode that does not reorganise: the fixed geometry starts at its places);
     ScenarioError when its formation cannot fly that mode."""
     path = scenario_io.resolve(name)
     data = scenario_io.read_yaml(path.read_text())
     data.setdefault('formation', {})['reorganize'] = mode
+    if mode not in ('thrust_margin', 'cable_forces'):
+        data['formation'].pop('start_places', None)
     return scenario_io.loads(yaml.safe_dump(data), where=str(path))
 
 

@@ -166,6 +166,29 @@ def static_margins(constants, places, effective):
 
 
 @jit
+def hover_mass(constants, places, index):
+    """The mass [kg] whose weight UAV `index`'s thrust carries at hover with the UAVs at
+    `places` (n, 3) [m]: m_i + T_i e_i,z / g, its own and its cable's vertical pull by the
+    statics of Eq. 2.73 (the payload at `hang_point`, the tensions `cable_tensions` of m_p g
+    e_z). The feedforward of the geometry flown: the seed's m_i + m_p / n is its even share,
+    which a reorganised formation does not carry (v3_mixed: UAV 3 0.17 kg of the payload
+    where the even share is 0.27 kg). The even share where the payload cannot hang."""
+    n = places.shape[0]
+    gravity = constants[FOLLOWER_GRAVITY]
+    own = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * index + REORGANIZE_UAV_MASS]
+    even = own + constants[REORGANIZE_PAYLOAD_MASS] / n
+    lengths = np.empty(n)
+    for j in range(n):
+        lengths[j] = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j + REORGANIZE_UAV_LENGTH]
+    payload, found = hang_point(places, lengths, np.array((0.0, 0.0, -1.0)))
+    if not found:
+        return even
+    load = np.array((0.0, 0.0, constants[REORGANIZE_PAYLOAD_MASS] * gravity))
+    tensions, units = cable_tensions(places, lengths, payload, load)
+    return own + tensions[index] * units[index, 2] / gravity
+
+
+@jit
 def margin_cost(margins, floor):
     """The cost the formation descends [-]: the margins' spread sum (mu_i - mean)^2 plus
     FLOOR_WEIGHT sum max(0, floor - mu_i)^2; infinite where a margin is NaN."""

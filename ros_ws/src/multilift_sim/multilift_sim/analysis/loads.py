@@ -31,6 +31,7 @@ from multilift_sim.analysis.coordinates import cable_offsets
 from multilift_sim.analysis.equilibrium import (payload_multipliers, scenario_configuration,
                                                 scenario_equilibrium)
 from multilift_sim.constraints import cable_tension
+from multilift_sim.formation_geometry import lowest_reached
 from multilift_sim.scenario import Scenario
 
 TAUT = 1e-6  # a cable within this share of its length of taut carries load [-]
@@ -107,60 +108,7 @@ class QuasiStatic:
 def _hang(uavs: np.ndarray, start: np.ndarray, lengths: np.ndarray,
           load: np.ndarray) -> np.ndarray:
     """Where a point payload hangs with its cables from `uavs` (n, 3) [m] when they must give
-    it `load` [N] (its apparent weight and drag): the lowest point along -load within every
-    cable's reach. A linear
-    potential over the balls' intersection is least on its boundary, where one cable (the end
-    of a straight cable), two (the lowest point of their circle) or three (a corner of the
-    spheres) are at their length: the lowest candidate every cable reaches. `start` (the hover
-    place) when none is (the cables cannot all reach one point)."""
-    down = -load / np.linalg.norm(load)  # where the apparent weight and the drag pull
-    n = len(lengths)
-    candidates = [uavs[i] + lengths[i] * down for i in range(n)]
-    for i in range(n):
-        for j in range(i + 1, n):
-            circle = _circle(uavs[i], lengths[i], uavs[j], lengths[j])
-            if circle is None:
-                continue
-            centre, axis, radius = circle
-            across = down - (down @ axis) * axis
-            if np.linalg.norm(across) > 1e-12:
-                candidates.append(centre + radius * across / np.linalg.norm(across))
-            for k in range(j + 1, n):
-                candidates.extend(_corners(circle, uavs[k], lengths[k]))
-    reached = [p for p in candidates
-               if np.all(np.linalg.norm(p - uavs, axis=1) <= lengths * (1.0 + 1e-9))]
-    if not reached:
-        return np.asarray(start, dtype=float)
-    return max(reached, key=lambda p: float(down @ p))
-
-
-def _circle(a: np.ndarray, ra: float, b: np.ndarray, rb: float):
-    """The circle where spheres (a, ra) and (b, rb) meet: (centre, unit axis a -> b, radius),
-    or None."""
-    span = b - a
-    distance = float(np.linalg.norm(span))
-    if distance == 0.0 or distance > ra + rb or distance < abs(ra - rb):
-        return None
-    axis = span / distance
-    along = (distance ** 2 + ra ** 2 - rb ** 2) / (2.0 * distance)
-    return a + along * axis, axis, float(np.sqrt(max(ra ** 2 - along ** 2, 0.0)))
-
-
-def _corners(circle, c: np.ndarray, rc: float) -> list[np.ndarray]:
-    """The points of `circle` (centre, axis, radius) at distance rc from c."""
-    centre, axis, radius = circle
-    offset = c - centre
-    height = float(offset @ axis)                 # c above the circle's plane
-    flat = offset - height * axis
-    reach = float(np.linalg.norm(flat))
-    # |p - c|^2 = radius^2 + reach^2 + height^2 - 2 radius reach cos(angle) = rc^2
-    if reach == 0.0:
-        return []
-    cosine = (radius ** 2 + reach ** 2 + height ** 2 - rc ** 2) / (2.0 * radius * reach) \
-        if radius > 0.0 else 2.0
-    if abs(cosine) > 1.0:
-        return []
-    e1 = flat / reach
-    e2 = np.cross(axis, e1)
-    sine = float(np.sqrt(1.0 - cosine ** 2))
-    return [centre + radius * (cosine * e1 + sign * sine * e2) for sign in (1.0, -1.0)]
+    it `load` [N] (its apparent weight and drag): `formation_geometry.lowest_reached` along
+    -load; `start` (the hover place) when the cables cannot all reach one point."""
+    reached = lowest_reached(uavs, lengths, -load / np.linalg.norm(load))
+    return np.asarray(start, dtype=float) if reached is None else reached

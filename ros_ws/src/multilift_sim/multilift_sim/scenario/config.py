@@ -132,6 +132,9 @@ class FormationConfig:
     max_spread: float = math.inf     # largest horizontal distance between UAVs [m]
     max_offset_rate: float = 0.2     # largest speed of a follower's offset [m/s]
     thrust_margin_floor: float = 0.05  # [-] share of the largest thrust
+    # issue 35: each follower's (x, y) from the leader at t = 0 [m], world (default (): the
+    # geometry's places); the UAVs level with the leader, a point payload where it hangs
+    start_places: tuple[tuple[float, float], ...] = ()
 
 
 @dataclass(frozen=True)

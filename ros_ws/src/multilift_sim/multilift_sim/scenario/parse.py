@@ -358,6 +358,11 @@ def _check_feasible(scenario: Scenario) -> None:
         try:
             hanging_payload(uavs, [u.cable_length for u in scenario.uavs],
                             scenario.payload.attach_points)
+            if f.start_places:
+                from multilift_sim.start import formation_start  # it reads a Scenario
+                reorganize.check_start_places(scenario)
+                uavs, _ = formation_start(scenario)
         except ValueError as exc:
             raise ScenarioError(f'{scenario.source}: formation: {exc}') from None
         reorganize.check_start(scenario.source, f, uavs)
+        reorganize.check_payload(scenario)

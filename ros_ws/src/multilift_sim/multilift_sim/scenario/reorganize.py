@@ -12,7 +12,12 @@ multilift_control's follower `thrust_margin`, `laws.reorganize`), read and check
 - `formation.max_spread` [m] (default: none): the largest horizontal distance between two UAVs;
 - `formation.max_offset_rate` [m/s] (default 0.2): the largest speed of a follower's offset;
 - `formation.thrust_margin_floor` [share, 0..1) (default 0.05): the margin below which a UAV's
-  shortfall weighs FLOOR_WEIGHT times its spread from the others'.
+  shortfall weighs FLOOR_WEIGHT times its spread from the others';
+- `formation.start_places` (default: the geometry's places): each follower's [x, y] from the
+  leader at t = 0 [m], world: the formation starts at the hover equilibrium of the geometry
+  it flies (the UAVs level with the leader, a point payload on rigid or slack cables hanging
+  where every cable reaches: `simulation.formation_start`); for `thrust_margin` and
+  `cable_forces` only, whose offsets start there (a fixed formation starts at its geometry's).
 """
 from __future__ import annotations
 
@@ -44,10 +49,31 @@ def parse(f: Section, n: int, geometry: str) -> dict[str, Any]:
                                                lambda v: 0.0 <= v < 1.0,
                                                'must be within [0, 1) (a share of the '
                                                'largest thrust)'))
+    values['start_places'] = _start_places(f, n, geometry)
+    if values['start_places'] and kind not in SPACED:
+        raise f.fail('start_places', f.raw('start_places'),
+                     f'starts a reorganising formation (thrust_margin, cable_forces), not '
+                     f'{kind!r}: a fixed one starts at its geometry\'s places')
     if values['max_spread'] < values['min_spacing']:
         raise f.fail('max_spread', values['max_spread'],
                      f'must be >= formation.min_spacing ({values["min_spacing"]})')
     return values
+
+
+def _start_places(f: Section, n: int, geometry: str) -> tuple[tuple[float, float], ...]:
+    """`formation.start_places`: n - 1 [x, y] pairs [m], for linear and V formations."""
+    if not f.has('start_places'):
+        return ()
+    raw = f.raw('start_places')
+    if geometry not in ('v', 'linear'):
+        raise f.fail('start_places', raw, f'places linear or V followers, not a {geometry!r} '
+                                          'formation')
+    if not isinstance(raw, list) or len(raw) != n - 1:
+        raise f.fail('start_places', raw, f'must list one [x, y] per follower ({n - 1})')
+    holder = Section({str(k): v for k, v in enumerate(raw)}, f.key('start_places'), f.where)
+    places = tuple(tuple(holder.vector(str(k), length=2)) for k in range(n - 1))
+    holder.done()
+    return places
 
 
 def control_of(c: Section, formation, control):
@@ -75,3 +101,25 @@ def check_start(source: str, formation, uavs) -> None:
                     f'{source}: formation: UAVs {i + 1} and {j + 1} start {gap:.3g} m apart, '
                     f'outside min_spacing {formation.min_spacing:g} .. max_spread '
                     f'{formation.max_spread:g} m')
+
+
+def check_start_places(scenario) -> None:
+    """`formation.start_places` hangs a point payload from cables that keep their length,
+    held at the UAVs' centres (the start's statics, `simulation.formation_start`)."""
+    why = ('a rigid-body payload' if scenario.payload.type == 'rigid_body' else
+           f'cable_model {scenario.cable_model!r}' if scenario.cable_model not in ('rigid',
+                                                                                   'slack')
+           else 'cables held off the UAVs\' centres' if any(any(u.attach_point)
+                                                            for u in scenario.uavs) else None)
+    if why is not None:
+        raise ScenarioError(f'{scenario.source}: formation.start_places: hangs a point payload '
+                            f'on rigid or slack cables from the UAVs\' centres, not {why}')
+
+
+def check_payload(scenario) -> None:
+    """`cable_forces` allocates a point payload's cables (its triangle of forces meets at one
+    point): a rigid-body payload is refused."""
+    f = scenario.formation
+    if f is not None and f.reorganize == 'cable_forces' and scenario.payload.type == 'rigid_body':
+        raise ScenarioError(f'{scenario.source}: formation.reorganize: \'cable_forces\' allocates '
+                            'a point payload\'s cables, not a rigid body\'s')

@@ -4,20 +4,26 @@ offsets move online so that the UAVs' thrust margins stay even, or above
 `formation.thrust_margin_floor` (`laws.reorganize`: the statics of Eq. 2.73 at the formation's
 apparent gravity, a rate-limited gradient step within `formation.min_spacing`, `max_spread`,
 `max_offset_rate`). The scenario's parse picks it when `formation.reorganize` is
-`thrust_margin`; every follower computes the same step (its memory keeps its copy). Its
-`answer` also flies `cable_forces` (REORGANIZE_MODE says which step).
+`thrust_margin`; every follower computes the same step (its memory keeps its copy), from
+`formation.start_places` when the file gives them. Its altitude loop feeds forward the
+weight its thrust carries at hover in the geometry it flies (`laws.reorganize.hover_mass`),
+not the seed's even share. Its `answer` also flies `cable_forces` (REORGANIZE_MODE says which
+step).
 
 Its constants are the seed follower's FOLLOWER_* then the REORGANIZE_* slots (laws.layout),
 its memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT; its matrices the
 linear rows' P and Q (it flies linear and V formations only)."""
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from multilift_control.controllers.followers import virtual_constraints
+from multilift_control.formation import FormationFollower
 from multilift_control.laws import jit
 from multilift_control.laws import layout as slots
-from multilift_control.laws.reorganize import allocate, reorganize
+from multilift_control.laws.reorganize import allocate, hover_mass, reorganize, target_places
 from multilift_sim.scenario import Scenario
 from multilift_sim.start import formation_start
 
@@ -51,9 +57,17 @@ def mode_arrays(scenario: Scenario, index: int, mode: float
         own[row + slots.REORGANIZE_UAV_MASS] = uav.vehicle.mass
         own[row + slots.REORGANIZE_UAV_LARGEST] = uav.vehicle.max_thrust
         own[row + slots.REORGANIZE_UAV_LENGTH] = uav.cable_length
-    rows = p.shape[1]
-    extended = np.zeros(slots.REORGANIZE_SHIFT + rows)  # the acceleration, the shift: 0
+    follower = FormationFollower.from_scenario(scenario, index)
+    rows, targets = follower.constraints.rows, follower.constraints.targets
+    extended = np.zeros(slots.REORGANIZE_SHIFT + len(targets))  # the acceleration: 0
     extended[:len(memory)] = memory
+    if f.start_places:  # the shift starts where the formation does: places - targets' places
+        start = uavs - uavs[0]
+        for k, row in enumerate(rows):
+            axis = row[slots.ROW_AXIS]
+            if row[slots.ROW_FIRST] == 0 and 0 <= axis < 2:
+                extended[slots.REORGANIZE_SHIFT + k] = -start[row[slots.ROW_SECOND], axis] \
+                    - targets[k]
     return own, extended, p, q
 
 
@@ -78,6 +92,32 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
         kept = allocate(constants, memory, t, masses, rows, targets, vectors)
     else:
         kept = reorganize(constants, memory, t, masses, rows, targets, vectors)
-    return virtual_constraints.answer_moved(constants, memory, cascade, mixer, index, t,
+    trimmed = constants.copy()  # the altitude loop's feedforward: the geometry flown's share
+    trimmed[slots.FOLLOWER_HOVER_MASS] = hover_mass(
+        constants, target_places(rows, kept, np.zeros(kept.shape[0]), vectors.shape[0]), index)
+    return virtual_constraints.answer_moved(trimmed, memory, cascade, mixer, index, t,
                                             states, vectors, masses, rows, kept, law_p, law_q,
                                             speeds, saturated, setpoint, errors, rates)
+
+
+def hover_places(scenario: Scenario, seconds: float = 60.0, dt: float = 0.01) -> np.ndarray:
+    """The followers' places from the leader (n - 1, 2) [m] the formation's step (`reorganize`
+    or, for cable_forces, `allocate`) reaches at hover from the geometry's places: the step
+    iterated `seconds` [s] at `dt` [s] with every UAV's lift m_i g e_z (no acceleration). What
+    `formation.start_places` gives to start at the hover equilibrium of the geometry flown."""
+    mode = (slots.REORGANIZE_ALLOCATE if scenario.formation.reorganize == 'cable_forces'
+            else slots.REORGANIZE_GRADIENT)
+    fixed = dataclasses.replace(scenario, formation=dataclasses.replace(
+        scenario.formation, start_places=()))
+    constants, memory, _, _ = mode_arrays(fixed, 1, mode)
+    follower = FormationFollower.from_scenario(fixed, 1)
+    rows, targets = follower.constraints.rows, follower.constraints.targets
+    masses = follower.masses
+    lifts = np.zeros((len(masses), 3))
+    lifts[:, 2] = masses * scenario.simulation.gravity
+    step = allocate if mode == slots.REORGANIZE_ALLOCATE else reorganize
+    for tick in range(int(round(seconds / dt))):
+        step(constants, memory, tick * dt, masses, rows, targets, lifts)
+        memory[slots.FOLLOWER_LAST_T] = tick * dt  # follower_update's advance
+    kept = targets + memory[slots.REORGANIZE_SHIFT:slots.REORGANIZE_SHIFT + len(targets)]
+    return target_places(rows, kept, np.zeros(len(kept)), len(masses))[1:, :2]

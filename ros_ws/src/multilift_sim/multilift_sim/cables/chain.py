@@ -18,7 +18,7 @@ import math
 from typing import Any
 
 from multilift_sim.cables import elastic
-from multilift_sim.cables.elastic import ELASTIC_OMEGA_H, ROPE_KEYS
+from multilift_sim.cables.elastic import ROPE_KEYS
 
 NAME = 'chain'
 NEEDS = frozenset({'chain'})
@@ -119,11 +119,4 @@ def chain_stepping(lengths, links: int, mass_per_length: float, payload_mass: fl
     ELASTIC_OMEGA_H (None then; `shortest` as `chain_rate`'s)."""
     rate = max(chain_rate(lengths, links, mass_per_length, payload_mass, gravity, shortest),
                axial)
-    omega_h = rate / (physics_rate * substeps)
-    if omega_h <= ELASTIC_OMEGA_H:
-        return None
-    needed = math.ceil(rate / (physics_rate * ELASTIC_OMEGA_H))
-    return (f'simulation.substeps: {substeps} steps the chain cables at omega h = '
-            f'{omega_h:.2f} (their fastest mode is bounded by {rate:.0f} rad/s), '
-            f'beyond {ELASTIC_OMEGA_H}: set simulation.substeps >= {needed} (or physics_rate '
-            f'>= {rate / ELASTIC_OMEGA_H / substeps:.0f} Hz)')
+    return elastic.stepping('chain', rate, physics_rate, substeps)

@@ -84,12 +84,19 @@ def rope_stepping(stiffness, damping, masses, payload_mass: float, physics_rate:
                   substeps: int) -> str | None:
     """One line naming the sub-steps or rate needed unless the ropes are stepped at
     omega h <= ELASTIC_OMEGA_H (None then)."""
-    rate = rope_rate(stiffness, damping, masses, payload_mass)
+    return stepping('elastic', rope_rate(stiffness, damping, masses, payload_mass),
+                    physics_rate, substeps)
+
+
+def stepping(cables: str, rate: float, physics_rate: float, substeps: int) -> str | None:
+    """One line naming the sub-steps or rate needed unless the `cables` (the model's word)
+    whose fastest mode is bounded by `rate` [rad/s] are stepped at omega h <= ELASTIC_OMEGA_H
+    (None then), h = 1 / (physics_rate [Hz] substeps)."""
     omega_h = rate / (physics_rate * substeps)
     if omega_h <= ELASTIC_OMEGA_H:
         return None
     needed = math.ceil(rate / (physics_rate * ELASTIC_OMEGA_H))
-    return (f'simulation.substeps: {substeps} steps the elastic cables at omega h = '
+    return (f'simulation.substeps: {substeps} steps the {cables} cables at omega h = '
             f'{omega_h:.2f} (their fastest mode is bounded by {rate:.0f} rad/s), beyond '
             f'{ELASTIC_OMEGA_H}: set simulation.substeps >= {needed} (or physics_rate >= '
             f'{rate / ELASTIC_OMEGA_H / substeps:.0f} Hz)')

@@ -111,6 +111,7 @@ SCENARIO_UNITS: dict[str, str] = {
     'formation.beta_vc': '1/s', 'formation.reorganize': NO_UNIT, 'formation.min_spacing': 'm',
     'formation.max_spread': 'm', 'formation.max_offset_rate': 'm/s',
     'formation.thrust_margin_floor': NO_UNIT,  # a share of the largest thrust
+    'formation.start_places': 'm',  # each follower's [x, y] from the leader at the start
     'control.mode': NO_UNIT, 'control.follower': NO_UNIT,
     'control.constant_rotor_speed': 'rad/s',
     **{f'control.{k}': u for k, u in GAINS.items()},

@@ -43,6 +43,9 @@ class GeneratedDispatcher:
     caller_module: str               # the module whose compiled `caller` calls `function`
     caller: str
     parts: Callable[[], Registry]    # the registry as it is
+    # whether the functions reaching `caller` are cached at the registries' folder once a part
+    # is registered (False: compiled anew in each process; see `refresh`)
+    cache_callers: bool = True
 
     def steps(self) -> list[Callable]:
         return [parts.python(getattr(part, self.step)) for part in self.parts().values()]
@@ -92,7 +95,7 @@ DISPATCHERS: list[GeneratedDispatcher] = []  # every kind of part compiled into 
 
 
 def declare(label: str, signature: str, step: str, caller: str,
-            parts: Callable[[], Registry]) -> GeneratedDispatcher:
+            parts: Callable[[], Registry], cache_callers: bool = True) -> GeneratedDispatcher:
     """The dispatcher `signature` ('function(selector, arguments)') of the kind `label`,
     calling the `step` of each part of `parts()`, for the compiled `caller` ('module.function'
     calling it by that name); known to the cache folder's choice (`cache_folder`), once."""
@@ -100,7 +103,7 @@ def declare(label: str, signature: str, step: str, caller: str,
     selector, arguments = (a.strip() for a in arguments.split(',', 1))
     caller_module, caller = caller.rsplit('.', 1)
     dispatcher = GeneratedDispatcher(label, function, selector, arguments, step, caller_module,
-                                     caller, parts)
+                                     caller, parts, cache_callers)
     if all(d.label != label for d in DISPATCHERS):
         DISPATCHERS.append(dispatcher)
     return dispatcher
@@ -143,6 +146,11 @@ def refresh(dispatcher: GeneratedDispatcher) -> None:
                 step._reset_overloads()
     setattr(module, dispatcher.function, dispatcher.compiled())
     if Dispatcher is not None:
+        from numba.core.caching import NullCache
         for function in parts.callers([getattr(module, dispatcher.caller)], Dispatcher):
-            function.enable_caching()  # at the registries' folder
+            if dispatcher.cache_callers:
+                function.enable_caching()  # at the registries' folder
+            else:  # (a sensor model's or an estimator's callers, loaded from that folder by a
+                # second process, failed in numba's boxing: 'descr' is NULL; not traced)
+                function._cache = NullCache()
             function._reset_overloads()

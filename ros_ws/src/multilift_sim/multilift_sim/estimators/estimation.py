@@ -10,11 +10,12 @@ from multilift_sim.kernels import jit
 
 ESTIMATORS_DISPATCH = part_dispatch.declare(
     'estimators', 'estimate_uav(model, constants, sensors, memory, tick, received)',
-    step='estimate', caller=f'{__name__}.estimated', parts=lambda: estimators.ESTIMATORS)
+    step='estimate', caller=f'{__name__}.estimated', parts=lambda: estimators.ESTIMATORS,
+    cache_callers=False)
 PAYLOAD_ESTIMATORS_DISPATCH = part_dispatch.declare(
     'payload_estimators', 'estimate_payload(model, constants, sensors, estimates, memory, tick)',
     step='estimate', caller=f'{__name__}.estimated',
-    parts=lambda: payload_estimators.PAYLOAD_ESTIMATORS)
+    parts=lambda: payload_estimators.PAYLOAD_ESTIMATORS, cache_callers=False)
 # each rebound when its registry changes
 estimate_uav = ESTIMATORS_DISPATCH.compiled()
 estimate_payload = PAYLOAD_ESTIMATORS_DISPATCH.compiled()

@@ -11,7 +11,8 @@ from multilift_sim.physics.layout import MEASURED_COLUMNS
 
 SENSORS = part_dispatch.declare(
     'sensors', 'measure_sensor(model, constants, draws, memory, tick, truth, received)',
-    step='measure', caller=f'{__name__}.sensed_states', parts=lambda: registry.SENSOR_MODELS)
+    step='measure', caller=f'{__name__}.sensed_states', parts=lambda: registry.SENSOR_MODELS,
+    cache_callers=False)
 measure_sensor = SENSORS.compiled()  # rebound when the registry changes (SENSORS.refresh)
 
 

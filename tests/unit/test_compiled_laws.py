@@ -221,6 +221,9 @@ def test_every_law_compiled_equals_its_uncompiled_run_bit_for_bit():
             check(follower.lift_vectors, states, rng.uniform(0, 60, size=len(r)))
             args = (f.constants, f.masses, rows, targets, f.law_p, f.law_q, f.index)
             check(follower.follower_force, *args, memories[id(f)].copy(), t, u, terms)
+            loaded, _ = check(follower.loaded_terms, f.constants, f.masses, rows, targets,
+                              states, u, rng.normal(size=(len(r), 3)))  # static pulls
+            check(follower.follower_force, *args, memories[id(f)].copy(), t, u, loaded)
             ticked, _ = check(follower.follower_tick, *args, memories[id(f)].copy(), t, states,
                               u, f.cascade.constants, f.cascade.mixer.rows)
             updated, after = check(follower.follower_update, *args, memories[id(f)], t,

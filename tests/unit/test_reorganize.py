@@ -15,6 +15,7 @@ from conftest import SCENARIOS
 from multilift_control.controllers.followers import thrust_margin
 from multilift_control.controllers import formation_rows
 from multilift_control.headless import fly
+from multilift_control.laws import cable_forces as allocation
 from multilift_control.laws import reorganize as laws
 from multilift_control.laws.layout import (REORGANIZE_ACCELERATION, REORGANIZE_MAX_RATE,
                                            REORGANIZE_SHIFT, REORGANIZE_UAV_LARGEST,
@@ -149,12 +150,15 @@ def test_every_reorganising_law_compiled_equals_its_uncompiled_run():
     check(laws._kept, constraints.rows, constraints.targets, np.zeros(6), constants, effective,
           places, places + 0.01)
     check(laws.hover_mass, constants, places, 2)
-    check(laws.load_shares, constants, effective)
-    check(laws.allocated_places, constants, effective)
-    steps(laws.allocate)
-    compiled = {name for name, value in vars(laws).items()
-                if hasattr(value, 'py_func') and value.__module__ == laws.__name__}
-    assert {name.rsplit('.', 1)[1] for name in check.met} == compiled
+    check(laws.hover_statics, constants, places)
+    check(laws.static_pulls, constants, places, masses)
+    check(allocation.load_shares, constants, effective)
+    check(allocation.allocated_places, constants, effective)
+    steps(allocation.allocate)
+    compiled = {f'{module.__name__}.{name}' for module in (laws, allocation)
+                for name, value in vars(module).items()
+                if hasattr(value, 'py_func') and value.__module__ == module.__name__}
+    assert check.met == compiled
 
 
 def test_the_allocated_places_pull_the_allocated_shares():
@@ -166,12 +170,12 @@ def test_the_allocated_places_pull_the_allocated_shares():
     row = REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * 2 + REORGANIZE_UAV_LARGEST
     constants[row] *= 0.95  # a UAV 3 weaker by 5 %: every share within its clips
     effective = np.array([0.0, 0.0, G])
-    shares = laws.load_shares(constants, effective)
+    shares = allocation.load_shares(constants, effective)
     largest = constants[REORGANIZE_UAVS + REORGANIZE_UAV_LARGEST::REORGANIZE_UAV_SIZE][:3]
     utilisation = (2.5 * G + shares * 0.8 * G) / largest
     assert shares.sum() == pytest.approx(1.0) and shares[2] < shares[0] == shares[1]
     np.testing.assert_allclose(utilisation, utilisation.mean(), rtol=1e-12)
-    places = laws.allocated_places(constants, effective)
+    places = allocation.allocated_places(constants, effective)
     payload, found = laws.hang_point(places, np.full(3, 10.26), np.array([0.0, 0.0, -1.0]))
     tensions, units = laws.cable_tensions(places, np.full(3, 10.26), payload,
                                           np.array([0.0, 0.0, 0.8 * G]))
@@ -248,12 +252,13 @@ def test_v3_mixed_saturates_fixed_and_carries_its_load_reorganised(tmp_path):
                    - _flown(scenario, HOVER)['sim']['saturated_time'][2])
         if saturates:
             assert after > 30.0 and climbed > 1.0
-        else:  # started at its hover places, fed forward their shares: UAV 3 never saturates
-            assert after == 0.0 and whole['sim']['saturated_time'][2] == 0.0
-            assert whole['sim']['least_thrust_margin'][2] > 0.04
+        else:  # started at rest at its hover places, the statics in its law: no rotor
+            assert after == 0.0 and sum(whole['sim']['saturated_time']) == 0.0
+            assert whole['sim']['least_thrust_margin'][2] > 0.045
             assert whole['leader']['max_tracking_error'] <= 1.2 * seed
-            # UAV 2: four ticks of the start's attitude transient (docs/loads.md)
-            assert sum(whole['sim']['saturated_time'][:2]) <= 0.05
+            # no cable pushes: each keeps a third of its even share statically
+            # (LEAST_TENSION_SHARE), of which the flight's dips take up to 0.7 N
+            assert whole['sim']['min_tension'] > 0.1
 
 
 def test_v3_mixed_flies_with_its_cables_allocated(tmp_path):
@@ -268,6 +273,7 @@ def test_v3_mixed_flies_with_its_cables_allocated(tmp_path):
              - _flown(allocated, HOVER)['sim']['saturated_time'][2])
     assert after == 0.0 and sum(whole['sim']['saturated_time']) == 0.0  # no rotor, no UAV
     assert whole['leader']['max_tracking_error'] <= 1.2 * seed
+    assert whole['sim']['min_tension'] > 0.1 and whole['sim']['least_thrust_margin'][2] > 0.045
 
 
 def test_the_hover_feedforward_is_the_statics_share_of_the_geometry_flown():
@@ -345,3 +351,60 @@ def test_cable_forces_refuses_a_rigid_body_in_one_line():
         scenario_io.loads(yaml.safe_dump(data))
     assert "allocates a point payload's cables, not a rigid body's" in str(error.value)
     assert '\n' not in str(error.value)
+
+
+def test_a_formation_started_at_its_places_starts_at_rest():
+    """With start_places the formation starts at the static equilibrium of Eq. 2.73 and its
+    controllers hold it (issue 35 item 1): each UAV tilted to carry its weight and its cable's
+    pull (`start.start_equilibrium`), the leader's integral at the pull
+    (`leaders.cascade.start_integral`), the followers' law counting the statics' pulls
+    (`static_pulls`) and weights (`hover_mass`). Through 2 s of v3_mixed's hover no UAV moves
+    0.1 mm nor turns 0.01 degree, and the rotors turn at the equilibrium's speeds (solved apart
+    by `analysis.equilibrium`) but for the followers' first tick (their thrust book's even-share
+    guess, 11 rad/s) and never saturate; the cables carry the equilibrium's tensions."""
+    from multilift_control.headless import run_headless
+    from multilift_sim.analysis.equilibrium import scenario_equilibrium
+    s = scenario_io.load('v3_mixed')
+    s = dataclasses.replace(s, simulation=dataclasses.replace(s.simulation, duration=2.0))
+    equilibrium = scenario_equilibrium(s)
+    speeds, positions, angles = [], [], []
+
+    def on_tick(sim, snapshot, answers):
+        positions.append([u.position.copy() for u in snapshot.uavs])
+        angles.append([u.euler.copy() for u in snapshot.uavs])
+        if answers:
+            speeds.append([a.output.rotor_speeds.copy() for a in answers])
+            assert not any(a.output.saturated.any() for a in answers)
+
+    summary = run_headless(s, on_tick).summary()
+    off = np.abs(np.array(speeds) - np.array(equilibrium.rotor_speeds)[None]).max(axis=2)
+    assert off[:, 0].max() < 0.01 and off[1:].max() < 2.5 and off[20:].max() < 0.1
+    assert np.abs(np.array(positions) - positions[0]).max() < 1e-4
+    assert np.degrees(np.abs(np.array(angles) - angles[0]).max()) < 0.01
+    assert np.degrees(np.abs(np.array(angles[0])[:, :2]).max()) > 0.5  # tilted, not level
+    assert summary['sim']['min_tension'] == pytest.approx(equilibrium.tensions.min(), abs=1e-3)
+    assert summary['sim']['max_tension'] == pytest.approx(equilibrium.tensions.max(), abs=1e-3)
+
+
+def test_the_static_pulls_balance_the_payload():
+    """`static_pulls`: T_j e_j - m_p g / n e_z. Even V: every vertical part zero and the
+    horizontal ones T sin(theta) towards the UAVs (T = m_p g l / (3 sqrt(l^2 - R^2)), R the
+    circumradius); any triangle: the payload's horizontal balance makes the pulls sum to zero,
+    the vertical parts too (sum T_j e_j,z = m_p g)."""
+    s = _table_start()
+    masses, _ = formation_rows(s)
+    constants, _, _, _ = thrust_margin.arrays(s, 1)
+    side, length, m_p = 4.0, 10.26, s.payload.mass
+    radius = side / math.sqrt(3.0)
+    v = _triangle([(0.0, 0.0), (-2.0 * math.sqrt(3.0), 2.0), (-2.0 * math.sqrt(3.0), -2.0)])
+    pulls = laws.static_pulls(constants, v, masses)
+    tension = m_p * G * length / (3.0 * math.sqrt(length ** 2 - radius ** 2))
+    centre = v.mean(axis=0)
+    for j in range(3):
+        outward = (v[j, :2] - centre[:2]) / radius
+        np.testing.assert_allclose(pulls[j, :2], tension * radius / length * outward, atol=1e-9)
+    np.testing.assert_allclose(pulls[:, 2], 0.0, atol=1e-9)
+    skewed = _triangle([(0.0, 0.0), (-4.143, 1.904), (-3.147, -1.389)])
+    pulls = laws.static_pulls(constants, skewed, masses)
+    np.testing.assert_allclose(pulls.sum(axis=0), 0.0, atol=1e-9)
+    assert abs(pulls[2, 2]) > 0.5  # UAV 3 carries well under its even share there

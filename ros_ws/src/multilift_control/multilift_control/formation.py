@@ -25,7 +25,8 @@ from multilift_control.laws.layout import (FOLLOWER_ALTITUDE_OFFSET, FOLLOWER_BE
                                            FOLLOWER_GRAVITY, FOLLOWER_HOVER_MASS,
                                            FOLLOWER_INTEGRAL, FOLLOWER_INTEGRAL_LIMIT,
                                            FOLLOWER_KD_Z, FOLLOWER_KI_Z, FOLLOWER_KP_Z,
-                                           FOLLOWER_LIFT, FOLLOWER_LINEAR,
+                                           FOLLOWER_LEADER_CLIMB, FOLLOWER_LIFT,
+                                           FOLLOWER_LINEAR,
                                            FOLLOWER_MEMORY_SIZE, FOLLOWER_SIZE,
                                            FOLLOWER_TWO_ALPHA, FOLLOWER_YAW)
 from multilift_control.virtual_constraints import FormationGeometry, VirtualConstraints
@@ -140,6 +141,7 @@ class FormationFollower:
         self.constants[FOLLOWER_FREE_MODE_GAIN] = (math.nan if free_mode_gain is None
                                                    else free_mode_gain)
         self.constants[FOLLOWER_LINEAR] = float(constraints.linear)
+        self.constants[FOLLOWER_LEADER_CLIMB] = 0.0  # the seed's: damping on -z_i_dot
         # linear rows: the law's constant matrices P, Q (none for nonlinear rows)
         self.law_p, self.law_q = (self._linear_law_matrices() if constraints.linear
                                   else (np.zeros((3, 0)), np.zeros((3, 0))))

@@ -24,7 +24,8 @@ from multilift_control.laws.layout import (CASCADE_THRUST_COEFFICIENT,
                                            FOLLOWER_GRAVITY, FOLLOWER_HOVER_MASS,
                                            FOLLOWER_INTEGRAL, FOLLOWER_INTEGRAL_LIMIT,
                                            FOLLOWER_KD_Z, FOLLOWER_KI_Z, FOLLOWER_KP_Z,
-                                           FOLLOWER_LAST_T, FOLLOWER_LIFT, FOLLOWER_LINEAR,
+                                           FOLLOWER_LAST_T, FOLLOWER_LEADER_CLIMB,
+                                           FOLLOWER_LIFT, FOLLOWER_LINEAR,
                                            FOLLOWER_TWO_ALPHA, FOLLOWER_YAW, UAV_EULER,
                                            UAV_POSITION, UAV_VELOCITY)
 from multilift_control.laws.linalg import minimum_norm_solve
@@ -127,13 +128,25 @@ def driven_entry(masses, gravity, two_alpha, j, axis, force, velocity):
 def formation_terms(constants, masses, rows, targets, states, thrust_vectors):
     """What the laws of every follower of one tick share, computed once in O(n + m) from the
     formation's states and thrust_vectors (the thrust book's, the same for every follower):
-    (positions (n, 3) [m], velocities (n, 3) [m/s], g_vc (m,), driven (3n,), row_start
-    (n + 1,), row_index), driven = M^-1 (u - f) + 2 alpha v (`driven_entry`) with
-    u = thrust_vectors (a follower that feeds back its own lift replaces its 3 entries:
-    `follower_force`), the rows of UAV j row_index[row_start[j]:row_start[j + 1]]
-    (`constraints.rows_by_uav`). constants: a follower's of the formation (its followers share
-    FOLLOWER_GRAVITY and FOLLOWER_TWO_ALPHA). A follower's own step (`follower_force`,
-    `follower_update`) then touches its own rows and columns only."""
+    `loaded_terms` with no static pulls (the seed's law: the cables' pulls are disturbances)."""
+    return loaded_terms(constants, masses, rows, targets, states, thrust_vectors,
+                        np.zeros((states.shape[0], 3)))
+
+
+@jit
+def loaded_terms(constants, masses, rows, targets, states, thrust_vectors, pulls):
+    """`formation_terms` with each UAV's static load beyond its hover mass's weight in f of Eq.
+    3.9: (positions (n, 3) [m], velocities (n, 3) [m/s], g_vc (m,), driven (3n,), row_start
+    (n + 1,), row_index, pulls (n, 3) [N]), driven = M^-1 (u - pulls - f) + 2 alpha v
+    (`driven_entry`) with u = thrust_vectors (a follower that feeds back its own lift replaces
+    its 3 entries: `follower_force`), the rows of UAV j row_index[row_start[j]:row_start[j + 1]]
+    (`constraints.rows_by_uav`). pulls (world [N]): the force each UAV's thrust spends on its
+    cable at rest beyond the weight of its hover mass, T_j e_j - (M_j - m_j) g e_z (zeros: the
+    seed's law; a formation that knows its statics, `laws.reorganize.static_pulls`), so a UAV
+    tilted to hold its cable at rest is not accelerating in the law's eyes. constants: a
+    follower's of the formation (its followers share FOLLOWER_GRAVITY and FOLLOWER_TWO_ALPHA).
+    A follower's own step (`follower_force`, `follower_update`) then touches its own rows and
+    columns only."""
     n = states.shape[0]
     positions = np.empty((n, 3))
     velocities = np.empty((n, 3))
@@ -146,10 +159,10 @@ def formation_terms(constants, masses, rows, targets, states, thrust_vectors):
         for axis in range(3):
             driven[3 * j + axis] = driven_entry(
                 masses, constants[FOLLOWER_GRAVITY], constants[FOLLOWER_TWO_ALPHA], j, axis,
-                thrust_vectors[j, axis], velocities[j, axis])
+                thrust_vectors[j, axis] - pulls[j, axis], velocities[j, axis])
     row_start, row_index = rows_by_uav(rows, n)
     return (positions, velocities, residual(rows, targets, positions), driven, row_start,
-            row_index)
+            row_index, pulls)
 
 
 @jit
@@ -191,7 +204,7 @@ def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory
     on and nonlinear rows: linear rows have no free motions), u_i the lift asked at the last
     tick when FOLLOWER_COMMANDED (memory), else thrust_vectors[i]; vertical: the altitude loop
     to z_1 + FOLLOWER_ALTITUDE_OFFSET."""
-    positions, velocities, g, driven, row_start, row_index = terms
+    positions, velocities, g, driven, row_start, row_index, pulls = terms
     own = thrust_vectors[index].copy()  # u_i
     if constants[FOLLOWER_COMMANDED] != 0.0 and not math.isnan(memory[FOLLOWER_LIFT]):
         for axis in range(3):
@@ -202,7 +215,7 @@ def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory
         for axis in range(3):
             own_driven[axis] = driven_entry(
                 masses, constants[FOLLOWER_GRAVITY], constants[FOLLOWER_TWO_ALPHA], index, axis,
-                own[axis], velocities[index, axis])
+                own[axis] - pulls[index, axis], velocities[index, axis])
         u_vf = linear_virtual_force(constants, law_p, law_q, index, driven, own_driven, g)
         for axis in range(2):
             force[axis] = own[axis] + u_vf[axis]
@@ -210,6 +223,9 @@ def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory
         u = thrust_vectors.copy()
         for axis in range(3):
             u[index, axis] = own[axis]
+        for j in range(u.shape[0]):  # the law's u - pulls (terms: `loaded_terms`)
+            for axis in range(3):
+                u[j, axis] -= pulls[j, axis]
         u_vf_all, _ = virtual_forces(rows, targets, masses, constants[FOLLOWER_GRAVITY],
                                      constants[FOLLOWER_TWO_ALPHA], constants[FOLLOWER_BETA_SQ],
                                      positions, velocities, u)
@@ -225,9 +241,11 @@ def follower_force(constants, masses, rows, targets, law_p, law_q, index, memory
     # z_d,i = z_1 (seed §3.2, after Eq. 3.13), a reference the outer loop updates each tick:
     # the damping acts on the follower's own climb rate, not on z_1_dot - z_i_dot, hence
     # the follower's lag in the climb (§4.3, Fig. 4.7) and the leader's larger thrust
-    # (Fig. 4.8)
+    # (Fig. 4.8); with FOLLOWER_LEADER_CLIMB on z_1_dot - z_i_dot (not in the seed)
     error = positions[0, 2] + constants[FOLLOWER_ALTITUDE_OFFSET] - positions[index, 2]
     error_rate = -velocities[index, 2]
+    if constants[FOLLOWER_LEADER_CLIMB] != 0.0:
+        error_rate += velocities[0, 2]
     memory[FOLLOWER_INTEGRAL] = clipped(
         memory[FOLLOWER_INTEGRAL] + constants[FOLLOWER_KI_Z] * error * dt,
         constants[FOLLOWER_INTEGRAL_LIMIT])

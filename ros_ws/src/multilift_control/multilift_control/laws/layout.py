@@ -104,7 +104,8 @@ FOLLOWER_INTEGRAL_LIMIT = 8     # [m/s^2]
 FOLLOWER_COMMANDED = 9          # 1: u_i is the lift asked at the last tick; 0: as measured
 FOLLOWER_FREE_MODE_GAIN = 10    # k_f [1/s] (NaN: off)
 FOLLOWER_LINEAR = 11            # 1: linear (and V) rows, the O(n) law of constant matrices
-FOLLOWER_SIZE = 12
+FOLLOWER_LEADER_CLIMB = 12      # 1: the altitude loop damps z_1_dot - z_i_dot; 0: -z_i_dot
+FOLLOWER_SIZE = 13
 # its memory
 FOLLOWER_INTEGRAL = 0   # altitude loop integral [m/s^2]
 FOLLOWER_LAST_T = 1     # time of the last tick [s] (NaN: none yet)
@@ -130,7 +131,7 @@ REORGANIZE_UAV_LARGEST = 1                    # u_T,max,i, every rotor at its li
 REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]
 REORGANIZE_UAV_SIZE = 3
 REORGANIZE_GRADIENT = 0.0  # thrust_margin: laws.reorganize.reorganize
-REORGANIZE_ALLOCATE = 1.0  # cable_forces: laws.reorganize.allocate
+REORGANIZE_ALLOCATE = 1.0  # cable_forces: laws.cable_forces.allocate
 # a follower whose offsets turn with the leader's heading (`formation.reorganize: heading`):
 # its constants after the FOLLOWER_* slots
 HEADING_LEADER_START_YAW = FOLLOWER_SIZE      # the leader's yaw at the start [rad]

@@ -23,7 +23,7 @@ from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_LAST_T, RO
                                            REORGANIZE_FILTER_TIME, REORGANIZE_FLOOR,
                                            REORGANIZE_GAIN, REORGANIZE_MAX_RATE,
                                            REORGANIZE_MAX_SPREAD, REORGANIZE_MIN_SPACING,
-                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_RADIUS,
+                                           REORGANIZE_PAYLOAD_MASS,
                                            REORGANIZE_SHIFT,
                                            REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_LENGTH,
                                            REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
@@ -35,10 +35,10 @@ REACH = 1e-9         # a candidate this share past a cable's length still counts
 FLOOR_WEIGHT = 10.0  # the floor's penalty against the margins' spread in the cost [-]
 STEP = 1e-3          # the cost's gradient by central differences of this step [m]
 # the least tension a cable keeps, as a share of m_p |g e_z + a| / n [-]: an unloaded cable
-# is one gust from slack (which the rigid-cable formulations cannot fly)
-LEAST_TENSION_SHARE = 0.25
-SHARE_MARGIN = 0.02  # cable_forces: every share at most 1/2 less this [-]
-REORGANIZE_COUNT = 3  # cable_forces allocates three cables in closed form
+# is one gust from slack (which the rigid-cable formulations cannot fly); in v3_mixed's flight
+# UAV 3's cable dips up to 0.7 N below its static tension (the climb's start, the corners), so
+# at a quarter (0.65 N) it pushed, at a third (0.87 N) it keeps 0.23 N (docs/loads.md)
+LEAST_TENSION_SHARE = 1.0 / 3.0
 
 
 @jit
@@ -166,26 +166,58 @@ def static_margins(constants, places, effective):
 
 
 @jit
-def hover_mass(constants, places, index):
-    """The mass [kg] whose weight UAV `index`'s thrust carries at hover with the UAVs at
-    `places` (n, 3) [m]: m_i + T_i e_i,z / g, its own and its cable's vertical pull by the
-    statics of Eq. 2.73 (the payload at `hang_point`, the tensions `cable_tensions` of m_p g
-    e_z). The feedforward of the geometry flown: the seed's m_i + m_p / n is its even share,
-    which a reorganised formation does not carry (v3_mixed: UAV 3 0.17 kg of the payload
-    where the even share is 0.27 kg). The even share where the payload cannot hang."""
+def hover_statics(constants, places):
+    """(T (n,) [N], e (n, 3), found) of the UAVs at `places` (n, 3) [m] at hover: the payload
+    at `hang_point` under g, the least-norm tensions `cable_tensions` that carry m_p g e_z
+    (Eq. 2.73's payload rows); found False where the payload cannot hang (T zero)."""
     n = places.shape[0]
-    gravity = constants[FOLLOWER_GRAVITY]
-    own = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * index + REORGANIZE_UAV_MASS]
-    even = own + constants[REORGANIZE_PAYLOAD_MASS] / n
     lengths = np.empty(n)
     for j in range(n):
         lengths[j] = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j + REORGANIZE_UAV_LENGTH]
     payload, found = hang_point(places, lengths, np.array((0.0, 0.0, -1.0)))
     if not found:
-        return even
-    load = np.array((0.0, 0.0, constants[REORGANIZE_PAYLOAD_MASS] * gravity))
+        return np.zeros(n), np.zeros((n, 3)), False
+    load = np.array((0.0, 0.0, constants[REORGANIZE_PAYLOAD_MASS] * constants[FOLLOWER_GRAVITY]))
     tensions, units = cable_tensions(places, lengths, payload, load)
-    return own + tensions[index] * units[index, 2] / gravity
+    return tensions, units, True
+
+
+@jit
+def hover_mass(constants, places, index):
+    """The mass [kg] whose weight UAV `index`'s thrust carries at hover with the UAVs at
+    `places` (n, 3) [m]: m_i + T_i e_i,z / g, its own and its cable's vertical pull by the
+    statics of Eq. 2.73 (`hover_statics`). The feedforward of the geometry flown: the seed's
+    m_i + m_p / n is its even share, which a reorganised formation does not carry (v3_mixed:
+    UAV 3 0.17 kg of the payload where the even share is 0.27 kg). The even share where the
+    payload cannot hang."""
+    n = places.shape[0]
+    own = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * index + REORGANIZE_UAV_MASS]
+    tensions, units, found = hover_statics(constants, places)
+    if not found:
+        return own + constants[REORGANIZE_PAYLOAD_MASS] / n
+    return own + tensions[index] * units[index, 2] / constants[FOLLOWER_GRAVITY]
+
+
+@jit
+def static_pulls(constants, places, masses):
+    """Each UAV's static load beyond its hover mass's weight (n, 3) [N], world: T_j e_j -
+    (M_j - m_j) g e_z with the UAVs at `places` (n, 3) [m] (`hover_statics`; M_j = masses[j],
+    the law's hover mass m_j + m_p / n), what its thrust spends at rest on its cable beyond
+    the even share the seed's law feeds forward (`follower.loaded_terms`): zero for an even
+    V, the horizontal pull of a tilted UAV's cable in any other. Zeros where the payload
+    cannot hang (the seed's law)."""
+    n = places.shape[0]
+    pulls = np.zeros((n, 3))
+    tensions, units, found = hover_statics(constants, places)
+    if not found:
+        return pulls
+    gravity = constants[FOLLOWER_GRAVITY]
+    for j in range(n):
+        own = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j + REORGANIZE_UAV_MASS]
+        for d in range(3):
+            pulls[j, d] = tensions[j] * units[j, d]
+        pulls[j, 2] -= (masses[j] - own) * gravity
+    return pulls
 
 
 @jit
@@ -311,72 +343,4 @@ def reorganize(constants, memory, t, masses, rows, targets, vectors):
             moved[j, d] += scale * rate[d] * dt
     if dt == 0.0:
         moved = places
-    return _kept(rows, targets, shift, constants, effective, places, moved)
-
-
-@jit
-def load_shares(constants, effective):
-    """Each cable's share s_i (n,) of the payload's apparent weight that gives every UAV the
-    same thrust utilisation (m_i |g_eff| + s_i m_p |g_eff|) / u_T,max,i (the least effort under
-    the thrust limits: the largest utilisation least), the cable's vertical pull counted as
-    its tension, clipped to [LEAST_TENSION_SHARE / n, 1/2 - SHARE_MARGIN] (a triangle of forces
-    exists only with every share below 1/2) and renormalised."""
-    n = REORGANIZE_COUNT
-    weight = math.sqrt(effective[0] ** 2 + effective[1] ** 2 + effective[2] ** 2)
-    load = constants[REORGANIZE_PAYLOAD_MASS] * weight
-    largest = np.empty(n)
-    own = np.empty(n)
-    for j in range(n):
-        row = REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j
-        largest[j] = constants[row + REORGANIZE_UAV_LARGEST]
-        own[j] = constants[row + REORGANIZE_UAV_MASS] * weight
-    utilisation = (load + own.sum()) / largest.sum()
-    shares = (utilisation * largest - own) / load
-    low, high = LEAST_TENSION_SHARE / n, 0.5 - SHARE_MARGIN
-    for _ in range(4):
-        for j in range(n):
-            shares[j] = min(max(shares[j], low), high)
-        shares /= shares.sum()
-    return shares
-
-
-@jit
-def allocated_places(constants, effective):
-    """The three UAVs' places relative to the leader (3, 3) [m] where their cables carry
-    `load_shares`: level UAVs on equal cables at REORGANIZE_RADIUS from the point below which
-    the payload hangs, in directions u_i with sum s_i u_i = 0 (the horizontal balance), the
-    leader ahead (+x) and UAV 2 on its left (+y) as in the V: the triangle of forces of sides
-    s_1, s_2, s_3, the angle between u_1 and u_2 by the law of cosines."""
-    s = load_shares(constants, effective)
-    cosine = (s[2] ** 2 - s[0] ** 2 - s[1] ** 2) / (2.0 * s[0] * s[1])
-    cosine = min(max(cosine, -1.0), 1.0)
-    sine = math.sqrt(1.0 - cosine * cosine)
-    units = np.zeros((3, 3))
-    units[0, 0] = 1.0
-    units[1, 0], units[1, 1] = cosine, sine
-    for d in range(2):
-        units[2, d] = -(s[0] * units[0, d] + s[1] * units[1, d]) / s[2]
-    places = np.zeros((3, 3))
-    radius = constants[REORGANIZE_RADIUS]
-    for j in range(3):
-        for d in range(2):
-            places[j, d] = radius * (units[j, d] - units[0, d])
-    return places
-
-
-@jit
-def allocate(constants, memory, t, masses, rows, targets, vectors):
-    """`reorganize`'s tick for `formation.reorganize: cable_forces` (three UAVs, a point
-    payload): the followers' places move towards `allocated_places` at the apparent gravity,
-    each at most REORGANIZE_MAX_RATE, within the limits; returns targets + shift (m,) [m]."""
-    n = vectors.shape[0]
-    dt, effective, shift, places = _begin(constants, memory, t, masses, rows, targets, vectors)
-    wanted = allocated_places(constants, effective)
-    moved = places.copy()
-    for j in range(1, n):
-        gap = math.sqrt((wanted[j, 0] - places[j, 0]) ** 2 + (wanted[j, 1] - places[j, 1]) ** 2)
-        step = constants[REORGANIZE_MAX_RATE] * dt
-        scale = 1.0 if gap <= step else step / gap
-        for d in range(2):
-            moved[j, d] += scale * (wanted[j, d] - places[j, d])
     return _kept(rows, targets, shift, constants, effective, places, moved)

@@ -359,9 +359,13 @@ def _check_feasible(scenario: Scenario) -> None:
             hanging_payload(uavs, [u.cable_length for u in scenario.uavs],
                             scenario.payload.attach_points)
             if f.start_places:
-                from multilift_sim.start import formation_start  # it reads a Scenario
+                from multilift_sim.start import formation_start, start_attitudes  # Scenario
                 reorganize.check_start_places(scenario)
                 uavs, _ = formation_start(scenario)
+                reorganize.check_start(scenario.source, f, uavs)
+                start_attitudes(scenario)  # the rotors hold every UAV at rest there
+        except ScenarioError:
+            raise
         except ValueError as exc:
             raise ScenarioError(f'{scenario.source}: formation: {exc}') from None
         reorganize.check_start(scenario.source, f, uavs)

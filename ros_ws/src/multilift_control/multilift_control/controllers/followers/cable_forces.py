@@ -1,10 +1,10 @@
 """Cable-force allocation (`formation.reorganize: cable_forces`, issue 35 item 3, three UAVs and
 a point payload): each tick the share of the payload's apparent weight each cable should carry
 so that every UAV flies at the same share of its largest thrust (the least effort under the
-thrust limits; `laws.reorganize.load_shares`, closed form), and the places where level cables
+thrust limits; `laws.cable_forces.load_shares`, closed form), and the places where level cables
 pull those forces (`allocated_places`: the triangle of forces); the followers' offsets move
 there at `formation.max_offset_rate` within the spacing and spread limits
-(`laws.reorganize.allocate`) and the followers fly the seed's virtual-constraint law to them.
+(`laws.cable_forces.allocate`) and the followers fly the seed's virtual-constraint law to them.
 Its arrays are `thrust_margin`'s in REORGANIZE_ALLOCATE mode, its answer that part's."""
 from __future__ import annotations
 

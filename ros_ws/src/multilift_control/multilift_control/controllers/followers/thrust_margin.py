@@ -7,8 +7,12 @@ apparent gravity, a rate-limited gradient step within `formation.min_spacing`, `
 `thrust_margin`; every follower computes the same step (its memory keeps its copy), from
 `formation.start_places` when the file gives them. Its altitude loop feeds forward the
 weight its thrust carries at hover in the geometry it flies (`laws.reorganize.hover_mass`),
-not the seed's even share. Its `answer` also flies `cable_forces` (REORGANIZE_MODE says which
-step).
+not the seed's even share; its virtual constraints count each UAV's static cable pull in f of
+Eq. 3.9 (`laws.reorganize.static_pulls`, `laws.follower.loaded_terms`: a UAV tilted to hold
+its cable is not accelerating), and its altitude loop damps z_1_dot - z_i_dot
+(FOLLOWER_LEADER_CLIMB: the seed's follower lags 0.25-0.29 m behind the leader in v3_mixed's
+climb, and 0.2 m of lag empties UAV 3's cable by the statics). Its `answer` also flies
+`cable_forces` (REORGANIZE_MODE says which step).
 
 Its constants are the seed follower's FOLLOWER_* then the REORGANIZE_* slots (laws.layout),
 its memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT; its matrices the
@@ -23,7 +27,10 @@ from multilift_control.controllers.followers import virtual_constraints
 from multilift_control.formation import FormationFollower
 from multilift_control.laws import jit
 from multilift_control.laws import layout as slots
-from multilift_control.laws.reorganize import allocate, hover_mass, reorganize, target_places
+from multilift_control.laws.cable_forces import allocate
+from multilift_control.laws.follower import loaded_terms
+from multilift_control.laws.reorganize import (hover_mass, reorganize, static_pulls,
+                                              target_places)
 from multilift_sim.scenario import Scenario
 from multilift_sim.start import formation_start
 
@@ -42,6 +49,7 @@ def mode_arrays(scenario: Scenario, index: int, mode: float
     f, n = scenario.formation, scenario.n_uavs
     extra = np.empty(slots.REORGANIZE_UAVS - len(constants) + slots.REORGANIZE_UAV_SIZE * n)
     own = np.concatenate([constants, extra])
+    own[slots.FOLLOWER_LEADER_CLIMB] = 1.0  # no lag in the climb (module docstring)
     own[slots.REORGANIZE_PAYLOAD_MASS] = scenario.payload.mass
     own[slots.REORGANIZE_MIN_SPACING] = f.min_spacing
     own[slots.REORGANIZE_MAX_SPREAD] = f.max_spread
@@ -85,19 +93,23 @@ shared = virtual_constraints.nothing_shared
 def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses, rows,
            targets, law_p, law_q, terms, speeds, saturated, setpoint, errors, rates):
     """Follower `index`'s tick at t [s]: the formation's step (`laws.reorganize.reorganize`, or
-    `allocate` in REORGANIZE_ALLOCATE mode), then the seed follower's answer to the moved
-    targets (`virtual_constraints.answer_moved`: it writes speeds, saturated, setpoint, errors
-    and rates); returns the collective thrust asked [N]."""
+    `laws.cable_forces.allocate` in REORGANIZE_ALLOCATE mode), then the seed follower's answer
+    to the moved targets (`virtual_constraints.answer`: it writes speeds, saturated, setpoint,
+    errors and rates) with the statics of the places flown in its law: the altitude loop
+    feeds forward `hover_mass`, Eq. 3.9's f holds each UAV's `static_pulls`
+    (`laws.follower.loaded_terms`); returns the collective thrust asked [N]."""
     if constants[slots.REORGANIZE_MODE] == slots.REORGANIZE_ALLOCATE:
         kept = allocate(constants, memory, t, masses, rows, targets, vectors)
     else:
         kept = reorganize(constants, memory, t, masses, rows, targets, vectors)
-    trimmed = constants.copy()  # the altitude loop's feedforward: the geometry flown's share
-    trimmed[slots.FOLLOWER_HOVER_MASS] = hover_mass(
-        constants, target_places(rows, kept, np.zeros(kept.shape[0]), vectors.shape[0]), index)
-    return virtual_constraints.answer_moved(trimmed, memory, cascade, mixer, index, t,
-                                            states, vectors, masses, rows, kept, law_p, law_q,
-                                            speeds, saturated, setpoint, errors, rates)
+    places = target_places(rows, kept, np.zeros(kept.shape[0]), vectors.shape[0])
+    trimmed = constants.copy()
+    trimmed[slots.FOLLOWER_HOVER_MASS] = hover_mass(constants, places, index)
+    loaded = loaded_terms(trimmed, masses, rows, kept, states, vectors,
+                          static_pulls(constants, places, masses))
+    return virtual_constraints.answer(trimmed, memory, cascade, mixer, index, t, states,
+                                      vectors, masses, rows, kept, law_p, law_q, loaded, speeds,
+                                      saturated, setpoint, errors, rates)
 
 
 def hover_places(scenario: Scenario, seconds: float = 60.0, dt: float = 0.01) -> np.ndarray:

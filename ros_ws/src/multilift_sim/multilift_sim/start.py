@@ -16,6 +16,7 @@ from multilift_sim.formation_geometry import (hanging_payload, lowest_reached,
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.scenario import Scenario
+from multilift_sim.scenario.reorganize import starts_at_rest
 
 
 def cable_reach(scenario: Scenario) -> np.ndarray:
@@ -127,8 +128,8 @@ def uav_start_motion(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
 def hanging_start(scenario: Scenario) -> np.ndarray:
     """The seed's start: the leader at its position, the followers at the formation's places,
     the payload hanging at rest (one UAV: released at the angles alpha, beta), the UAVs level;
-    with `formation.start_places` the whole formation at rest, each UAV at the attitude of the
-    statics (`start_attitudes`)."""
+    a reorganising formation of a point payload (`scenario.reorganize.starts_at_rest`) the
+    whole formation at rest, each UAV at the attitude of the statics (`start_attitudes`)."""
     if scenario.n_uavs == 1:
         uav = scenario.uavs[0]
         return initial_state_single_lift(np.asarray(uav.position, dtype=float),
@@ -142,7 +143,7 @@ def hanging_start(scenario: Scenario) -> np.ndarray:
         offsets = uav_offsets(scenario)
         ends = uavs if offsets is None else uavs + offsets
         payload = swing_about_uav_axis(payload, ends[0], ends[1], scenario.payload.swing)
-    euler = (start_attitudes(scenario) if formation.start_places
+    euler = (start_attitudes(scenario) if starts_at_rest(scenario)
              else np.array([[0.0, 0.0, u.yaw] for u in scenario.uavs]))
     layout = StateLayout(scenario.n_uavs, scenario.payload.type == 'rigid_body')
     return layout.pack(uavs, euler, payload)  # a rigid payload level (the identity attitude)
@@ -159,9 +160,9 @@ def start_equilibrium(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     """(ZYX Euler angles (n, 3) [rad], thrust vectors R_i e_z u_T,i (n, 3) [N], world) of the
     UAVs at the static equilibrium of Eq. 2.73 at the formation's start
     (`analysis.equilibrium.scenario_equilibrium`): each tilted so that its thrust carries its
-    weight and its cable's pull, as it hovers at rest there (with `formation.start_places`: a
-    level UAV whose cable pulls it sideways is not at rest). Raises ValueError naming the UAV
-    whose rotors cannot hold it."""
+    weight and its cable's pull, as it hovers at rest there (a level UAV whose cable pulls it
+    sideways is not at rest: `scenario.reorganize.starts_at_rest`). Raises ValueError naming
+    the UAV whose rotors cannot hold it."""
     from multilift_sim.analysis.equilibrium import scenario_equilibrium  # it imports this
     equilibrium = scenario_equilibrium(scenario)
     layout = StateLayout(scenario.n_uavs, scenario.payload.type == 'rigid_body')

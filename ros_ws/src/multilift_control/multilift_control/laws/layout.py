@@ -125,7 +125,9 @@ REORGANIZE_FILTER_TIME = FOLLOWER_SIZE + 6    # the apparent gravity's low-pass 
 REORGANIZE_RADIUS = FOLLOWER_SIZE + 7         # cable_forces: the UAVs' horizontal distance
 #                                               from the payload at the start [m]
 REORGANIZE_MODE = FOLLOWER_SIZE + 8           # REORGANIZE_GRADIENT or REORGANIZE_ALLOCATE
-REORGANIZE_UAVS = FOLLOWER_SIZE + 9           # then a row of REORGANIZE_UAV_SIZE per UAV:
+REORGANIZE_AT_REST = FOLLOWER_SIZE + 9        # 1: a point payload's statics in the law
+#                                               (laws.reorganize.static_pulls), 0: none
+REORGANIZE_UAVS = FOLLOWER_SIZE + 10          # then a row of REORGANIZE_UAV_SIZE per UAV:
 REORGANIZE_UAV_MASS = 0                       # its vehicle's mass m_i [kg]
 REORGANIZE_UAV_LARGEST = 1                    # u_T,max,i, every rotor at its limit [N]
 REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]

@@ -358,15 +358,15 @@ def _check_feasible(scenario: Scenario) -> None:
         try:
             hanging_payload(uavs, [u.cable_length for u in scenario.uavs],
                             scenario.payload.attach_points)
+            from multilift_sim.start import formation_start, start_attitudes  # Scenario
             if f.start_places:
-                from multilift_sim.start import formation_start, start_attitudes  # Scenario
                 reorganize.check_start_places(scenario)
                 uavs, _ = formation_start(scenario)
-                reorganize.check_start(scenario.source, f, uavs)
+            reorganize.check_start(scenario.source, f, uavs)
+            if reorganize.starts_at_rest(scenario):
                 start_attitudes(scenario)  # the rotors hold every UAV at rest there
         except ScenarioError:
             raise
         except ValueError as exc:
             raise ScenarioError(f'{scenario.source}: formation: {exc}') from None
-        reorganize.check_start(scenario.source, f, uavs)
         reorganize.check_payload(scenario)

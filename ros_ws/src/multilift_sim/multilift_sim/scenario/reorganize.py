@@ -103,14 +103,31 @@ def check_start(source: str, formation, uavs) -> None:
                     f'{formation.max_spread:g} m')
 
 
+def point_statics_refused(scenario) -> str | None:
+    """Why the statics of a point payload on cables that keep their length, held at the UAVs'
+    centres (`simulation.formation_start`, `laws.reorganize`), do not hold the scenario's
+    formation at rest (a rigid body, a cable model, attach points), or None when they do."""
+    return ('a rigid-body payload' if scenario.payload.type == 'rigid_body' else
+            f'cable_model {scenario.cable_model!r}' if scenario.cable_model not in ('rigid',
+                                                                                    'slack')
+            else 'cables held off the UAVs\' centres' if any(any(u.attach_point)
+                                                             for u in scenario.uavs) else None)
+
+
+def starts_at_rest(scenario) -> bool:
+    """Whether the formation starts at the static equilibrium of Eq. 2.73 with its controllers
+    trimmed to it (`start.start_equilibrium`): a reorganising formation (thrust_margin,
+    cable_forces) of a point payload whose statics hold (`point_statics_refused`); every other
+    starts level (the seed's start)."""
+    f = scenario.formation
+    return (f is not None and f.reorganize in SPACED and scenario.n_uavs > 1
+            and point_statics_refused(scenario) is None)
+
+
 def check_start_places(scenario) -> None:
     """`formation.start_places` hangs a point payload from cables that keep their length,
     held at the UAVs' centres (the start's statics, `simulation.formation_start`)."""
-    why = ('a rigid-body payload' if scenario.payload.type == 'rigid_body' else
-           f'cable_model {scenario.cable_model!r}' if scenario.cable_model not in ('rigid',
-                                                                                   'slack')
-           else 'cables held off the UAVs\' centres' if any(any(u.attach_point)
-                                                            for u in scenario.uavs) else None)
+    why = point_statics_refused(scenario)
     if why is not None:
         raise ScenarioError(f'{scenario.source}: formation.start_places: hangs a point payload '
                             f'on rigid or slack cables from the UAVs\' centres, not {why}')

@@ -9,7 +9,8 @@ apparent gravity, a rate-limited gradient step within `formation.min_spacing`, `
 weight its thrust carries at hover in the geometry it flies (`laws.reorganize.hover_mass`),
 not the seed's even share; its virtual constraints count each UAV's static cable pull in f of
 Eq. 3.9 (`laws.reorganize.static_pulls`, `laws.follower.loaded_terms`: a UAV tilted to hold
-its cable is not accelerating), and its altitude loop damps z_1_dot - z_i_dot
+its cable is not accelerating; a point payload's, whose formation starts at rest:
+`scenario.reorganize.starts_at_rest`), and its altitude loop damps z_1_dot - z_i_dot
 (FOLLOWER_LEADER_CLIMB: the seed's follower lags 0.25-0.29 m behind the leader in v3_mixed's
 climb, and 0.2 m of lag empties UAV 3's cable by the statics). Its `answer` also flies
 `cable_forces` (REORGANIZE_MODE says which step).
@@ -32,6 +33,7 @@ from multilift_control.laws.follower import loaded_terms
 from multilift_control.laws.reorganize import (hover_mass, reorganize, static_pulls,
                                               target_places)
 from multilift_sim.scenario import Scenario
+from multilift_sim.scenario.reorganize import starts_at_rest
 from multilift_sim.start import formation_start
 
 NAME = 'thrust_margin'
@@ -60,6 +62,7 @@ def mode_arrays(scenario: Scenario, index: int, mode: float
     uavs, payload = formation_start(scenario)  # where the formation hangs at the start
     own[slots.REORGANIZE_RADIUS] = float(np.mean(np.hypot(*(uavs[:, :2] - payload[:2]).T)))
     own[slots.REORGANIZE_MODE] = mode
+    own[slots.REORGANIZE_AT_REST] = float(starts_at_rest(scenario))
     for j, uav in enumerate(scenario.uavs):
         row = slots.REORGANIZE_UAVS + slots.REORGANIZE_UAV_SIZE * j
         own[row + slots.REORGANIZE_UAV_MASS] = uav.vehicle.mass
@@ -97,7 +100,9 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
     to the moved targets (`virtual_constraints.answer`: it writes speeds, saturated, setpoint,
     errors and rates) with the statics of the places flown in its law: the altitude loop
     feeds forward `hover_mass`, Eq. 3.9's f holds each UAV's `static_pulls`
-    (`laws.follower.loaded_terms`); returns the collective thrust asked [N]."""
+    (`laws.follower.loaded_terms`) where a point payload's statics hold (REORGANIZE_AT_REST:
+    the formation started at rest; a rigid body's cables do not meet at a point: none);
+    returns the collective thrust asked [N]."""
     if constants[slots.REORGANIZE_MODE] == slots.REORGANIZE_ALLOCATE:
         kept = allocate(constants, memory, t, masses, rows, targets, vectors)
     else:
@@ -105,8 +110,9 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
     places = target_places(rows, kept, np.zeros(kept.shape[0]), vectors.shape[0])
     trimmed = constants.copy()
     trimmed[slots.FOLLOWER_HOVER_MASS] = hover_mass(constants, places, index)
-    loaded = loaded_terms(trimmed, masses, rows, kept, states, vectors,
-                          static_pulls(constants, places, masses))
+    pulls = (static_pulls(constants, places, masses) if constants[slots.REORGANIZE_AT_REST]
+             else np.zeros((vectors.shape[0], 3)))
+    loaded = loaded_terms(trimmed, masses, rows, kept, states, vectors, pulls)
     return virtual_constraints.answer(trimmed, memory, cascade, mixer, index, t, states,
                                       vectors, masses, rows, kept, law_p, law_q, loaded, speeds,
                                       saturated, setpoint, errors, rates)

@@ -16,6 +16,7 @@ from multilift_control.laws.cascade import leader_update
 from multilift_control.laws.layout import (CASCADE_HOVER_MASS, CASCADE_INTEGRAL,
                                            CASCADE_LAST_T, CASCADE_MEMORY_SIZE, REFERENCE_SIZE)
 from multilift_sim.scenario import Scenario
+from multilift_sim.scenario.reorganize import starts_at_rest
 from multilift_sim.start import start_equilibrium
 
 NAME = 'cascade'
@@ -25,11 +26,11 @@ TRACKS_MISSION = True    # answers with the mission reference (/uav1/reference)
 
 def arrays(scenario: Scenario, index: int) -> tuple[np.ndarray, np.ndarray]:
     """(constants: none of its own, memory at t = 0: CASCADE_* memory slots; the integral
-    zero, or with `formation.start_places` the one that holds the formation's rest:
-    `start_integral`)."""
+    zero, or for a formation that starts at rest (`scenario.reorganize.starts_at_rest`) the one
+    that holds it there: `start_integral`)."""
     memory = np.zeros(CASCADE_MEMORY_SIZE)
     memory[CASCADE_LAST_T] = math.nan
-    if scenario.formation is not None and scenario.formation.start_places:
+    if starts_at_rest(scenario):
         memory[CASCADE_INTEGRAL:CASCADE_INTEGRAL + 3] = start_integral(scenario, index)
     return np.zeros(0), memory
 
@@ -37,7 +38,7 @@ def arrays(scenario: Scenario, index: int) -> tuple[np.ndarray, np.ndarray]:
 def start_integral(scenario: Scenario, index: int) -> np.ndarray:
     """The position loop's integral [m/s^2] (3,) at which UAV `index` asks, at rest on its
     reference, the thrust u_i that holds it at the formation's static equilibrium
-    (`multilift_sim.start.start_equilibrium`, the start of `formation.start_places`): u_i / M_i
+    (`multilift_sim.start.start_equilibrium`, a reorganising formation's start): u_i / M_i
     - g e_z, M_i its cascade's hover mass (`position_force`: M_i (integral + g e_z)). The
     integral the seed's start would build as its cable pulls it (a trimmed start)."""
     from multilift_control.controllers import vehicle_cascade  # the registry imports this

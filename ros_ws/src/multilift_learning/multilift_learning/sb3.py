@@ -24,7 +24,33 @@ from multilift_learning.parallel_env import agent_spaces
 from multilift_learning.vector_env import FormationVectorEnv
 
 
-class SB3VecEnv(VecEnv):
+class _OneVectorEnv(VecEnv):
+    """What SB3's VecEnv asks of attributes and methods, answered by the one FormationVectorEnv
+    (`self.vector_env`) behind all of its environments."""
+
+    def close(self) -> None:
+        self.vector_env.close()
+
+    def get_attr(self, attr_name: str, indices=None) -> list[Any]:
+        return [getattr(self.vector_env, attr_name)] * len(self._indices(indices))
+
+    def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
+        setattr(self.vector_env, attr_name, value)
+
+    def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs):
+        method = getattr(self.vector_env, method_name)
+        return [method(*method_args, **method_kwargs)] * len(self._indices(indices))
+
+    def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
+        return [False] * len(self._indices(indices))
+
+    def _indices(self, indices) -> list[int]:
+        if indices is None:
+            return list(range(self.num_envs))
+        return [indices] if isinstance(indices, int) else list(indices)
+
+
+class SB3VecEnv(_OneVectorEnv):
     """SB3's VecEnv over `vector_env`, a FormationVectorEnv in AutoresetMode.SAME_STEP. Each
     environment's info carries the vector env's ('t', 'tension', 'payload_error',
     'termination'), SB3's 'TimeLimit.truncated' and, at an episode's end,
@@ -72,29 +98,8 @@ class SB3VecEnv(VecEnv):
         keys = [key for key in ('t', 'tension', 'payload_error', 'termination') if key in infos]
         return [{key: infos[key][k] for key in keys} for k in range(self.num_envs)]
 
-    def close(self) -> None:
-        self.vector_env.close()
 
-    def get_attr(self, attr_name: str, indices=None) -> list[Any]:
-        return [getattr(self.vector_env, attr_name)] * len(self._indices(indices))
-
-    def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
-        setattr(self.vector_env, attr_name, value)
-
-    def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs):
-        method = getattr(self.vector_env, method_name)
-        return [method(*method_args, **method_kwargs)] * len(self._indices(indices))
-
-    def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
-        return [False] * len(self._indices(indices))
-
-    def _indices(self, indices) -> list[int]:
-        if indices is None:
-            return list(range(self.num_envs))
-        return [indices] if isinstance(indices, int) else list(indices)
-
-
-class SB3AgentVecEnv(VecEnv):
+class SB3AgentVecEnv(_OneVectorEnv):
     """The PettingZoo env's agents over a FormationVectorEnv (SAME_STEP) of B formations, as B n
     environments of SB3's VecEnv, so that one policy, its parameters shared, learns to fly
     every UAV (`multilift_learning.parallel_env`: agent k sees its UAV's slots and the
@@ -104,6 +109,7 @@ class SB3AgentVecEnv(VecEnv):
 
     def __init__(self, vector_env: FormationVectorEnv):
         self.formations = SB3VecEnv(vector_env)
+        self.vector_env = vector_env
         self.n = n = vector_env.batch.n
         self.slots = agent_observation_slots(n)
         observation, action = agent_spaces(vector_env.batch)
@@ -141,21 +147,3 @@ class SB3AgentVecEnv(VecEnv):
                 split.append(agent)
         return (self._agents(observations), np.repeat(rewards, self.n),
                 np.repeat(dones, self.n), split)
-
-    def close(self) -> None:
-        self.formations.close()
-
-    def get_attr(self, attr_name: str, indices=None) -> list[Any]:
-        return [getattr(self.formations.vector_env, attr_name)] * len(self._indices(indices))
-
-    def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
-        setattr(self.formations.vector_env, attr_name, value)
-
-    def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs):
-        method = getattr(self.formations.vector_env, method_name)
-        return [method(*method_args, **method_kwargs)] * len(self._indices(indices))
-
-    def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
-        return [False] * len(self._indices(indices))
-
-    _indices = SB3VecEnv._indices

@@ -293,3 +293,36 @@ def test_a_task_s_scenario_file_flies_the_task_s_physics():
     a.step(300)
     b.step(300)
     assert np.array_equal(a.state, b.state) and a.finished[0]
+
+
+@pytest.mark.parametrize('agents', [False, True])
+def test_the_training_example_writes_a_policy_its_curve_and_its_evaluation(tmp_path, monkeypatch,
+                                                                         agents):
+    """examples/learning/train_ppo.py, two updates: policy.npz loads with the environment's
+    (or one agent's) sizes, progress.csv has a row per update, evaluation.json the policy's and
+    the baseline's figures (and, with --agents, the PettingZoo env's, equal to the batch's: the
+    same seeds)."""
+    pytest.importorskip('stable_baselines3')
+    import runpy
+    import sys
+
+    from conftest import ROOT
+    out = tmp_path / 'ppo'
+    monkeypatch.setattr(sys, 'argv', [
+        'train_ppo.py', '--steps', '1024', '--envs', '2', '--rollout', '256', '--batch', '256',
+        '--epochs', '1', '--duration', '0.5', '--eval-episodes', '2', '--scenario', 'multi_lift',
+        '--out', str(out)] + (['--agents'] if agents else []))
+    runpy.run_path(str(ROOT / 'examples' / 'learning' / 'train_ppo.py'), run_name='__main__')
+    policy = policies.load(out / 'policy.npz')
+    assert policy.environment['trained']['steps'] == 1024
+    assert (policy.observation_size, policy.action_size) == ((22, 4) if agents else (54, 12))
+    rows = (out / 'progress.csv').read_text().splitlines()
+    assert rows[0].startswith('steps,') and [r.split(',')[0] for r in rows[1:]] == ['512', '1024']
+    result = json.loads((out / 'evaluation.json').read_text())
+    assert result['baseline']['flown_to_end'] == 1.0
+    assert ('parallel_env' in result) == agents
+    if agents:
+        assert result['parallel_env']['flown_to_end'] == result['policy']['flown_to_end']
+        if result['policy']['flown_to_end']:
+            assert result['parallel_env']['payload_error_mean'] == pytest.approx(
+                result['policy']['payload_error_mean'], rel=1e-9)

@@ -141,7 +141,7 @@ def evaluate(env_id: str, arguments: dict, policy, episodes: int, last: float) -
 def evaluate_parallel(env_id: str, arguments: dict, policy, episodes: int, last: float) -> dict:
     """`evaluate`'s figures for an agent's policy flown by every agent of the PettingZoo env
     (`multilift_learning.parallel_env`), one episode after another: episode k is seeded as
-    `evaluate`'s environment k (EVALUATION_SEED + k), so the figures are the same."""
+    `evaluate`'s environment k (EVALUATION_SEED + k), so these are its first `episodes`."""
     from multilift_learning.parallel_env import parallel_env
     env = parallel_env(scenario=arguments['scenario'], task=gymnasium.spec(env_id).kwargs['task'],
                        duration=arguments['duration'], **arguments['options'])

@@ -30,3 +30,10 @@ def test_a_reorganising_v_flies_alike_through_ros_and_headless(tmp_path, multili
     # issue 35 item 1: through ROS too, UAV 3 saturates in neither mode (hover and climb)
     assert ros.summary['sim']['saturated_time'][2] == 0.0
     assert headless.summary['sim']['saturated_time'][2] == 0.0
+    # issue 35 item 1: started at rest, no rotor of any UAV saturates
+    assert sum(ros.summary['sim']['saturated_time']) == 0.0
+    # issue 35 item 6: each UAV's thrust margin recorded alike (/uav{i}/thrust_margin)
+    for i in (1, 2, 3):
+        margins = [run.topic(f'/uav{i}/thrust_margin')['data'] for run in (ros, headless)]
+        assert len(margins[0]) == len(margins[1]) > 1000
+        assert np.abs(margins[0] - margins[1]).max() < 1e-9

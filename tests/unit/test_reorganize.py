@@ -408,3 +408,29 @@ def test_the_static_pulls_balance_the_payload():
     pulls = laws.static_pulls(constants, skewed, masses)
     np.testing.assert_allclose(pulls.sum(axis=0), 0.0, atol=1e-9)
     assert abs(pulls[2, 2]) > 0.5  # UAV 3 carries well under its even share there
+
+
+def test_a_reorganising_run_records_each_uav_s_thrust_margin(tmp_path):
+    """Issue 35 item 6: /uav{i}/thrust_margin (a reorganising formation only): each UAV's
+    1 - sum omega^2 / (N omega_max^2) of the rotor commands it sent (/uav{i}/rotor_cmd,
+    recomputed here), whose least is the summary's least_thrust_margin; the Foxglove layout
+    plots it; a fixed formation's bag and layout have none (its bag keeps its bits)."""
+    from multilift_sim.topics import margin_topics, scenario_topics
+    from multilift_tools.bagdata import load_run
+    from multilift_tools.foxglove.layout import layout
+    from multilift_tools.headless_bag import record_headless
+    s = scenario_io.load('v3_mixed')
+    s = dataclasses.replace(s, simulation=dataclasses.replace(s.simulation, duration=12.0))
+    flown = record_headless(s, tmp_path / 'bag').summary()
+    run = load_run(tmp_path / 'bag')
+    for i, uav in enumerate(s.uavs, start=1):
+        margin = run.topic(f'/uav{i}/thrust_margin')
+        speeds = run.rotor_speeds(i)
+        expected = 1.0 - (speeds ** 2).sum(axis=1) / (4 * uav.vehicle.rotor_speed_max ** 2)
+        np.testing.assert_allclose(margin['data'][:len(expected)], expected, atol=1e-12)
+        assert margin['data'].min() == pytest.approx(flown['sim']['least_thrust_margin'][i - 1],
+                                                     abs=1e-12)
+    assert 'Plot!margins' in layout(s)['configById']
+    twin = scenario_io.load('twin_lift')
+    assert not margin_topics(twin) and 'Plot!margins' not in layout(twin)['configById']
+    assert not any(topic.endswith('thrust_margin') for topic, _ in scenario_topics(twin))

@@ -51,6 +51,7 @@ ATTITUDE_SETPOINT = 'attitude_setpoint'  # UAV i's outer-loop output (every UAV)
 REFERENCE = 'reference'                 # the mission reference (the leader only)
 FORMATION_ERROR = 'formation_error'     # follower i's rows of g_vc (followers only)
 CABLE_LENGTH = 'cable_length'           # UAV i's cable length [m] (a UAV with a winch)
+THRUST_MARGIN = 'thrust_margin'         # UAV i's thrust margin (a reorganising formation)
 WINCH_CMD = 'winch_cmd'                 # a live reel rate for UAV i's winch [m/s] (run --live)
 WINCH_CMD_STAMPED = 'winch_cmd_stamped'  # the same from its stamp's tick (simulated time)
 
@@ -58,7 +59,8 @@ UAV_TYPES = {ODOM: ODOMETRY_TYPE, MEASURED_ODOM: ODOMETRY_TYPE, ESTIMATE: ODOMET
              ROTOR_CMD: ROTOR_COMMAND_TYPE,
              ATTITUDE_SETPOINT: ATTITUDE_SETPOINT_TYPE, REFERENCE: TRACKING_REFERENCE_TYPE,
              FORMATION_ERROR: FORMATION_ERROR_TYPE, CABLE_LENGTH: FLOAT64_TYPE,
-             WINCH_CMD: FLOAT64_TYPE, WINCH_CMD_STAMPED: WINCH_COMMAND_TYPE}
+             WINCH_CMD: FLOAT64_TYPE, WINCH_CMD_STAMPED: WINCH_COMMAND_TYPE,
+             THRUST_MARGIN: FLOAT64_TYPE}
 RUN_TYPES = {CLOCK: CLOCK_TYPE, PAYLOAD_ODOM: ODOMETRY_TYPE,
              FORMATION_STATE: FORMATION_STATE_TYPE, FORMATION_SNAPSHOT: FORMATION_SNAPSHOT_TYPE,
              PAYLOAD_GUST: VECTOR3_STAMPED_TYPE,
@@ -112,7 +114,7 @@ def topic_type(topic: str) -> str | None:
 def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
                sensors: bool = False, wind: bool = False, commands: bool = True,
                live: bool = False, winches: Sequence[int] = (), estimates: bool = False,
-               payload_estimate: bool = False) -> list[tuple[str, str]]:
+               payload_estimate: bool = False, margins: bool = False) -> list[tuple[str, str]]:
     """Every topic a run of n UAVs publishes, with its type: what the recorder records. Without
     `controllers`, only the rotor commands of what the controllers publish (a policy's run,
     which has no reference, set-points or formation errors); with `events` (a scenario with
@@ -123,7 +125,8 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
     winch) /uav{i}/cable_length, and with `live` /uav{i}/winch_cmd and
     /uav{i}/winch_cmd_stamped; with `estimates` (an
     estimator, docs/estimation.md) every /uav{i}/estimate; with `payload_estimate` (a payload
-    estimator) /payload/estimate."""
+    estimator) /payload/estimate; with `margins` (a reorganising formation, `margin_topics`)
+    every /uav{i}/thrust_margin."""
     topics = list(RUN_TYPES.items()) + (list(EVENT_TYPES.items()) if events else []) + (
         list(WIND_TYPES.items()) if wind else []) + (list(LIVE_TYPES.items()) if live else []) + (
         list(PAYLOAD_ESTIMATE_TYPES.items()) if payload_estimate else [])
@@ -139,6 +142,8 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
             topics.append((uav_topic(i, ESTIMATE), ODOMETRY_TYPE))
         if i > 1 and controllers:
             topics.append((uav_topic(i, FORMATION_ERROR), FORMATION_ERROR_TYPE))
+        if margins:
+            topics.append((uav_topic(i, THRUST_MARGIN), FLOAT64_TYPE))
         if i in winches:
             topics += [(uav_topic(i, leaf), UAV_TYPES[leaf])
                        for leaf in ((CABLE_LENGTH, WINCH_CMD, WINCH_CMD_STAMPED) if live
@@ -149,14 +154,25 @@ def run_topics(n_uavs: int, controllers: bool = True, events: bool = False,
 def scenario_topics(scenario, controllers: bool = True, live: bool = False
                     ) -> list[tuple[str, str]]:
     """`run_topics` of a scenario (multilift_sim.scenario.Scenario): its n, and the topics its
-    `events:`, `sensors:`, estimator, wind and winches add (and a live run's, `live`); none of
+    `events:`, `sensors:`, estimator, wind, winches and reorganisation add (and a live run's,
+    `live`); none of
     the controllers' when every UAV's motion is prescribed (`uavs[i].trajectory`: no
     controller runs)."""
     return run_topics(scenario.n_uavs, controllers and scenario.controlled,
                       bool(scenario.events), scenario.measures, scenario.has_wind,
                       commands=scenario.controlled, live=live, winches=scenario.winches,
                       estimates=scenario.estimator is not None,
-                      payload_estimate=scenario.payload_estimator is not None)
+                      payload_estimate=scenario.payload_estimator is not None,
+                      margins=margin_topics(scenario))
+
+
+def margin_topics(scenario) -> bool:
+    """Whether the run publishes each UAV's /uav{i}/thrust_margin: a formation that
+    reorganises to share its load (`formation.reorganize: thrust_margin` or `cable_forces`,
+    issue 35), whose controllers fly; the others' bags keep their topics."""
+    formation = scenario.formation
+    return (scenario.controlled and formation is not None
+            and formation.reorganize in ('thrust_margin', 'cable_forces'))
 
 
 def parse_external(text: str, n_uavs: int) -> list[int]:

@@ -81,6 +81,7 @@ class EngineBag:
         self._counts = None if min(counts) == rotors else counts
         self._real = np.concatenate([i * rotors + np.arange(c) for i, c in enumerate(counts)])
         self._held: np.ndarray | None = None  # the rotor speeds held up to the next tick
+        self._last_speeds: list | None = None  # each UAV's answer to the last tick written
         self._sensors = scenario.measures  # /uav{i}/measured_odom
         self._rigid = scenario.payload.type == 'rigid_body'  # its pose in /payload/odom, /tf
         # a heavy cable's inner nodes per cable (cable_model: chain; 0: none), in its markers
@@ -170,7 +171,10 @@ class EngineBag:
                                       errors[i][k] if i else None, rates[i][k] if i else None)
             write(messages, t_ns)
             self._formation(tick, t_ns, tension[k], g[k], g_dot[k], taut[k], odometry[k],
-                            euler[k], payload_position[k], orientations[k], chains[k])
+                            euler[k], payload_position[k], orientations[k], chains[k],
+                            speed_lists[k] if self._commands else None)
+        if count:
+            self._last_speeds = speed_lists[count - 1] if self._commands else None
 
     def last(self) -> None:
         """Write the state at t_max (the engine's current state, which nothing answers) and
@@ -208,7 +212,8 @@ class EngineBag:
                         memory.g_dot[0].tolist(), memory.taut[0].tolist(), odometry,
                         layout.uav_euler(state).tolist(), payload_position,
                         None if pose is None else pose[0],
-                        layout.chain_positions(state) if self._chain_nodes else None)
+                        layout.chain_positions(state) if self._chain_nodes else None,
+                        self._last_speeds)
 
     def _events_at(self, tick: int, t_ns: int) -> list:
         """/formation/events of the events that fall on `tick` (the state there shows them)."""
@@ -218,9 +223,12 @@ class EngineBag:
 
     def _formation(self, tick: int, t_ns: int, tension: list, g: list, g_dot: list,
                    taut: list, odometry: list, euler: list, payload_position: list,
-                   payload_orientation=None, chain_points=None) -> None:
-        """`/formation/state` of a tick and, every MARKER_DECIMATION-th, its markers."""
+                   payload_orientation=None, chain_points=None, speeds=None) -> None:
+        """`/formation/state` of a tick, the thrust margins of its commands `speeds` (each
+        UAV's [rad/s]; a reorganising formation's) and, every MARKER_DECIMATION-th, its
+        markers."""
         messages = [self._simulator.formation_of(t_ns, tension, g, g_dot, taut)]
+        messages += self._simulator.margins(speeds)
         if tick % MARKER_DECIMATION == 0:
             messages.append(self._simulator.markers_of(
                 t_ns, [u[:3] for u in odometry], euler, payload_position, tension, taut,
@@ -272,6 +280,7 @@ class HeadlessBag:
         self._pending = None
         tension, g, g_dot = sim.cables_of(held)
         messages = [self._simulator.formation(snap.t_ns, tension, g, g_dot, held.taut)]
+        messages += self._simulator.margins(held.rotor_speeds)
         if held.tick % MARKER_DECIMATION == 0:
             messages.append(self._simulator.markers(snap, tension, held.taut))
         self._write(messages, snap.t_ns)

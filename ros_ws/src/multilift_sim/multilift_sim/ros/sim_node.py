@@ -43,8 +43,8 @@ from multilift_sim.ros.introspection import AdaptiveSubscription
 from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
                                   FORMATION_STATE, MARKER_DECIMATION, MARKERS, MEASURED_ODOM,
                                   ODOM, PAYLOAD_ESTIMATE, PAYLOAD_GUST, PAYLOAD_ODOM, ROTOR_CMD,
-                                  TF, WIND, WINCH_CMD, WINCH_CMD_STAMPED, parse_external,
-                                  state_topics, uav_topic)
+                                  TF, THRUST_MARGIN, WIND, WINCH_CMD, WINCH_CMD_STAMPED,
+                                  margin_topics, parse_external, state_topics, uav_topic)
 from multilift_sim.simulation import FormationSimulator, SimulationStopped, Snapshot, TickCables
 from multilift_sim.schedules import run_seeds
 from multilift_sim.wire.tick_messages import SimulatorMessages
@@ -114,12 +114,15 @@ class SimNode(Node):
         # /uav{i}/cable_length of each UAV with a winch
         lengths = [self.create_publisher(Float64, uav_topic(i, CABLE_LENGTH), PUBLISHER_QOS)
                    for i in scenario.winches]
+        # /uav{i}/thrust_margin of every UAV of a reorganising formation
+        margins = [self.create_publisher(Float64, uav_topic(i, THRUST_MARGIN), PUBLISHER_QOS)
+                   for i in range(1, n + 1)] if margin_topics(scenario) else []
         # every message goes out as CDR bytes packed from the tick's numbers (tick_messages)
         self.packer = SimulatorMessages(scenario)
         self.outputs = RawPublishers(
             self.clock_pub, *self.odom_pubs, self.payload_pub, self.snapshot_pub,
             self.formation_pub, self.gust_pub, self.marker_pub, self.tf_pub, *events, *winds,
-            *self.measured_pubs, *estimates, *payload_estimate, *lengths,
+            *self.measured_pubs, *estimates, *payload_estimate, *lengths, *margins,
             confirm_first=FIRST_ACK_TIMEOUT if self.record else 0.0)
         # a user's node publishes volatile as a rule: ask it of theirs from the start (our own
         # controllers offer transient_local, which the request adapts to)
@@ -256,7 +259,8 @@ class SimNode(Node):
         """/formation/state (and the markers) of the tick of `snap`, once it is integrated:
         the tension comes from that integration (`FormationSimulator.cables_of`)."""
         tension, g, g_dot = self.sim.cables_of(held)
-        self.outputs.send([self.packer.formation(snap.t_ns, tension, g, g_dot, held.taut)])
+        self.outputs.send([self.packer.formation(snap.t_ns, tension, g, g_dot, held.taut)]
+                          + self.packer.margins(held.rotor_speeds))
         if held.tick % MARKER_DECIMATION == 0:
             self.outputs.send([self.packer.markers(snap, tension, held.taut)])
 

@@ -28,7 +28,8 @@ from multilift_sim.simulation import Snapshot
 from multilift_sim.estimators.published import payload_read
 from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATION_SNAPSHOT,
                                   FORMATION_STATE, MARKERS, MEASURED_ODOM, PAYLOAD_ESTIMATE,
-                                  PAYLOAD_GUST, PAYLOAD_ODOM, TF, ODOM, WIND, uav_topic)
+                                  PAYLOAD_GUST, PAYLOAD_ODOM, TF, THRUST_MARGIN, ODOM, WIND,
+                                  margin_topics, uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
 _ZERO = (0.0, 0.0, 0.0)
@@ -58,6 +59,12 @@ class SimulatorMessages:
         # each winch's cable length (/uav{i}/cable_length), where UAVs carry winches
         self._lengths = [(i - 1, uav_topic(i, CABLE_LENGTH), cdr.Float64())
                          for i in scenario.winches]
+        # each UAV's thrust margin (/uav{i}/thrust_margin), in a reorganising formation: its
+        # topic, its packer, its rotors' largest sum of squared speeds N omega_max^2 [rad^2/s^2]
+        self._margins = [(uav_topic(i, THRUST_MARGIN), cdr.Float64(),
+                          u.vehicle.n_rotors * u.vehicle.rotor_speed_max ** 2)
+                         for i, u in enumerate(scenario.uavs, start=1)] \
+            if margin_topics(scenario) else []
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
         # the payload's estimate with its covariance (/payload/estimate), with a payload
         # estimator
@@ -165,6 +172,22 @@ class SimulatorMessages:
                      g_dot: Sequence[float], taut: Sequence[bool]) -> Message:
         """`formation` from plain numbers."""
         return FORMATION_STATE, self._state.pack(t_ns, tension, g, g_dot, taut)
+
+    def margins(self, rotor_speeds: Sequence[Sequence[float]] | None) -> list[Message]:
+        """/uav{i}/thrust_margin of a tick (a reorganising formation, else none): each UAV's
+        1 - u_T / u_T,max = 1 - sum_r omega_r^2 / (N omega_max^2) of the rotor speeds its
+        commands held over the tick [rad/s] (seed Eq. 2.9 with equal k_T; every rotor counted
+        fully effective, as `multilift plot`'s thrust_margins.png; the summary's
+        least_thrust_margin also counts a failed rotor's effectiveness)."""
+        out: list[Message] = []
+        if rotor_speeds is None:  # no command yet
+            return out
+        for (topic, packer, largest), speeds in zip(self._margins, rotor_speeds):
+            squares = 0.0
+            for omega in speeds:
+                squares += float(omega) * float(omega)
+            out.append((topic, packer.pack(1.0 - squares / largest)))
+        return out
 
     def markers(self, snap: Snapshot, tension: np.ndarray, taut: np.ndarray) -> Message:
         """/visualization/markers: the formation of `snap` drawn (cables by tension)."""

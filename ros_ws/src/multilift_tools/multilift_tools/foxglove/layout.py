@@ -4,7 +4,8 @@ The layout has the 3D panel (the markers of /visualization/markers and the tf fr
 following `world`) beside plots, every series against its message's header stamp: every
 cable's tension, every UAV's rotor speeds (as many as its frame type has), the leader's position
 against its mission reference, every UAV's attitude set-point, and every follower's formation
-(virtual-constraint) errors, where UAVs carry winches each one's cable length, and with an
+(virtual-constraint) errors, where UAVs carry winches each one's cable length, in a
+reorganising formation (issue 35) each UAV's thrust margin, and with an
 estimator each UAV's estimated position beside its true one (and the payload's with a
 `payload_estimator:`). A scenario
 with `events:` has, under the 3D panel, the messages
@@ -15,7 +16,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from multilift_sim.topics import EVENTS, PAYLOAD_ESTIMATE, PAYLOAD_ODOM
+from multilift_sim.topics import EVENTS, PAYLOAD_ESTIMATE, PAYLOAD_ODOM, margin_topics
 
 COLORS = ['#4e98e2', '#f5774d', '#61cbff', '#b87fd6', '#71c26a', '#f7df71', '#e96d9f',
           '#9b9b9b']
@@ -101,6 +102,10 @@ def layout(scenario) -> dict:
         plots['Plot!winches'] = _plot('Cable length [m] (/uav{i}/cable_length)', [
             _series(f'/uav{i}/cable_length.data', f'cable {i}', i - 1, 'receiveTime')
             for i in scenario.winches])
+    if margin_topics(scenario):  # a reorganising formation: each UAV's thrust margin
+        plots['Plot!margins'] = _plot('Thrust margin 1 - u_T / u_T,max (/uav{i}/thrust_margin)', [
+            _series(f'/uav{i}/thrust_margin.data', f'uav{i}', i - 1, 'receiveTime')
+            for i in range(1, n + 1)])
     if scenario.estimator is not None:  # each UAV's estimated position beside the truth
         for i in range(1, n + 1):
             plots[f'Plot!estimate{i}'] = _plot(

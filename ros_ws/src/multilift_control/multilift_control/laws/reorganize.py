@@ -188,8 +188,8 @@ def hover_mass(constants, places, index):
     `places` (n, 3) [m]: m_i + T_i e_i,z / g, its own and its cable's vertical pull by the
     statics of Eq. 2.73 (`hover_statics`). The feedforward of the geometry flown: the seed's
     m_i + m_p / n is its even share, which a reorganised formation does not carry (v3_mixed:
-    UAV 3 0.09 kg of the payload at its start places, where the even share is 0.27 kg). The even share where the
-    payload cannot hang."""
+    UAV 3 0.09 kg of the payload at its start places, where the even share is 0.27 kg). The
+    even share where the payload cannot hang."""
     n = places.shape[0]
     own = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * index + REORGANIZE_UAV_MASS]
     tensions, units, found = hover_statics(constants, places)

@@ -207,8 +207,11 @@ def _compile_in_turn() -> None:
         with global_compiler_lock:  # numba's own lock first: this process's threads in turn
             if index in held:
                 return compile_signature(self, sig)
-            os.makedirs(os.path.dirname(index), exist_ok=True)
-            with open(f'{index}.lock', 'a') as lock:
+            try:
+                lock = open(f'{index}.lock', 'a')
+            except OSError:  # a folder this process cannot write: numba's cache as it is
+                return compile_signature(self, sig)
+            with lock:
                 fcntl.flock(lock, fcntl.LOCK_EX)
                 held.add(index)
                 try:

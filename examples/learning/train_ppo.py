@@ -29,14 +29,15 @@ import gymnasium  # noqa: E402
 import numpy as np  # noqa: E402
 
 import multilift_learning  # noqa: E402,F401 - registers the environments
-from multilift_learning.policies import MlpPolicy, save  # noqa: E402
+from multilift_learning.policies import MlpPolicy, save, shared_by_agents  # noqa: E402
 
 EVALUATION_SEED = 1_000_000  # held out: training seeds its streams with 1000 seed + k, k < envs
 
 
 def env_arguments(args: argparse.Namespace) -> dict:
-    """The environment's arguments (the ones policy.npz records)."""
-    return {'scenario': args.scenario, 'duration': args.duration,
+    """The environment's arguments (the ones policy.npz records; `agents`: a policy of one UAV
+    that every UAV flies, the PettingZoo env's agent)."""
+    return {'scenario': args.scenario, 'duration': args.duration, 'agents': args.agents,
             'options': {'action_mode': args.action_mode, 'start': 'rest',
                         'normalise': False}}
 
@@ -47,12 +48,14 @@ def train(args: argparse.Namespace) -> MlpPolicy:
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
-    from multilift_learning.sb3 import SB3VecEnv
+    from multilift_learning.sb3 import SB3AgentVecEnv, SB3VecEnv
 
     torch.set_num_threads(1)
     arguments = env_arguments(args)
-    venv = SB3VecEnv.make(args.env, args.envs, scenario=args.scenario, duration=args.duration,
-                          **arguments['options'])
+    venv = (SB3AgentVecEnv if args.agents else SB3VecEnv).make(
+        args.env, args.envs, scenario=args.scenario, duration=args.duration,
+        **arguments['options'])
+    agents = venv.n if args.agents else 1  # SB3 counts each agent's step
     venv.seed(args.seed * 1000)
     venv = VecNormalize(VecMonitor(venv), norm_obs=True, norm_reward=True, clip_obs=10.0,
                         gamma=args.gamma)
@@ -77,7 +80,8 @@ def train(args: argparse.Namespace) -> MlpPolicy:
         def _on_rollout_end(self) -> None:
             episodes = list(self.model.ep_info_buffer)
             wall = time.perf_counter() - start
-            row = [self.num_timesteps, round(wall, 1), round(self.num_timesteps / wall),
+            steps = self.num_timesteps // agents
+            row = [steps, round(wall, 1), round(steps / wall),
                    round(float(np.mean([e['r'] for e in episodes])), 2) if episodes else '',
                    round(float(np.mean([e['l'] for e in episodes])), 1) if episodes else '']
             self.writer.writerow(row)
@@ -87,8 +91,8 @@ def train(args: argparse.Namespace) -> MlpPolicy:
     with open(out / 'progress.csv', 'w', newline='') as handle:
         writer = csv.writer(handle)
         writer.writerow(['steps', 'wall_s', 'steps_per_s', 'return_mean', 'length_mean'])
-        model.learn(total_timesteps=args.steps, callback=Curve(writer))
-    args.steps = model.num_timesteps  # fewer where --minutes ran out
+        model.learn(total_timesteps=args.steps * agents, callback=Curve(writer))
+    args.steps = model.num_timesteps // agents  # fewer where --minutes ran out
     return exported(model, venv, args, arguments)
 
 
@@ -114,6 +118,8 @@ def evaluate(env_id: str, arguments: dict, policy, episodes: int, last: float) -
     envs = gymnasium.make_vec(env_id, num_envs=episodes, scenario=arguments['scenario'],
                               duration=arguments['duration'],
                               **(arguments['options'] if policy is not None else {}))
+    if policy is not None and arguments['agents']:
+        policy = shared_by_agents(policy, envs.batch.n)
     observations, _ = envs.reset(seed=EVALUATION_SEED)
     steps = int(round(arguments['duration'] * 100))
     errors = np.full((steps, episodes), np.nan)
@@ -132,6 +138,30 @@ def evaluate(env_id: str, arguments: dict, policy, episodes: int, last: float) -
             'payload_error_worst': float(np.max(per_episode))}
 
 
+def evaluate_parallel(env_id: str, arguments: dict, policy, episodes: int, last: float) -> dict:
+    """`evaluate`'s figures for an agent's policy flown by every agent of the PettingZoo env
+    (`multilift_learning.parallel_env`), one episode after another: episode k is seeded as
+    `evaluate`'s environment k (EVALUATION_SEED + k), so these are its first `episodes`."""
+    from multilift_learning.parallel_env import parallel_env
+    env = parallel_env(scenario=arguments['scenario'], task=gymnasium.spec(env_id).kwargs['task'],
+                       duration=arguments['duration'], **arguments['options'])
+    flown, per_episode = 0, []
+    for k in range(episodes):
+        observations, _ = env.reset(seed=EVALUATION_SEED + k)
+        errors, ended = [], False
+        while env.agents:
+            observations, _, terminated, _, infos = env.step(
+                {agent: policy(observations[agent]) for agent in env.agents})
+            errors.append(infos['uav1']['payload_error'])
+            ended = terminated['uav1']
+        if not ended:
+            flown += 1
+            per_episode.append(np.mean(errors[-int(last * 100):]))
+    return {'episodes': episodes, 'flown_to_end': flown / episodes, 'payload_error_last_s': last,
+            'payload_error_mean': float(np.mean(per_episode)) if per_episode else None,
+            'payload_error_worst': float(np.max(per_episode)) if per_episode else None}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--env', default='multilift/Hover-v0')
@@ -141,7 +171,10 @@ def main() -> None:
     parser.add_argument('--scenario', default='twin_lift')
     parser.add_argument('--duration', type=float, default=20.0, help='episode length [s]')
     parser.add_argument('--action-mode', default='thrust_body_rates')
-    parser.add_argument('--envs', type=int, default=32, help='environments in the batch')
+    parser.add_argument('--envs', type=int, default=32, help='formations in the batch')
+    parser.add_argument('--agents', action='store_true',
+                        help='one policy per UAV, its parameters shared (the PettingZoo '
+                             'env\'s agents, multilift_learning.sb3.SB3AgentVecEnv)')
     parser.add_argument('--rollout', type=int, default=256, help='steps per env per update')
     parser.add_argument('--batch', type=int, default=512, help='PPO minibatch')
     parser.add_argument('--epochs', type=int, default=10, help='PPO epochs per update')
@@ -161,6 +194,9 @@ def main() -> None:
     arguments = env_arguments(args)
     result = {'policy': evaluate(args.env, arguments, policy, args.eval_episodes, 10.0),
               'baseline': evaluate(args.env, arguments, None, args.eval_episodes, 10.0)}
+    if args.agents:  # the same policy in the PettingZoo env itself, its first episodes
+        result['parallel_env'] = evaluate_parallel(args.env, arguments, policy,
+                                                   min(args.eval_episodes, 5), 10.0)
     (Path(args.out) / 'evaluation.json').write_text(json.dumps(result, indent=1))
     print(f'{path}: {json.dumps(result)}')
 

@@ -16,6 +16,7 @@ from multilift_sim.formation_params import StateLayout
 from multilift_sim.physics import layout
 from multilift_sim.physics.formation_dae import integrate_period, solve
 from multilift_sim.simulation import FormationSimulator
+from multilift_sim.statistics import summary_row
 
 
 def _chain(**cable):
@@ -124,7 +125,8 @@ def test_a_chain_stepped_too_coarsely_is_refused_naming_its_sub_steps():
 def test_the_summary_gives_each_chain_s_sag_and_the_markers_draw_its_links():
     """A second of twin_lift_chain hovering: each cable's max sag (an inner node's largest
     distance from its chord, at the ticks) as measured here from the states, in the figures
-    and summary.json's `max_sag`; the cable markers are the N links through the nodes."""
+    and summary.json's `max_sag` (a sweep row's: the larger); the cable markers are the N
+    links through the nodes."""
     from multilift_sim.wire.scene import FormationScene
     s = scenario_io.load(SCENARIOS / 'twin_lift_chain.yaml').with_duration(1.0)
     sim = FormationSimulator(s)
@@ -145,6 +147,8 @@ def test_the_summary_gives_each_chain_s_sag_and_the_markers_draw_its_links():
     assert np.all(sags > 1e-3)    # they sag from the straight start
     np.testing.assert_allclose(sim.stats.chain_figures['max_sag'], sags, rtol=1e-12)
     assert sim.stats.as_dict()['max_sag'] == sim.stats.chain_figures['max_sag']
+    row = summary_row({'sim': sim.stats.as_dict()})  # a sweep's row: the worst cable's
+    assert row['max_sag'] == sags.max() and row['max_stretch'] is None
     snap = sim.snapshot()
     scene = FormationScene(s)
     scene.update([u.position for u in snap.uavs], [u.euler for u in snap.uavs],

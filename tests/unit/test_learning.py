@@ -18,6 +18,7 @@ from multilift_control.engine import Engine
 from multilift_learning.attitude import AttitudeActions
 from multilift_learning.batch import observation_names
 from multilift_learning.parallel_env import parallel_env
+from multilift_learning.policies import MlpPolicy, shared_by_agents
 from multilift_learning.recording import RecordEpisodes
 from multilift_learning.tasks import task_scenario
 from multilift_learning.vector_env import FormationVectorEnv
@@ -134,6 +135,43 @@ def test_the_parallel_env_passes_pettingzoo_s_test_and_flies_the_baseline():
         flat, reward, *_ = single.step(single.unwrapped.expert_action())
         assert np.array_equal(observations['uav3'][-6:], flat[-6:]) and rewards['uav1'] == reward
     assert truncated['uav1'] and not terminated['uav1']
+
+
+def _agent_policy(observation_size: int, action_size: int) -> MlpPolicy:
+    """A random one-agent MLP (small weights: it flies near hover for a while)."""
+    rng = np.random.default_rng(3)
+    weights = (rng.normal(0, 0.1, (observation_size, 8)), rng.normal(0, 0.1, (8, action_size)))
+    return MlpPolicy(weights, (np.zeros(8), np.zeros(action_size)), 'tanh',
+                     np.zeros(observation_size), np.ones(observation_size), 10.0)
+
+
+def test_an_agent_s_policy_shared_by_every_uav_flies_the_parallel_env_as_the_batch():
+    """One agent's policy (the PettingZoo env's agent: its UAV's slots and the payload's)
+    flown by every UAV: `policies.shared_by_agents` on the vector env's observations gives each
+    agent what the parallel env shows it, and both fly the same episode (environment k of the
+    vector env seeded s is the parallel env seeded s + k)."""
+    kwargs = {'scenario': 'multi_lift', 'duration': 0.5, 'action_mode': 'thrust_body_rates'}
+    env = parallel_env(**kwargs)
+    agent = _agent_policy(env.observation_space('uav1').shape[0],
+                          env.action_space('uav1').shape[0])
+    vector = FormationVectorEnv(2, **kwargs)
+    act = shared_by_agents(agent, 3)
+    flat, _ = vector.reset(seed=7)
+    observations, _ = env.reset(seed=8)
+    steps = 0
+    while env.agents:
+        actions = act(flat)
+        assert actions.shape == (2, 12)
+        for k, name in enumerate(env.possible_agents):
+            assert np.array_equal(observations[name], flat[1, env.agent_slots[k]])
+            assert np.allclose(actions[1, 4 * k:4 * k + 4], agent(observations[name]),
+                               rtol=0, atol=1e-12)  # one matrix product or one row's
+        observations, rewards, *_ = env.step({name: actions[1, 4 * k:4 * k + 4]
+                                              for k, name in enumerate(env.agents)})
+        flat, reward, *_ = vector.step(actions)
+        assert rewards['uav1'] == reward[1]
+        steps += 1
+    assert steps == 50
 
 
 def test_a_population_in_one_batch_scores_as_its_candidates_alone():

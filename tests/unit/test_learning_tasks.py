@@ -240,6 +240,46 @@ def test_the_sb3_adapter_steps_as_sb3_s_own_dummy_vec_env():
     assert ends['terminated'] >= 2 and ends['truncated'] >= 4
 
 
+def test_the_sb3_agents_adapter_steps_as_the_parallel_env():
+    """SB3AgentVecEnv (one environment per UAV of a batch of formations, for a policy whose
+    parameters the UAVs share) against the PettingZoo env: formation b's agents see and earn
+    what the parallel env's agents do, step for step, and end with their formation (a tilt)."""
+    pytest.importorskip('stable_baselines3')
+    from multilift_learning.parallel_env import parallel_env
+    from multilift_learning.sb3 import SB3AgentVecEnv
+    kwargs = {'scenario': 'multi_lift', 'duration': 1.0, 'action_mode': 'thrust_body_rates',
+              'tilt_limit_deg': 5.0}
+    ours = SB3AgentVecEnv.make('multilift/Hover-v0', 2, **kwargs)
+    assert ours.num_envs == 6 and ours.observation_space.shape == (22,)
+    theirs = [parallel_env(**kwargs) for _ in range(2)]
+    ours.seed(9)  # formation b: agent 0's seed, 9 + 3 b
+    first = ours.reset()
+    for b, env in enumerate(theirs):
+        seen, _ = env.reset(seed=9 + 3 * b)
+        assert np.array_equal(first[3 * b:3 * b + 3], np.stack(list(seen.values())))
+    rng = np.random.default_rng(1)
+    ended = 0
+    for _ in range(60):
+        actions = rng.uniform(-0.2, 0.2, (6, 4))
+        actions[0, 1] = 1.0  # formation 0's leader rolls past the tilt limit
+        observations, rewards, dones, infos = ours.step(actions)
+        for b, env in enumerate(theirs):
+            seen, earned, terminated, *_ = env.step(
+                {name: actions[3 * b + k] for k, name in enumerate(env.possible_agents)})
+            done = terminated['uav1']
+            assert np.array_equal(rewards[3 * b:3 * b + 3], [np.float32(earned['uav1'])] * 3)
+            assert list(dones[3 * b:3 * b + 3]) == [done] * 3
+            if done:
+                ended += 1
+                final = np.stack([infos[3 * b + k]['terminal_observation'] for k in range(3)])
+                assert np.array_equal(final, np.stack(list(seen.values())))
+            else:
+                assert np.array_equal(observations[3 * b:3 * b + 3], np.stack(list(seen.values())))
+        if ended:
+            break
+    assert ended == 1 and dones[:3].all() and not dones[3:].any()
+
+
 def test_a_task_s_scenario_file_flies_the_task_s_physics():
     """The YAML `multilift run` flies for a policy (tasks.task_scenario_yaml) is the task's
     scenario: the same states to the bit after 3 s."""
@@ -253,3 +293,36 @@ def test_a_task_s_scenario_file_flies_the_task_s_physics():
     a.step(300)
     b.step(300)
     assert np.array_equal(a.state, b.state) and a.finished[0]
+
+
+@pytest.mark.parametrize('agents', [False, True])
+def test_the_training_example_writes_a_policy_its_curve_and_its_evaluation(tmp_path, monkeypatch,
+                                                                         agents):
+    """examples/learning/train_ppo.py, two updates: policy.npz loads with the environment's
+    (or one agent's) sizes, progress.csv has a row per update, evaluation.json the policy's and
+    the baseline's figures (and, with --agents, the PettingZoo env's, equal to the batch's: the
+    same seeds)."""
+    pytest.importorskip('stable_baselines3')
+    import runpy
+    import sys
+
+    from conftest import ROOT
+    out = tmp_path / 'ppo'
+    monkeypatch.setattr(sys, 'argv', [
+        'train_ppo.py', '--steps', '1024', '--envs', '2', '--rollout', '256', '--batch', '256',
+        '--epochs', '1', '--duration', '0.5', '--eval-episodes', '2', '--scenario', 'multi_lift',
+        '--out', str(out)] + (['--agents'] if agents else []))
+    runpy.run_path(str(ROOT / 'examples' / 'learning' / 'train_ppo.py'), run_name='__main__')
+    policy = policies.load(out / 'policy.npz')
+    assert policy.environment['trained']['steps'] == 1024
+    assert (policy.observation_size, policy.action_size) == ((22, 4) if agents else (54, 12))
+    rows = (out / 'progress.csv').read_text().splitlines()
+    assert rows[0].startswith('steps,') and [r.split(',')[0] for r in rows[1:]] == ['512', '1024']
+    result = json.loads((out / 'evaluation.json').read_text())
+    assert result['baseline']['flown_to_end'] == 1.0
+    assert ('parallel_env' in result) == agents
+    if agents:
+        assert result['parallel_env']['flown_to_end'] == result['policy']['flown_to_end']
+        if result['policy']['flown_to_end']:
+            assert result['parallel_env']['payload_error_mean'] == pytest.approx(
+                result['policy']['payload_error_mean'], rel=1e-9)

@@ -42,6 +42,16 @@ def observation_names(n: int) -> list[str]:
     return names + [f'payload.{name}' for name, _ in PAYLOAD_SLOTS]
 
 
+def agent_observation_slots(n: int) -> np.ndarray:
+    """(n, OBSERVATION_PER_UAV + OBSERVATION_PAYLOAD) int: the slots of a formation's
+    observation that agent k (UAV k + 1) sees, its own UAV's then the payload's (the
+    PettingZoo env's agents, `multilift_learning.parallel_env`)."""
+    payload = np.arange(OBSERVATION_PER_UAV * n, OBSERVATION_PER_UAV * n + OBSERVATION_PAYLOAD)
+    return np.array([np.concatenate([np.arange(OBSERVATION_PER_UAV * k,
+                                               OBSERVATION_PER_UAV * (k + 1)), payload])
+                     for k in range(n)])
+
+
 def observation_scales(n: int) -> np.ndarray:
     """Every slot's scale (its typical size near hover, in its unit), float32 (size,)."""
     scales = [scale for _ in range(n) for _, scale in UAV_SLOTS]

@@ -17,7 +17,7 @@ from pettingzoo import ParallelEnv
 
 from multilift_learning.batch import observation_names
 from multilift_learning.env import formation_batch, spaces
-from multilift_learning.observations import OBSERVATION_PAYLOAD, OBSERVATION_PER_UAV
+from multilift_learning.observations import agent_observation_slots
 from multilift_sim.scenario import Scenario
 
 
@@ -34,17 +34,11 @@ class FormationParallelEnv(ParallelEnv):
         self.possible_agents = [f'uav{i}' for i in range(1, n + 1)]
         self.agents: list[str] = []
         names = observation_names(n)
-        payload = names[-OBSERVATION_PAYLOAD:]
-        self.observation_names = {
-            agent: names[k * OBSERVATION_PER_UAV:(k + 1) * OBSERVATION_PER_UAV] + payload
-            for k, agent in enumerate(self.possible_agents)}
-        size = OBSERVATION_PER_UAV + OBSERVATION_PAYLOAD
-        whole_observation, _ = spaces(self.batch)
-        self._observation_space = gymnasium.spaces.Box(
-            whole_observation.low[:size], whole_observation.high[:size], (size,), np.float32)
-        self.action_per_agent = self.batch.action_size // n
-        self._action_space = gymnasium.spaces.Box(-1.0, 1.0, (self.action_per_agent,),
-                                                  np.float64)
+        self.agent_slots = agent_observation_slots(n)
+        self.observation_names = {agent: [names[s] for s in self.agent_slots[k]]
+                                  for k, agent in enumerate(self.possible_agents)}
+        self._observation_space, self._action_space = agent_spaces(self.batch)
+        self.action_per_agent = self._action_space.shape[0]
         self._seeded = False  # the batch's random draws seeded (at the first reset)
 
     def observation_space(self, agent: str) -> gymnasium.spaces.Box:
@@ -54,9 +48,7 @@ class FormationParallelEnv(ParallelEnv):
         return self._action_space
 
     def _split(self, observation: np.ndarray) -> dict[str, np.ndarray]:
-        payload = observation[-OBSERVATION_PAYLOAD:]
-        return {agent: np.concatenate([observation[k * OBSERVATION_PER_UAV:
-                                                   (k + 1) * OBSERVATION_PER_UAV], payload])
+        return {agent: observation[self.agent_slots[k]]
                 for k, agent in enumerate(self.possible_agents)}
 
     def reset(self, seed: int | None = None, options: dict | None = None):
@@ -94,6 +86,17 @@ class FormationParallelEnv(ParallelEnv):
         size = self.action_per_agent
         return {agent: flat[k * size:(k + 1) * size]
                 for k, agent in enumerate(self.possible_agents)}
+
+
+def agent_spaces(batch) -> tuple[gymnasium.spaces.Box, gymnasium.spaces.Box]:
+    """One agent's observation and action spaces in a formation of `batch`'s shape (its UAV's
+    slots and the payload's; its UAV's actions)."""
+    whole_observation, _ = spaces(batch)
+    slots = agent_observation_slots(batch.n)[0]
+    observation = gymnasium.spaces.Box(whole_observation.low[slots],
+                                       whole_observation.high[slots], (len(slots),), np.float32)
+    return observation, gymnasium.spaces.Box(-1.0, 1.0, (batch.action_size // batch.n,),
+                                             np.float64)
 
 
 def parallel_env(**kwargs) -> FormationParallelEnv:

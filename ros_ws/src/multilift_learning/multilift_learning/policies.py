@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from multilift_learning.observations import agent_observation_slots
+
 ACTIVATIONS = {'tanh': np.tanh, 'relu': lambda x: np.maximum(x, 0.0)}
 
 
@@ -57,6 +59,20 @@ class MlpPolicy:
             if k < len(self.weights) - 1:
                 x = hidden(x)
         return np.clip(x, -1.0, 1.0)
+
+
+def shared_by_agents(policy, n: int):
+    """A policy of one agent (the PettingZoo env's: its UAV's observation slots and the
+    payload's -> its UAV's actions) flown by every UAV of a formation of n, its parameters
+    shared: `act(observations (B, size)) -> actions (B, n * agent actions)`."""
+    slots = agent_observation_slots(n)
+
+    def act(observations: np.ndarray) -> np.ndarray:
+        o = np.asarray(observations)
+        batch = o.reshape(-1, o.shape[-1])
+        actions = policy(batch[:, slots].reshape(batch.shape[0] * n, -1))
+        return actions.reshape(o.shape[:-1] + (-1,))
+    return act
 
 
 def save(path: str | Path, policy: MlpPolicy) -> Path:

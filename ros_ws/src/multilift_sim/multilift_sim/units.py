@@ -44,6 +44,12 @@ STATISTIC_UNITS: dict[str, str] = {
     'formation_error_max': 'm or m^2',
     'formation_error_mean': 'm or m^2',
     'least_clearance': 'm',           # of every kind (`world:`, physics.clearance); none: None
+    # per cable in the summary, over the cables in a sweep row; None in a run without them
+    'max_stretch': 'm',               # elastic ropes' and chain links' L_i - l_i
+    'peak_tension': 'N',              # elastic ropes' and elastic chains' at the UAV
+    'max_sag': 'm',                   # a chain's inner node's largest distance from its chord
+    'shortest_cable': 'm',            # a winch's reeled length, least and largest
+    'longest_cable': 'm',
 }
 
 TABLE_UNITS: dict[str, str] = {
@@ -64,13 +70,9 @@ ROPE_UNITS = {'stiffness': 'N/m', 'axial_stiffness': 'N', 'damping': 'N s/m'}
 # a heavy cable's keys (`cable:`, multilift_sim.cables.chain)
 CHAIN_UNITS = {'links': '', 'mass_per_length': 'kg/m', 'drag_coefficient': '',
                'diameter': 'm'}
-# an elastic run's figures per cable (the summary's, not a sweep column)
-ROPE_FIGURE_UNITS = {'max_stretch': 'm', 'peak_tension': 'N'}
-CHAIN_FIGURE_UNITS = {'max_sag': 'm'}   # a chain run's figure per cable (cables.chain)
-# a winch's keys (`uavs[i].winch`, multilift_sim.cables.winch) and a winched run's figures
+# a winch's keys (`uavs[i].winch`, multilift_sim.cables.winch)
 WINCH_UNITS = {'rate_limit': 'm/s', 'acceleration_limit': 'm/s^2', 'min_length': 'm',
                'max_length': 'm'}
-REEL_FIGURE_UNITS = {'shortest_cable': 'm', 'longest_cable': 'm'}
 
 GAINS = {'position_gains.kp': '1/s^2', 'position_gains.kd': '1/s', 'position_gains.ki': '1/s^3',
          'attitude_gains.kp': '1/s^2', 'attitude_gains.kd': '1/s'}
@@ -133,9 +135,7 @@ SCENARIO_UNITS: dict[str, str] = {
     **LINK_UNITS,
 }
 
-UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS,
-                         **ROPE_FIGURE_UNITS, **REEL_FIGURE_UNITS,
-                         **CHAIN_FIGURE_UNITS}
+UNITS: dict[str, str] = {**TABLE_UNITS, **STATISTIC_UNITS, **SCENARIO_UNITS}
 
 _INDEX = re.compile(r'\[\d+\]')
 _WIND_KEY = re.compile(r'^wind\.(\w+)\.(\w+)(?:\[\])?$')  # wind.<model>.<key>

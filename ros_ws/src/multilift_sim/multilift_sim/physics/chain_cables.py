@@ -240,24 +240,25 @@ def chain_solve(x, wrenches, uavs, gusts, formation, taut, acc, multipliers):
                     above[CHAIN_LINK_OFFSET] * dx + above[CHAIN_LINK_OFFSET + 1] * dy
                     + above[CHAIN_LINK_OFFSET + 2] * dz)
         lk[links - 1, CHAIN_LINK_UPPER] = 0.0
-        if stretchy:  # every link's multiplier known
-            top[i] = top_tension / math.sqrt(length_sq)
-        # Thomas' algorithm on A (symmetric positive definite), two right-hand sides
-        for k in range(1 if not stretchy else links, links):
-            factor = lk[k - 1, CHAIN_LINK_UPPER] / lk[k - 1, CHAIN_LINK_DIAGONAL]
-            lk[k, CHAIN_LINK_DIAGONAL] -= factor * lk[k - 1, CHAIN_LINK_UPPER]
-            lk[k, CHAIN_LINK_U] -= factor * lk[k - 1, CHAIN_LINK_U]
-            lk[k, CHAIN_LINK_W] -= factor * lk[k - 1, CHAIN_LINK_W]
         last = links - 1
-        if not stretchy:
+        if stretchy:  # every link's multiplier known: no solve
+            top[i] = top_tension / math.sqrt(length_sq)
+        else:  # Thomas' algorithm on A (symmetric positive definite), two right-hand sides
+            for k in range(1, links):
+                factor = lk[k - 1, CHAIN_LINK_UPPER] / lk[k - 1, CHAIN_LINK_DIAGONAL]
+                lk[k, CHAIN_LINK_DIAGONAL] -= factor * lk[k - 1, CHAIN_LINK_UPPER]
+                lk[k, CHAIN_LINK_U] -= factor * lk[k - 1, CHAIN_LINK_U]
+                lk[k, CHAIN_LINK_W] -= factor * lk[k - 1, CHAIN_LINK_W]
             lk[last, CHAIN_LINK_U] /= lk[last, CHAIN_LINK_DIAGONAL]
             lk[last, CHAIN_LINK_W] /= lk[last, CHAIN_LINK_DIAGONAL]
-        for k in range(links - 2 if not stretchy else -1, -1, -1):
-            row, below = lk[k], lk[k + 1]
-            row[CHAIN_LINK_U] = (row[CHAIN_LINK_U] - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_U]) \
-                / row[CHAIN_LINK_DIAGONAL]
-            row[CHAIN_LINK_W] = (row[CHAIN_LINK_W] - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_W]) \
-                / row[CHAIN_LINK_DIAGONAL]
+            for k in range(links - 2, -1, -1):
+                row, below = lk[k], lk[k + 1]
+                row[CHAIN_LINK_U] = (row[CHAIN_LINK_U]
+                                     - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_U]) \
+                    / row[CHAIN_LINK_DIAGONAL]
+                row[CHAIN_LINK_W] = (row[CHAIN_LINK_W]
+                                     - row[CHAIN_LINK_UPPER] * below[CHAIN_LINK_W]) \
+                    / row[CHAIN_LINK_DIAGONAL]
         dx, dy, dz = get3(lk[last], CHAIN_LINK_OFFSET)
         if rigid:  # the 6 x 6 system's terms (physics.chain_payload)
             put3(last_links[i], 0, dx, dy, dz)

@@ -16,6 +16,11 @@ def summary_row(summary: dict) -> dict:
     def finite(value: float | None) -> float | None:
         return value if value is not None and math.isfinite(value) else None
 
+    def over_cables(key: str, pick=max) -> float | None:
+        """The largest (or least) of a per-cable figure; None where the run has none."""
+        values = [v for v in sim.get(key) or [] if finite(v) is not None]
+        return pick(values) if values else None
+
     return {
         'simulated_time': sim.get('simulated_time'),
         'max_abs_g': sim.get('max_abs_constraint'),
@@ -38,4 +43,9 @@ def summary_row(summary: dict) -> dict:
         'formation_error_mean': (sum(f['mean_formation_error_norm'] for f in followers)
                                  / len(followers) if followers else None),
         'least_clearance': sim.get('least_clearance'),
+        'max_stretch': over_cables('max_stretch'),           # elastic cables and links
+        'peak_tension': over_cables('peak_tension'),
+        'max_sag': over_cables('max_sag'),                   # chains
+        'shortest_cable': over_cables('shortest_cable', min),  # winches
+        'longest_cable': over_cables('longest_cable'),
     }

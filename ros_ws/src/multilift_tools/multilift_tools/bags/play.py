@@ -180,8 +180,11 @@ class BagPlayer:
 
     def _wait_for_subscribers(self) -> bool:
         deadline = time.monotonic() + WAIT_FOR_SUBSCRIBERS_MAX
+        publishers = dict(self.publishers)  # the generated /clock's too
+        if self.clock_publisher is not None:
+            publishers[CLOCK_TOPIC] = self.clock_publisher
         while True:
-            lonely = [name for name, pub in self.publishers.items()
+            lonely = [name for name, pub in publishers.items()
                       if pub.get_subscription_count() == 0]
             if not lonely:
                 return True

@@ -2,20 +2,32 @@
 low), a stage per call, so scripts/setup runs them in two lanes of processes on the machine's
 two cores (a kernel one stage compiled is loaded from the cache by a later one; numba
 optimises each compiled function with every function it calls, so what a kernel calls should
-be in the cache before it is compiled, or the two lanes compile it twice):
+be in the cache before it is compiled, or the two lanes compile it twice).
+
+scripts/setup compiles what a tick of the ROS run needs (`scripts/multilift run`: the
+simulator node and the controller nodes) and the rest of the object path (`run --compose`, the
+tools' tick-by-tick runs):
 
 - `advance`: the physics' tick (multilift_sim.physics.tick) as the simulator node steps it:
   its start, its advance (rigid and slack cables, a rigid payload, events, a prescribed UAV's
   start) and the tension at a tick; in one lane, beside
-- `measure`: the physics' measure (sensors, estimators) as the simulator node calls it,
-- `laws`: every controller's compiled laws as the controller nodes call them (the runtimes),
-- `engine_start`: the engine's start (its physics' start from the cache `advance` filled);
-- then `engine`: the engine's tick over B formations (`run --headless`, sweeps), beside
-- `learning`: the engine's calls the learning environments make (answers, commanded ticks,
-  references, attitude commands, their own attitude-rate loop);
+- `measure`: the physics' measure (sensors, estimators) as the simulator node calls it, and
+- `laws`: every controller's compiled laws as the controller nodes call them (the runtimes);
 - `rest`: the simulator's messages and a run of every kind, tick by tick (mostly loads).
 
-Run by scripts/setup with the workspace's environment (scripts/env.sh), MULTILIFT_KERNEL=jit.
+The engine's tick over B formations (`run --headless`, sweeps, studies) and the learning
+environments' calls compile on their first use into the same cache (about 40 and 20 CPU
+seconds; `multilift_sim.kernels`: one process compiles a kernel while the others wait for
+it), or ahead of it with these stages:
+
+- `engine_start`: the engine's start (its physics' start from the cache `advance` filled);
+- `engine`: the engine's tick over B formations (`run --headless`, sweeps);
+- `learning`: the engine's calls the learning environments make (answers, commanded ticks,
+  references, attitude commands, their own attitude-rate loop).
+
+Run by scripts/setup with the workspace's environment (scripts/env.sh), MULTILIFT_KERNEL=jit:
+`MULTILIFT_KERNEL=jit python scripts/compile_kernels.py engine_start engine learning` after
+it compiles the rest ahead (a benchmark's or a training's first seconds).
 """
 from __future__ import annotations
 
@@ -121,21 +133,17 @@ def learning() -> None:
 
 
 def rest() -> None:
-    from multilift_control.engine import Engine
     from multilift_control.headless import run_headless
     from multilift_sim.wire.tick_messages import SimulatorMessages
     kernels.prune_cache()  # the folders of older sources
     for short in (_short('twin_lift'), _short('circle3'), _short('twin_lift', 'slack')):
         run_headless(short)
-        Engine(short).step(5)
     events = _every_kind()
     run = run_headless(events)
     SimulatorMessages(events).state(run.simulator.snapshot(), [0.0] * 3, None)
     rigid = _short('box_lift')
     SimulatorMessages(rigid).state(run_headless(rigid).simulator.snapshot(), [0.0] * 3, None)
-    obstacles = _short('window')  # its load measures the start's clearances (world:)
-    run_headless(obstacles)
-    Engine(obstacles).step(5)
+    run_headless(_short('window'))  # its load measures the start's clearances (world:)
 
 
 STAGES = {'advance': advance, 'measure': measure, 'laws': laws, 'engine_start': engine_start,

@@ -179,6 +179,51 @@ def _uncompiled(function: Callable, done: dict[int, Callable]) -> Callable:
     return copy
 
 
+def _compile_in_turn() -> None:
+    """One process at a time compiles a cached kernel: numba's `Dispatcher.compile` (which
+    loads a signature from the on-disk cache, or compiles and saves it) runs holding an
+    exclusive lock (`fcntl.flock`) on a file beside the kernel's cache index. A kernel
+    scripts/setup left to its first use (the engine's, the learning calls') asked for by
+    several processes at once (pytest-xdist workers, a run's nodes) is compiled by the first;
+    the others wait and load what it saved, instead of each compiling it (numba's cache is
+    safe to share, writes replace whole files, but every process would pay the compile). The
+    locks follow the call graph (a kernel's compile takes its callees' locks inside its own),
+    which has no cycles, so no two processes wait for each other; a lock a process already
+    holds (a recursive call's other signature) is not taken again; the system releases the
+    locks of a process that dies."""
+    import fcntl
+
+    from numba.core import dispatcher
+    from numba.core.compiler_lock import global_compiler_lock
+    if getattr(dispatcher.Dispatcher.compile, 'in_turn', False):
+        return
+    compile_signature = dispatcher.Dispatcher.compile
+    held: set[str] = set()
+
+    def compile_in_turn(self, sig):
+        index = getattr(getattr(self._cache, '_cache_file', None), '_index_path', None)
+        if index is None:  # not cached (NullCache)
+            return compile_signature(self, sig)
+        with global_compiler_lock:  # numba's own lock first: this process's threads in turn
+            if index in held:
+                return compile_signature(self, sig)
+            try:
+                lock = open(f'{index}.lock', 'a')
+            except OSError:  # a folder this process cannot write: numba's cache as it is
+                return compile_signature(self, sig)
+            with lock:
+                fcntl.flock(lock, fcntl.LOCK_EX)
+                held.add(index)
+                try:
+                    return compile_signature(self, sig)
+                finally:
+                    held.discard(index)
+                    fcntl.flock(lock, fcntl.LOCK_UN)
+
+    compile_in_turn.in_turn = True
+    dispatcher.Dispatcher.compile = compile_in_turn
+
+
 def _import_numba_quietly() -> None:
     """Import numba's array implementations without scipy or coverage. Loading even a cached
     kernel imports numba.np.arraymath, whose import imports scipy.linalg only to learn whether
@@ -195,3 +240,4 @@ def _import_numba_quietly() -> None:
         for name in hidden:
             if sys.modules.get(name, False) is None:
                 del sys.modules[name]
+    _compile_in_turn()

@@ -88,6 +88,7 @@ class PolicyNode(Node):
                             f'observations to {self.policy.action_size} actions; {name} '
                             f'({task}) has {size} and {self.batch.action_size}')
         self.batch.reset()
+        self.compile_answer(formation_batch([name], task, None, options))
         scenario = self.batch.scenarios[0]
         n = self.batch.n
         self.period_ns = int(self.batch.engine.arrays.period_ns[0])
@@ -105,6 +106,24 @@ class PolicyNode(Node):
         self.answered = 0
         self.pending: bytes | None = None   # a snapshot waiting for its tick's tension
         self.tension_ns = -1                # the stamp of the tension held [ns]
+
+    def compile_answer(self, batch) -> None:
+        """The compiled calls of `answer` made once, on `batch` (a throwaway batch of the same
+        scenario), before the node joins the graph: the engine's and the learning calls'
+        kernels, which scripts/setup leaves to their first use, compile here (tens of seconds
+        on a cold cache, a fraction of one from the cache), not at the first snapshot, which
+        the simulator waits for `command_timeout` (5 s) only. The policy itself is not called
+        (a user's callable may note what it sees)."""
+        batch.reset()
+        measured = np.array(batch.engine.measured())
+        if self.policy is None:
+            batch.engine.answer(measured)
+            return
+        state = batch.engine.state
+        batch.observation_of(measured, np.array(batch.layout.payload_position(state)),
+                             np.array(batch.layout.payload_velocity(state)),
+                             np.zeros((1, batch.n)), np.zeros(1))
+        batch.speeds(np.zeros((1, batch.action_size)), measured)
 
     def missing_peers(self) -> str | None:
         for pub in self.cmd_pubs:

@@ -90,6 +90,16 @@ class MultirotorParams:
         total = self.thrust_coefficient * np.add.reduce(speeds * speeds, axis=-1)
         return float(total) if total.ndim == 0 else total
 
+    def thrust_margin(self, rotor_speeds: ArrayLike) -> float | np.ndarray:
+        """1 - u_T / u_T,max = 1 - sum_k omega_k^2 / (n_r omega_max^2): the share of the
+        largest thrust that rotor speeds [rad/s] leave (issue 35; every rotor counted fully
+        effective); rotor_speeds (..., n_r) gives shape (...)."""
+        speeds = np.asarray(rotor_speeds, dtype=float)
+        share = np.add.reduce(speeds * speeds, axis=-1) / (self.n_rotors
+                                                           * self.rotor_speed_max ** 2)
+        margin = 1.0 - share
+        return float(margin) if margin.ndim == 0 else margin
+
     @property
     def max_thrust(self) -> float:
         """Total thrust with every rotor at rotor_speed_max [N]: ``n_r k_T omega_max^2``."""

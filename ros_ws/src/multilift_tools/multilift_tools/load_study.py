@@ -62,9 +62,7 @@ def thrust_margins(speeds: np.ndarray, scenario: scenario_io.Scenario) -> np.nda
     rotor speeds (T, n, rotors) [rad/s] (every rotor fully effective; N its rotor count)."""
     out = np.empty(speeds.shape[:2])
     for i, uav in enumerate(scenario.uavs):
-        rotors = uav.vehicle.n_rotors
-        out[:, i] = 1.0 - (np.sum(speeds[:, i, :rotors] ** 2, axis=1)
-                           / (rotors * uav.vehicle.rotor_speed_max ** 2))
+        out[:, i] = uav.vehicle.thrust_margin(speeds[:, i, :uav.vehicle.n_rotors])
     return out
 
 

@@ -61,8 +61,7 @@ class SimulatorMessages:
                          for i in scenario.winches]
         # each UAV's thrust margin (/uav{i}/thrust_margin), in a reorganising formation: its
         # topic, its packer, its rotors' largest sum of squared speeds N omega_max^2 [rad^2/s^2]
-        self._margins = [(uav_topic(i, THRUST_MARGIN), cdr.Float64(),
-                          u.vehicle.n_rotors * u.vehicle.rotor_speed_max ** 2)
+        self._margins = [(uav_topic(i, THRUST_MARGIN), cdr.Float64(), u.vehicle)
                          for i, u in enumerate(scenario.uavs, start=1)] \
             if margin_topics(scenario) else []
         self._payload = cdr.Odometry(PAYLOAD_FRAME)
@@ -182,11 +181,8 @@ class SimulatorMessages:
         out: list[Message] = []
         if rotor_speeds is None:  # no command yet
             return out
-        for (topic, packer, largest), speeds in zip(self._margins, rotor_speeds):
-            squares = 0.0
-            for omega in speeds:
-                squares += float(omega) * float(omega)
-            out.append((topic, packer.pack(1.0 - squares / largest)))
+        for (topic, packer, vehicle), speeds in zip(self._margins, rotor_speeds):
+            out.append((topic, packer.pack(vehicle.thrust_margin(speeds))))
         return out
 
     def markers(self, snap: Snapshot, tension: np.ndarray, taut: np.ndarray) -> Message:

@@ -133,8 +133,7 @@ def fig_thrust_margins(ctx: Context) -> Figure:
         vehicle = vehicle_of(ctx, i)
         if vehicle is None or not run.has(uav_topic(i, ROTOR_CMD)):
             continue
-        margin = 100.0 * (1.0 - vehicle.collective_thrust(run.rotor_speeds(i))
-                          / vehicle.max_thrust)
+        margin = 100.0 * vehicle.thrust_margin(run.rotor_speeds(i))
         ax.plot(run.rotor_time(i), margin, color=uav_color(i), lw=uav_width(i),
                 label=f'{uav_label(i)}: least {margin.min():.1f} %')
     ax.axhline(0.0, color='tab:red', lw=1.0, ls='-.',

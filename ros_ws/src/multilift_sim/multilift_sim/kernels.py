@@ -71,6 +71,7 @@ os.environ.setdefault('NUMBA_CACHE_DIR', str(CACHE_ROOT / _sources_digest()))
 CACHE_DIR = Path(os.environ['NUMBA_CACHE_DIR'])  # as this process found it (a test may restore
 #                                                 the environment after the import)
 
+PLAIN_COUNTS = 'MULTILIFT_PLAIN_REFCOUNTS'  # 1: plain reference counts (`plain_reference_counts`)
 VARIABLE = 'MULTILIFT_KERNEL'  # auto (or unset), jit or python: see the docstring
 PHYSICS = 'multilift_sim.physics.formation_dae'  # the physics' compiled module (the DAE)
 MODES = ('auto', 'jit', 'python')
@@ -224,6 +225,42 @@ def _compile_in_turn() -> None:
     dispatcher.Dispatcher.compile = compile_in_turn
 
 
+def plain_reference_counts() -> bool:
+    """Whether this process counts the kernels' arrays' references with plain adds, not atomic
+    ones: where MULTILIFT_PLAIN_REFCOUNTS is 1 when numba's runtime (NRT) is built (the
+    process's first kernel loaded or compiled), which our commands (`multilift`) and nodes set
+    for themselves and the processes they start. NRT counts every array's references with a
+    locked add (`lock incq`), thread-safe and slow; a tick passes the batch's tuples of arrays
+    through its calls, so those counts took over a third of a twin-lift tick here (perf:
+    NRT_incref and NRT_decref; `python benchmarks/refcounts.py`). Plain counts are exact while
+    no two threads run compiled code on the same arrays at once: our processes run kernels from
+    one thread (single-threaded executors, process pools); a library user's process (which may
+    share arrays between threads, numba's `parallel=True`) keeps numba's default. NRT builds
+    its add and sub from `nrtdynmod._define_atomic_inc_dec`, which this replaces by
+    `_plain_add_sub`: a deliberate use of a private name, as `_compile_in_turn`."""
+    from numba.core.runtime import nrt, nrtdynmod
+    if os.environ.get(PLAIN_COUNTS) == '1' and not nrt.rtsys._init:
+        nrtdynmod._define_atomic_inc_dec = _plain_add_sub
+    return nrtdynmod._define_atomic_inc_dec is _plain_add_sub
+
+
+def _plain_add_sub(module, op: str, ordering: str):
+    """NRT's reference count add or sub (`op`) into the LLVM `module`, as numba's
+    `nrtdynmod._define_atomic_inc_dec` defines it (`nrt_atomic_<op>`, returning the new count)
+    with a plain load, add and store (the `ordering` unused). numba's own switch,
+    `_disable_atomicity`, is not used: it returns the old count, so nothing is ever freed
+    (measured: NRT's frees stayed at 4 of 5.3 million allocations)."""
+    from numba.core.runtime.nrtdynmod import _word_type, ir  # llvmlite's ir, as numba's
+    function = ir.Function(module, ir.FunctionType(_word_type, [_word_type.as_pointer()]),
+                           name=f'nrt_atomic_{op}')
+    [count] = function.args
+    builder = ir.IRBuilder(function.append_basic_block())
+    new = getattr(builder, op)(builder.load(count), ir.Constant(_word_type, 1))
+    builder.store(new, count)
+    builder.ret(new)
+    return function
+
+
 def _import_numba_quietly() -> None:
     """Import numba's array implementations without scipy or coverage. Loading even a cached
     kernel imports numba.np.arraymath, whose import imports scipy.linalg only to learn whether
@@ -241,3 +278,4 @@ def _import_numba_quietly() -> None:
             if sys.modules.get(name, False) is None:
                 del sys.modules[name]
     _compile_in_turn()
+    plain_reference_counts()

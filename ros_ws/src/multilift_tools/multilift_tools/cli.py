@@ -15,9 +15,11 @@ Exit codes: 0 done, 1 the run failed, 2 bad input, 130 interrupted.
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 
+from multilift_sim.kernels import PLAIN_COUNTS
 from multilift_sim.ros.fastdds import LIVE_VIEW_ANNOUNCEMENT, use_fastdds_profile
 from multilift_tools.run_command import cmd_run
 
@@ -116,6 +118,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    # plain reference counts for this command's kernels and the processes it starts (nodes,
+    # sweep workers): each runs its kernels from one thread (kernels.plain_reference_counts)
+    os.environ.setdefault(PLAIN_COUNTS, '1')
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `multilift bag info B | head` ends quietly
     # our Fast DDS profile for every subcommand's participants and the nodes `run` starts
     use_fastdds_profile(LIVE_VIEW_ANNOUNCEMENT if argv[:1] == ['foxglove'] else None)

@@ -106,7 +106,8 @@ def stop_quaternion(a, m, b, body):
         m.state[b], uav_attitude_slot(n, body) if body < n else attitude_slot(n))
 
 
-@jit
+@jit(inline=True)  # into advance and start: a call passing the batch's tuples counts every array's
+# reference in and out (`kernels.plain_reference_counts`)
 def check(a, m, b):
     """Algorithm 1, lines 10-13, at formation b's current state (its g, g_dot), the run's
     figures accumulated (`statistics.accumulators.run_check`, then the gust at the payload):
@@ -138,7 +139,7 @@ def check(a, m, b):
             m.g_dot[b, cable])
 
 
-@jit
+@jit(inline=True)  # into advance and start, as check
 def clearance_check(a, m, b):
     """The clearances of formation b's current state (`physics.clearance.measure`) where its
     world is checked (WORLD_CHECKED: a `world:` section or vehicle.radius; else nothing, not
@@ -242,7 +243,7 @@ def start(a, m, which):
             m.status[b] = STATUS_FINISHED
 
 
-@jit
+@jit(inline=True)  # into its callers (the engine's tick, measure_all), as check
 def measure(a, m, b, states):
     """What formation b's controllers receive of its UAVs at its current tick, into states
     (n, MEASURED_COLUMNS): the measured states (seed Eq. 2.7), with `sensors:` as its sensor

@@ -7,6 +7,9 @@ whole episodes of each task, twin-lift and V, and what a tick pays the baseline,
 (action 0) and random actions (`reference_rewards`).
 
     python benchmarks/learning.py [--envs 256] [--steps 2000] [--rewards-only]
+    MULTILIFT_PLAIN_REFCOUNTS=1 python benchmarks/learning.py ...   (plain reference counts,
+    `multilift_sim.kernels.plain_reference_counts`: what a process that runs the environments
+    from one thread may choose; the figures say which counts they had)
 """
 from __future__ import annotations
 
@@ -16,7 +19,7 @@ import time
 
 os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
 
-from multilift_sim import kernels  # noqa: E402,F401 - NUMBA_CACHE_DIR before numba loads
+from multilift_sim import kernels  # noqa: E402 - NUMBA_CACHE_DIR before numba loads
 
 import gymnasium  # noqa: E402
 import numpy as np  # noqa: E402
@@ -52,7 +55,8 @@ def main() -> None:
                          ('baseline policy (expert_actions)', envs.expert_actions)):
         wall, cpu = throughput(envs, args.steps, policy)
         print(f'Hover-v0 twin_lift, {args.envs} envs, {name}: {wall:,.0f} env steps/s wall, '
-              f'{cpu:,.0f} per CPU s (target >= 50,000)')
+              f'{cpu:,.0f} per CPU s (target >= 50,000; '
+              f'{"plain" if kernels.plain_reference_counts() else "atomic"} reference counts)')
     baseline_returns()
     reference_rewards()
 

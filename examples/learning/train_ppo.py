@@ -22,6 +22,9 @@ import time
 from pathlib import Path
 
 os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
+# plain reference counts (multilift_sim.kernels.plain_reference_counts): this process steps the
+# environments from one thread and runs no parallel numba code of its own
+os.environ.setdefault('MULTILIFT_PLAIN_REFCOUNTS', '1')
 
 from multilift_sim import kernels  # noqa: E402,F401 - NUMBA_CACHE_DIR before numba loads
 

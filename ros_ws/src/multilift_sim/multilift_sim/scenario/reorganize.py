@@ -37,8 +37,6 @@ def parse(f: Section, n: int, geometry: str) -> dict[str, Any]:
     kind = f.text('reorganize', 'none', choices=REORGANIZE)
     if kind != 'none' and n < 2:
         raise f.fail('reorganize', kind, 'needs a formation of two UAVs or more (n = 1)')
-    if kind == 'cable_forces' and n != 3:
-        raise f.fail('reorganize', kind, f'allocates three cables in closed form, not {n}')
     if kind != 'none' and geometry not in ('v', 'linear'):
         raise f.fail('reorganize', kind, f'moves linear or V offsets, not a {geometry!r} '
                                          'formation')

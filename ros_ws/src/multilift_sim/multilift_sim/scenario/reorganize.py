@@ -3,8 +3,9 @@ multilift_control's follower `thrust_margin`, `laws.reorganize`), read and check
 
 - `formation.reorganize`: `none` (the seed's fixed geometry, the default), `thrust_margin`
   (the followers' horizontal offsets move online so that the UAVs' thrust margins stay even,
-  or above the floor) or `cable_forces` (they move where the cables carry the shares that give
-  every UAV the same share of its largest thrust: three UAVs) or `heading` (they turn about
+  or above the floor) or `cable_forces` (they move where the cables carry the shares that
+  give the UAVs the least largest share of their largest thrust, by the statics of Eq. 2.73:
+  any n >= 2, a point payload; n = 2's follower also changes height) or `heading` (they turn about
   the leader with its heading: its yaw from its start, as a mission's yaw turns it; issue 34,
   the `window` scenario); needs a linear or V formation of two UAVs or more;
 - `formation.min_spacing` [m] (default 1.0): the least horizontal distance between two UAVs;

@@ -103,8 +103,10 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
     (`laws.follower.loaded_terms`) where a point payload's statics hold (REORGANIZE_AT_REST:
     the formation started at rest; a rigid body's cables do not meet at a point: none); the
     statics solved once (`hover_statics`, or `laws.cable_forces.allocated_statics`: the
-    allocation's tensions where four cables or more leave them open); returns the collective
-    thrust asked [N]."""
+    allocation's tensions where four cables or more leave them open); in REORGANIZE_ALLOCATE
+    mode its altitude loop's offset from the leader follows the height allocated (the seed's
+    altitude loop holds z_1 + FOLLOWER_ALTITUDE_OFFSET whatever its z row asks); returns the
+    collective thrust asked [N]."""
     allocating = constants[slots.REORGANIZE_MODE] == slots.REORGANIZE_ALLOCATE
     if allocating:
         kept = allocate(constants, memory, t, masses, rows, targets, vectors)
@@ -115,6 +117,9 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
                               else hover_statics(constants, places))  # once a tick
     trimmed = constants.copy()
     trimmed[slots.FOLLOWER_HOVER_MASS] = hover_mass(constants, tensions, units, found, index)
+    if allocating:  # its altitude loop flies the height allocated (n = 2, a tilted plane)
+        trimmed[slots.FOLLOWER_ALTITUDE_OFFSET] += places[index, 2] - target_places(
+            rows, targets, np.zeros(kept.shape[0]), vectors.shape[0])[index, 2]
     pulls = (static_pulls(constants, tensions, units, found, masses)
              if constants[slots.REORGANIZE_AT_REST] else np.zeros((vectors.shape[0], 3)))
     loaded = loaded_terms(trimmed, masses, rows, kept, states, vectors, pulls)

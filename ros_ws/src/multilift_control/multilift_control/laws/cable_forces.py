@@ -3,7 +3,9 @@ cables of a point payload: each tick the share of the payload's apparent weight 
 should carry so that the largest thrust utilisation of the UAVs is least (`load_shares`,
 closed form), the places where the cables pull those shares by the statics of seed Eq. 2.73
 (`allocated_places`: the horizontal balance sum_i T_i,horizontal = 0, the directions nearest
-the current ones for n >= 3, the heights for n = 2), and the followers' step towards them
+the current ones for n >= 3, the heights for n = 2; in the frame where the apparent gravity
+g e_z + a is vertical, the formation tilted as one body), the tensions nearest those shares
+that the followers feed forward (`allocated_statics`), and the followers' step towards them
 (`allocate`), rate limited and within the spacing and spread limits of `laws.reorganize`
 (whose statics, apparent gravity and memory it shares: constants FOLLOWER_* then REORGANIZE_*,
 memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT).
@@ -201,10 +203,10 @@ def allocated_places(constants, effective, places):
 @jit
 def level_places(constants, gravity, places):
     """(places (n, 3) [m] relative to the leader, found) under a vertical apparent gravity of
-    `gravity` [m/s^2]: where the cables carry
-    `load_shares` by the statics (module docstring), near the current `places` (n, 3) [m].
-    n >= 3: level UAVs, each at r_i = sqrt(l_i^2 - H^2) from the point above the payload (H
-    the start's depth, REORGANIZE_DEPTH), in directions with sum_i s_i (r_i / H) u_i = 0
+    `gravity` [m/s^2]: where the cables carry `load_shares` by the statics (module
+    docstring), near the current `places` (n, 3) [m]. n >= 3: level UAVs, each at
+    r_i = sqrt(l_i^2 - H^2) from the point above the payload (H the start's depth,
+    REORGANIZE_DEPTH), in directions with sum_i s_i (r_i / H) u_i = 0
     turned little from the current ones (seen from where the payload hangs below them,
     `balanced_directions`): there the tensions T_i = s_i W l_i / H balance the payload
     (`allocated_statics`; n = 3 the only ones, n >= 4 one of many). n = 2: the follower on

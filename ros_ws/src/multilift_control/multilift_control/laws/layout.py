@@ -122,8 +122,8 @@ REORGANIZE_MAX_RATE = FOLLOWER_SIZE + 3       # largest speed of a follower's of
 REORGANIZE_FLOOR = FOLLOWER_SIZE + 4          # thrust margin floor [-]
 REORGANIZE_GAIN = FOLLOWER_SIZE + 5           # offset rate per unit of cost gradient [m^2/s]
 REORGANIZE_FILTER_TIME = FOLLOWER_SIZE + 6    # the apparent gravity's low-pass time [s]
-REORGANIZE_RADIUS = FOLLOWER_SIZE + 7         # cable_forces: the UAVs' horizontal distance
-#                                               from the payload at the start [m]
+REORGANIZE_DEPTH = FOLLOWER_SIZE + 7          # cable_forces: the payload's depth below its
+#                                               level UAVs at the start [m]
 REORGANIZE_MODE = FOLLOWER_SIZE + 8           # REORGANIZE_GRADIENT or REORGANIZE_ALLOCATE
 REORGANIZE_AT_REST = FOLLOWER_SIZE + 9        # 1: a point payload's statics in the law
 #                                               (laws.reorganize.static_pulls), 0: none

@@ -183,32 +183,31 @@ def hover_statics(constants, places):
 
 
 @jit
-def hover_mass(constants, places, index):
-    """The mass [kg] whose weight UAV `index`'s thrust carries at hover with the UAVs at
-    `places` (n, 3) [m]: m_i + T_i e_i,z / g, its own and its cable's vertical pull by the
-    statics of Eq. 2.73 (`hover_statics`). The feedforward of the geometry flown: the seed's
+def hover_mass(constants, tensions, units, found, index):
+    """The mass [kg] whose weight UAV `index`'s thrust carries at hover with the statics of
+    the places flown (tensions T (n,) [N], units e (n, 3), found: as `hover_statics` returns
+    them, solved once a tick for this and `static_pulls`): m_i + T_i e_i,z / g, its own and
+    its cable's vertical pull by Eq. 2.73. The feedforward of the geometry flown: the seed's
     m_i + m_p / n is its even share, which a reorganised formation does not carry (v3_mixed:
     UAV 3 0.09 kg of the payload at its start places, where the even share is 0.27 kg). The
-    even share where the payload cannot hang."""
-    n = places.shape[0]
+    even share where the payload cannot hang (found False)."""
+    n = tensions.shape[0]
     own = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * index + REORGANIZE_UAV_MASS]
-    tensions, units, found = hover_statics(constants, places)
     if not found:
         return own + constants[REORGANIZE_PAYLOAD_MASS] / n
     return own + tensions[index] * units[index, 2] / constants[FOLLOWER_GRAVITY]
 
 
 @jit
-def static_pulls(constants, places, masses):
+def static_pulls(constants, tensions, units, found, masses):
     """Each UAV's static load beyond its hover mass's weight (n, 3) [N], world: T_j e_j -
-    (M_j - m_j) g e_z with the UAVs at `places` (n, 3) [m] (`hover_statics`; M_j = masses[j],
-    the law's hover mass m_j + m_p / n), what its thrust spends at rest on its cable beyond
-    the even share the seed's law feeds forward (`follower.loaded_terms`): zero for an even
-    V, the horizontal pull of a tilted UAV's cable in any other. Zeros where the payload
-    cannot hang (the seed's law)."""
-    n = places.shape[0]
+    (M_j - m_j) g e_z with the statics of the places flown (tensions, units, found as
+    `hover_statics` returns them; M_j = masses[j], the law's hover mass m_j + m_p / n), what
+    its thrust spends at rest on its cable beyond the even share the seed's law feeds forward
+    (`follower.loaded_terms`): zero for an even V, the horizontal pull of a tilted UAV's cable
+    in any other. Zeros where the payload cannot hang (found False: the seed's law)."""
+    n = tensions.shape[0]
     pulls = np.zeros((n, 3))
-    tensions, units, found = hover_statics(constants, places)
     if not found:
         return pulls
     gravity = constants[FOLLOWER_GRAVITY]
@@ -297,15 +296,23 @@ def _begin(constants, memory, t, masses, rows, targets, vectors):
 
 
 @jit
-def _kept(rows, targets, shift, constants, effective, places, moved):
-    """Take `moved` (the shift of its x, y rows) when it keeps the limits and the statics;
-    returns targets + shift (m,)."""
+def statics_hold(constants, places, effective):
+    """Whether the payload hangs from the UAVs at `places` (n, 3) [m] under the apparent
+    gravity `effective` [m/s^2] with every cable's least-norm tension at least
+    LEAST_TENSION_SHARE of its even share (`static_margins` finite)."""
+    return math.isfinite(margin_cost(static_margins(constants, places, effective), 0.0))
+
+
+@jit
+def _kept(rows, targets, shift, constants, moved, axes, accepted):
+    """Take `moved` (the shift of its rows of the first `axes` axes: 2 x, y; 3 also z) when
+    the statics `accepted` it and it keeps the spacing and spread limits; returns
+    targets + shift (m,)."""
     m = rows.shape[0]
-    if within_limits(moved, constants[REORGANIZE_MIN_SPACING],
-                     constants[REORGANIZE_MAX_SPREAD]) \
-            and math.isfinite(margin_cost(static_margins(constants, moved, effective), 0.0)):
+    if accepted and within_limits(moved, constants[REORGANIZE_MIN_SPACING],
+                                  constants[REORGANIZE_MAX_SPREAD]):
         for k in range(m):
-            if rows[k, ROW_FIRST] == 0 and 0 <= rows[k, ROW_AXIS] < 2:
+            if rows[k, ROW_FIRST] == 0 and 0 <= rows[k, ROW_AXIS] < axes:
                 shift[k] = -moved[rows[k, ROW_SECOND], rows[k, ROW_AXIS]] - targets[k]
     kept = np.empty(m)
     for k in range(m):
@@ -343,4 +350,5 @@ def reorganize(constants, memory, t, masses, rows, targets, vectors):
             moved[j, d] += scale * rate[d] * dt
     if dt == 0.0:
         moved = places
-    return _kept(rows, targets, shift, constants, effective, places, moved)
+    return _kept(rows, targets, shift, constants, moved, 2,
+                 statics_hold(constants, moved, effective))

@@ -3,8 +3,9 @@ multilift_control's follower `thrust_margin`, `laws.reorganize`), read and check
 
 - `formation.reorganize`: `none` (the seed's fixed geometry, the default), `thrust_margin`
   (the followers' horizontal offsets move online so that the UAVs' thrust margins stay even,
-  or above the floor) or `cable_forces` (they move where the cables carry the shares that give
-  every UAV the same share of its largest thrust: three UAVs) or `heading` (they turn about
+  or above the floor) or `cable_forces` (they move where the cables carry the shares that
+  give the UAVs the least largest share of their largest thrust, by the statics of Eq. 2.73:
+  any n >= 2, a point payload; n = 2's follower also changes height) or `heading` (they turn about
   the leader with its heading: its yaw from its start, as a mission's yaw turns it; issue 34,
   the `window` scenario); needs a linear or V formation of two UAVs or more;
 - `formation.min_spacing` [m] (default 1.0): the least horizontal distance between two UAVs;
@@ -37,8 +38,6 @@ def parse(f: Section, n: int, geometry: str) -> dict[str, Any]:
     kind = f.text('reorganize', 'none', choices=REORGANIZE)
     if kind != 'none' and n < 2:
         raise f.fail('reorganize', kind, 'needs a formation of two UAVs or more (n = 1)')
-    if kind == 'cable_forces' and n != 3:
-        raise f.fail('reorganize', kind, f'allocates three cables in closed form, not {n}')
     if kind != 'none' and geometry not in ('v', 'linear'):
         raise f.fail('reorganize', kind, f'moves linear or V offsets, not a {geometry!r} '
                                          'formation')

@@ -28,10 +28,10 @@ from multilift_control.controllers.followers import virtual_constraints
 from multilift_control.formation import FormationFollower
 from multilift_control.laws import jit
 from multilift_control.laws import layout as slots
-from multilift_control.laws.cable_forces import allocate
+from multilift_control.laws.cable_forces import allocate, allocated_statics
 from multilift_control.laws.follower import loaded_terms
-from multilift_control.laws.reorganize import (hover_mass, reorganize, static_pulls,
-                                              target_places)
+from multilift_control.laws.reorganize import (hover_mass, hover_statics, reorganize,
+                                              static_pulls, target_places)
 from multilift_sim.scenario import Scenario
 from multilift_sim.scenario.reorganize import starts_at_rest
 from multilift_sim.start import formation_start
@@ -60,7 +60,7 @@ def mode_arrays(scenario: Scenario, index: int, mode: float
     own[slots.REORGANIZE_GAIN] = GAIN
     own[slots.REORGANIZE_FILTER_TIME] = FILTER_TIME
     uavs, payload = formation_start(scenario)  # where the formation hangs at the start
-    own[slots.REORGANIZE_RADIUS] = float(np.mean(np.hypot(*(uavs[:, :2] - payload[:2]).T)))
+    own[slots.REORGANIZE_DEPTH] = float(np.mean(uavs[:, 2]) - payload[2])  # a level start
     own[slots.REORGANIZE_MODE] = mode
     own[slots.REORGANIZE_AT_REST] = float(starts_at_rest(scenario))
     for j, uav in enumerate(scenario.uavs):
@@ -101,17 +101,27 @@ def answer(constants, memory, cascade, mixer, index, t, states, vectors, masses,
     errors and rates) with the statics of the places flown in its law: the altitude loop
     feeds forward `hover_mass`, Eq. 3.9's f holds each UAV's `static_pulls`
     (`laws.follower.loaded_terms`) where a point payload's statics hold (REORGANIZE_AT_REST:
-    the formation started at rest; a rigid body's cables do not meet at a point: none);
-    returns the collective thrust asked [N]."""
-    if constants[slots.REORGANIZE_MODE] == slots.REORGANIZE_ALLOCATE:
+    the formation started at rest; a rigid body's cables do not meet at a point: none); the
+    statics solved once (`hover_statics`, or `laws.cable_forces.allocated_statics`: the
+    allocation's tensions where four cables or more leave them open); in REORGANIZE_ALLOCATE
+    mode its altitude loop's offset from the leader follows the height allocated (the seed's
+    altitude loop holds z_1 + FOLLOWER_ALTITUDE_OFFSET whatever its z row asks); returns the
+    collective thrust asked [N]."""
+    allocating = constants[slots.REORGANIZE_MODE] == slots.REORGANIZE_ALLOCATE
+    if allocating:
         kept = allocate(constants, memory, t, masses, rows, targets, vectors)
     else:
         kept = reorganize(constants, memory, t, masses, rows, targets, vectors)
     places = target_places(rows, kept, np.zeros(kept.shape[0]), vectors.shape[0])
+    tensions, units, found = (allocated_statics(constants, places) if allocating
+                              else hover_statics(constants, places))  # once a tick
     trimmed = constants.copy()
-    trimmed[slots.FOLLOWER_HOVER_MASS] = hover_mass(constants, places, index)
-    pulls = (static_pulls(constants, places, masses) if constants[slots.REORGANIZE_AT_REST]
-             else np.zeros((vectors.shape[0], 3)))
+    trimmed[slots.FOLLOWER_HOVER_MASS] = hover_mass(constants, tensions, units, found, index)
+    if allocating:  # its altitude loop flies the height allocated (n = 2, a tilted plane)
+        trimmed[slots.FOLLOWER_ALTITUDE_OFFSET] += places[index, 2] - target_places(
+            rows, targets, np.zeros(kept.shape[0]), vectors.shape[0])[index, 2]
+    pulls = (static_pulls(constants, tensions, units, found, masses)
+             if constants[slots.REORGANIZE_AT_REST] else np.zeros((vectors.shape[0], 3)))
     loaded = loaded_terms(trimmed, masses, rows, kept, states, vectors, pulls)
     return virtual_constraints.answer(trimmed, memory, cascade, mixer, index, t, states,
                                       vectors, masses, rows, kept, law_p, law_q, loaded, speeds,

@@ -67,7 +67,7 @@ def test_v3_box_mixed_saturates_fixed_and_carries_its_box_reorganised(tmp_path):
 @pytest.mark.parametrize('payload, formation, rule', [
     ({}, {'start_places': [[-5.149, 1.968]]}, 'must list one [x, y] per follower (2)'),
     ({}, {'start_places': [[-5.149, 1.968], [-12.0, -0.625]]}, 'outside min_spacing'),
-    ({}, {'reorganize': 'cable_forces'}, "allocates a point payload's cables"),
+    ({'attach_points': [[0.4, 0.0, 0.3]] * 2}, {}, 'attach_points'),
 ])
 def test_bad_rigid_reorganisation_input_is_one_line(tmp_path, payload, formation, rule):
     with pytest.raises(ScenarioError) as error:

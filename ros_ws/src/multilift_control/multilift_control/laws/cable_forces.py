@@ -12,10 +12,11 @@ import numpy as np
 
 from multilift_control.laws import jit
 from multilift_control.laws.layout import (REORGANIZE_MAX_RATE, REORGANIZE_PAYLOAD_MASS,
-                                           REORGANIZE_RADIUS, REORGANIZE_UAV_LARGEST,
-                                           REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
-                                           REORGANIZE_UAVS)
+                                           REORGANIZE_RADIUS, REORGANIZE_RIGID,
+                                           REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_MASS,
+                                           REORGANIZE_UAV_SIZE, REORGANIZE_UAVS)
 from multilift_control.laws.reorganize import LEAST_TENSION_SHARE, _begin, _kept
+from multilift_control.laws.rigid_allocation import body_allocated_places
 
 SHARE_MARGIN = 0.02  # every share at most 1/2 less this [-]
 REORGANIZE_COUNT = 3  # allocates three cables in closed form
@@ -78,7 +79,8 @@ def allocate(constants, memory, t, masses, rows, targets, vectors):
     each at most REORGANIZE_MAX_RATE, within the limits; returns targets + shift (m,) [m]."""
     n = vectors.shape[0]
     dt, effective, shift, places = _begin(constants, memory, t, masses, rows, targets, vectors)
-    wanted = allocated_places(constants, effective)
+    wanted = (body_allocated_places(constants, effective) if constants[REORGANIZE_RIGID]
+              else allocated_places(constants, effective))  # a rigid body: rigid_allocation
     moved = places.copy()
     for j in range(1, n):
         gap = math.sqrt((wanted[j, 0] - places[j, 0]) ** 2 + (wanted[j, 1] - places[j, 1]) ** 2)

@@ -144,8 +144,11 @@ def check_start_places(scenario) -> None:
 
 def check_payload(scenario) -> None:
     """`cable_forces` allocates a point payload's cables (its triangle of forces meets at one
-    point): a rigid-body payload is refused."""
+    point) or a rigid body's (`laws.rigid_allocation`, `rigid_start`): another body is
+    refused."""
     f = scenario.formation
-    if f is not None and f.reorganize == 'cable_forces' and scenario.payload.type == 'rigid_body':
+    if f is not None and f.reorganize == 'cable_forces' and scenario.payload.type == 'rigid_body' \
+            and not rigid_start(scenario):
         raise ScenarioError(f'{scenario.source}: formation.reorganize: \'cable_forces\' allocates '
-                            'a point payload\'s cables, not a rigid body\'s')
+                            'a point payload\'s cables or a rigid body\'s on cables that keep '
+                            'their length from the UAVs\' centres, not this one')

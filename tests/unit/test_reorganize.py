@@ -151,6 +151,7 @@ def test_every_reorganising_law_compiled_equals_its_uncompiled_run():
           places, places + 0.01)
     check(laws.hover_mass, constants, places, 2)
     check(laws.hover_statics, constants, places)
+    check(laws.cable_statics, constants, places, effective)
     check(laws.static_pulls, constants, places, masses)
     check(allocation.load_shares, constants, effective)
     check(allocation.allocated_places, constants, effective)

@@ -135,6 +135,10 @@ def test_the_rigid_statics_compiled_equal_their_uncompiled_run():
     check(reorganize.cable_statics, constants, MOVED, np.array([0.3, -0.2, G]))
     check(reorganize.static_margins, constants, MOVED, np.array([0.3, -0.2, G]))
     check(laws._level_start, MOVED, lengths, _attach(s))
+    jacobian = np.random.default_rng(5).normal(size=(9, 9))
+    check(laws._solved, jacobian, np.arange(9.0))
+    jacobian[:, 4] = 0.0  # a null direction: the SVD's minimum norm
+    check(laws._solved, jacobian, np.arange(9.0))
     check(laws._turned, np.eye(3), np.array([0.1, -0.2, 0.05]))
     check(laws._product, np.eye(3) * 2.0, np.arange(9.0).reshape(3, 3))
     check(laws._applied, np.arange(9.0).reshape(3, 3), np.array([1.0, -2.0, 0.5]))
@@ -149,3 +153,18 @@ def test_the_hover_feedforward_of_a_rigid_body_is_its_cable_s_vertical_pull():
             s.uavs[i].vehicle.mass + tensions[i] * units[i, 2] / G, rel=1e-12)
     # the vertical pulls carry the box's weight
     assert sum(tensions * units[:, 2]) == pytest.approx(s.payload.mass * G, rel=1e-9)
+
+
+def test_the_newton_step_solves_regular_and_singular_systems():
+    """Elimination on a regular system equals numpy's solve; with a zero column (a beam's spin)
+    it falls back to the minimum-norm least squares, numpy's lstsq."""
+    rng = np.random.default_rng(7)
+    matrix = rng.normal(size=(9, 9))
+    rhs = rng.normal(size=9)
+    np.testing.assert_allclose(laws._solved(matrix, rhs), np.linalg.solve(matrix, rhs),
+                               rtol=1e-10, atol=1e-12)
+    matrix[:, 4] = 0.0
+    matrix[4, :] = 0.0
+    rhs[4] = 0.0
+    np.testing.assert_allclose(laws._solved(matrix, rhs),
+                               np.linalg.lstsq(matrix, rhs, rcond=None)[0], atol=1e-10)

@@ -27,6 +27,7 @@ from multilift_control.laws.linalg import minimum_norm_solve
 
 NEWTON_STEPS = 30  # Newton steps at most (from the level start: 3 to 9 in the shipped cases)
 SETTLED = 1e-11    # a residual this share of its scale (l_i, |load|, |load| max |b_i|) is zero
+PIVOT = 1e-12      # a pivot this share of the Jacobian's largest entry is singular: the SVD
 
 
 @jit
@@ -70,6 +71,44 @@ def _turned(rotation, angle):
 
 
 @jit
+def _solved(matrix, rhs):
+    """x of the square system A x = rhs (m,): Gaussian elimination with partial pivoting, in
+    plain loops; where a pivot falls to PIVOT of A's largest entry (a beam's spin about its
+    own line moves nothing: a null direction), the least-squares, minimum-norm solution of
+    `minimum_norm_solve` (the SVD, a dozen times the work)."""
+    m = matrix.shape[0]
+    a = matrix.copy()
+    x = rhs.copy()
+    largest = 0.0
+    for i in range(m):
+        for j in range(m):
+            largest = max(largest, abs(a[i, j]))
+    for k in range(m):
+        pivot = k
+        for i in range(k + 1, m):
+            if abs(a[i, k]) > abs(a[pivot, k]):
+                pivot = i
+        if abs(a[pivot, k]) <= PIVOT * largest:
+            return minimum_norm_solve(matrix, rhs)
+        if pivot != k:
+            for j in range(m):
+                a[k, j], a[pivot, j] = a[pivot, j], a[k, j]
+            x[k], x[pivot] = x[pivot], x[k]
+        for i in range(k + 1, m):
+            factor = a[i, k] / a[k, k]
+            if factor != 0.0:
+                for j in range(k, m):
+                    a[i, j] -= factor * a[k, j]
+                x[i] -= factor * x[k]
+    for k in range(m - 1, -1, -1):
+        total = x[k]
+        for j in range(k + 1, m):
+            total -= a[k, j] * x[j]
+        x[k] = total / a[k, k]
+    return x
+
+
+@jit
 def _level_start(uavs, lengths, attach):
     """(p (3,) [m], found): the body level under the centroid of s_i - b_i, at the mean depth
     its cables reach there (formation_geometry.hanging_payload's start); found False when a
@@ -95,10 +134,10 @@ def hang_body(uavs, lengths, attach, load):
     `lengths` (n,) [m] holding it at `attach` (n, 3) [m], payload frame, under `load` [N]
     (world: the support its apparent weight asks, m_p (g e_z + a)). Newton's method on the
     n + 6 equations in (p, a small turn theta of R, lambda), from the body level
-    (`_level_start`); each step by `minimum_norm_solve` (a beam's spin about its own line moves
-    nothing: a null direction, left out). found False when a cable cannot reach the start or
-    the residual does not settle to SETTLED of its scale; lambda may come out negative (a
-    cable that would push: the caller's to refuse)."""
+    (`_level_start`); each step by `_solved` (elimination; a beam's spin about its own line
+    moves nothing: a null direction, which the SVD's minimum norm leaves out). found False
+    when a cable cannot reach the start or the residual does not settle to SETTLED of its
+    scale; lambda may come out negative (a cable that would push: the caller's to refuse)."""
     n = uavs.shape[0]
     position, found = _level_start(uavs, lengths, attach)
     rotation = np.eye(3)
@@ -150,7 +189,7 @@ def hang_body(uavs, lengths, attach, load):
         torque = math.sqrt(residual[n + 3] ** 2 + residual[n + 4] ** 2 + residual[n + 5] ** 2)
         if settled and force <= SETTLED * weight and torque <= SETTLED * weight * arm:
             return position, rotation, multipliers, True
-        step = minimum_norm_solve(jacobian, -residual)
+        step = _solved(jacobian, -residual)
         for d in range(3):
             position[d] += step[d]
         rotation = _turned(rotation, step[3:6])

@@ -73,3 +73,17 @@ def test_bad_rigid_reorganisation_input_is_one_line(tmp_path, payload, formation
     with pytest.raises(ScenarioError) as error:
         scenario_io.load(_variant(tmp_path, payload, **formation))
     assert rule in str(error.value) and '\n' not in str(error.value)
+
+
+def test_a_rigid_body_whose_level_start_is_not_at_rest_is_refused_in_one_line(tmp_path):
+    """A reorganising formation of a rigid body starts at rest (`scenario.reorganize.
+    rigid_start`): level at the geometry's places, its attach points must balance it there."""
+    data = yaml.safe_load((SCENARIOS / 'v3_box_mixed.yaml').read_text())
+    del data['formation']['start_places']
+    data['payload']['attach_points'][2] = [-0.3, -0.346410161514, 0.3]  # off the balance
+    path = tmp_path / 'unbalanced.yaml'
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ScenarioError) as error:
+        scenario_io.load(str(path))
+    assert 'the body cannot hang at rest in this attitude' in str(error.value)
+    assert '\n' not in str(error.value)

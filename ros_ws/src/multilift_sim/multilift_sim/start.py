@@ -14,6 +14,7 @@ from multilift_sim.dynamics import initial_state_single_lift
 from multilift_sim.formation_geometry import (hanging_payload, lowest_reached,
                                               nominal_positions, swing_about_uav_axis)
 from multilift_sim.formation_params import StateLayout
+from multilift_sim.rigid_hang import hanging_body
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.scenario import Scenario
 from multilift_sim.scenario.reorganize import starts_at_rest
@@ -145,8 +146,10 @@ def hanging_start(scenario: Scenario) -> np.ndarray:
         payload = swing_about_uav_axis(payload, ends[0], ends[1], scenario.payload.swing)
     euler = (start_attitudes(scenario) if starts_at_rest(scenario)
              else np.array([[0.0, 0.0, u.yaw] for u in scenario.uavs]))
-    layout = StateLayout(scenario.n_uavs, scenario.payload.type == 'rigid_body')
-    return layout.pack(uavs, euler, payload)  # a rigid payload level (the identity attitude)
+    rigid = scenario.payload.type == 'rigid_body'
+    layout = StateLayout(scenario.n_uavs, rigid)
+    return layout.pack(uavs, euler, payload,  # a rigid payload level but from start_places
+                       payload_quaternion=start_body_pose(scenario)[1] if rigid else None)
 
 
 def start_attitudes(scenario: Scenario) -> np.ndarray:
@@ -182,6 +185,8 @@ def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
         leader = np.asarray(scenario.uavs[0].position, dtype=float)
         uavs = np.tile(leader, (scenario.n_uavs, 1))
         uavs[1:, :2] += np.asarray(f.start_places, dtype=float)
+        if scenario.payload.type == 'rigid_body':  # a body tilted as it hangs there
+            return uavs, start_body_pose(scenario, uavs)[0]
         payload = lowest_reached(uavs, start_lengths(scenario), np.array([0.0, 0.0, -1.0]))
         if payload is None:
             raise ValueError('formation.start_places: the cables cannot all reach one point')
@@ -190,6 +195,18 @@ def formation_start(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
                              f.distance, f.half_angle)
     return hanging_payload(uavs, start_lengths(scenario), scenario.payload.attach_points,
                            uav_offsets(scenario))
+
+
+def start_body_pose(scenario: Scenario, uavs: np.ndarray | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """(position (3,) [m], quaternion (w, x, y, z)) of a rigid payload at t = 0: level (the
+    identity) at the geometry's places; from `formation.start_places` (UAVs `uavs` (n, 3) [m]),
+    tilted where it hangs at rest (`rigid_hang.hanging_body`, issue 35)."""
+    if uavs is None:
+        uavs, payload = formation_start(scenario)
+        if not scenario.formation.start_places:
+            return payload, np.array([1.0, 0.0, 0.0, 0.0])
+    return hanging_body(uavs, start_lengths(scenario), scenario.payload.attach_points)
 
 
 def start_lengths(scenario: Scenario) -> np.ndarray:

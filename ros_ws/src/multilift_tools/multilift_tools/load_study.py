@@ -31,7 +31,8 @@ from multilift_sim import scenario as scenario_io
 from multilift_sim.formation_params import StateLayout
 from multilift_sim.scenario import ScenarioError
 
-MISSIONS = ('twin_lift', 'multi_lift', 'v3_mixed', 'beam_lift')   # beam_lift: a rigid body
+# beam_lift and v3_box_mixed carry rigid bodies
+MISSIONS = ('twin_lift', 'multi_lift', 'v3_mixed', 'beam_lift', 'v3_box_mixed')
 MODES = ('none', 'thrust_margin', 'cable_forces')
 AFTER = 10.0   # [s] the least margins after the start (v3_mixed hovers 10 s, reorganising)
 

@@ -22,11 +22,13 @@ import numpy as np
 
 from multilift_control.laws import jit
 from multilift_control.laws.layout import (FOLLOWER_GRAVITY, REORGANIZE_DEPTH, REORGANIZE_MAX_RATE,
-                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_UAV_LARGEST,
-                                           REORGANIZE_UAV_LENGTH, REORGANIZE_UAV_MASS,
-                                           REORGANIZE_UAV_SIZE, REORGANIZE_UAVS)
+                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_RIGID,
+                                           REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_LENGTH,
+                                           REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
+                                           REORGANIZE_UAVS)
 from multilift_control.laws.reorganize import (LEAST_TENSION_SHARE, TAUT, _begin, _kept,
-                                              cable_tensions, hang_point)
+                                              cable_tensions, hang_point, statics_hold)
+from multilift_control.laws.rigid_allocation import body_allocated_places
 
 SHARE_MARGIN = 0.02  # n >= 3: every share at most 1/2 less this [-] (a polygon of forces)
 BISECTIONS = 60      # halvings of a bracket: the utilisation's, n = 2's radius [-]
@@ -263,9 +265,14 @@ def allocate(constants, memory, t, masses, rows, targets, vectors):
     [m]."""
     n = vectors.shape[0]
     dt, effective, shift, places = _begin(constants, memory, t, masses, rows, targets, vectors)
-    wanted, found = allocated_places(constants, effective, places)
-    if not found:  # the places hold
-        return _kept(rows, targets, shift, constants, places, 3, False)
+    rigid = constants[REORGANIZE_RIGID] != 0.0
+    if rigid:  # a rigid body's (laws.rigid_allocation): the places move in x, y only
+        wanted = body_allocated_places(constants, effective)
+        wanted[:, 2] = places[:, 2]
+    else:
+        wanted, found = allocated_places(constants, effective, places)
+        if not found:  # the places hold
+            return _kept(rows, targets, shift, constants, places, 3, False)
     moved = places.copy()
     step = constants[REORGANIZE_MAX_RATE] * dt
     for j in range(1, n):
@@ -276,6 +283,9 @@ def allocate(constants, memory, t, masses, rows, targets, vectors):
         scale = 1.0 if gap <= step else step / gap
         for d in range(3):
             moved[j, d] += scale * (wanted[j, d] - places[j, d])
+    if rigid:  # the rigid statics (laws.rigid_statics through reorganize.cable_statics)
+        return _kept(rows, targets, shift, constants, moved, 2,
+                     statics_hold(constants, moved, effective))
     return _kept(rows, targets, shift, constants, moved, 3,
                  tensions_hold(constants, moved, effective))
 

@@ -127,11 +127,15 @@ REORGANIZE_DEPTH = FOLLOWER_SIZE + 7          # cable_forces: the payload's dept
 REORGANIZE_MODE = FOLLOWER_SIZE + 8           # REORGANIZE_GRADIENT or REORGANIZE_ALLOCATE
 REORGANIZE_AT_REST = FOLLOWER_SIZE + 9        # 1: a point payload's statics in the law
 #                                               (laws.reorganize.static_pulls), 0: none
-REORGANIZE_UAVS = FOLLOWER_SIZE + 10          # then a row of REORGANIZE_UAV_SIZE per UAV:
+REORGANIZE_RIGID = FOLLOWER_SIZE + 10         # 1: a rigid-body payload's statics
+#                                               (laws.rigid_statics), 0: a point payload's
+REORGANIZE_UAVS = FOLLOWER_SIZE + 11          # then a row of REORGANIZE_UAV_SIZE per UAV:
 REORGANIZE_UAV_MASS = 0                       # its vehicle's mass m_i [kg]
 REORGANIZE_UAV_LARGEST = 1                    # u_T,max,i, every rotor at its limit [N]
 REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]
-REORGANIZE_UAV_SIZE = 3
+REORGANIZE_UAV_ATTACH = 3                     # (3) a rigid body: where its cable holds it,
+#                                               b_i, payload frame [m] (a point payload: 0)
+REORGANIZE_UAV_SIZE = 6
 REORGANIZE_GRADIENT = 0.0  # thrust_margin: laws.reorganize.reorganize
 REORGANIZE_ALLOCATE = 1.0  # cable_forces: laws.cable_forces.allocate
 # a follower whose offsets turn with the leader's heading (`formation.reorganize: heading`):

@@ -23,12 +23,13 @@ from multilift_control.laws.layout import (FOLLOWER_GRAVITY, FOLLOWER_LAST_T, RO
                                            REORGANIZE_FILTER_TIME, REORGANIZE_FLOOR,
                                            REORGANIZE_GAIN, REORGANIZE_MAX_RATE,
                                            REORGANIZE_MAX_SPREAD, REORGANIZE_MIN_SPACING,
-                                           REORGANIZE_PAYLOAD_MASS,
+                                           REORGANIZE_PAYLOAD_MASS, REORGANIZE_RIGID,
                                            REORGANIZE_SHIFT,
                                            REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_LENGTH,
                                            REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
                                            REORGANIZE_UAVS)
 from multilift_control.laws.linalg import minimum_norm_solve
+from multilift_control.laws.rigid_statics import body_tensions
 
 TAUT = 1e-6          # a cable within this share of its length of taut carries load [-]
 REACH = 1e-9         # a candidate this share past a cable's length still counts as reached [-]
@@ -142,15 +143,10 @@ def static_margins(constants, places, effective):
     its even share."""
     n = places.shape[0]
     size = math.sqrt(effective[0] ** 2 + effective[1] ** 2 + effective[2] ** 2)
-    lengths = np.empty(n)
-    for j in range(n):
-        lengths[j] = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j + REORGANIZE_UAV_LENGTH]
     margins = np.full(n, np.nan)
-    payload, found = hang_point(places, lengths, -effective / size)
+    tensions, units, found = cable_statics(constants, places, effective)
     if not found:
         return margins
-    load = constants[REORGANIZE_PAYLOAD_MASS] * effective
-    tensions, units = cable_tensions(places, lengths, payload, load)
     least = LEAST_TENSION_SHARE * constants[REORGANIZE_PAYLOAD_MASS] * size / n
     for j in range(n):
         if tensions[j] < least:
@@ -167,18 +163,31 @@ def static_margins(constants, places, effective):
 
 @jit
 def hover_statics(constants, places):
-    """(T (n,) [N], e (n, 3), found) of the UAVs at `places` (n, 3) [m] at hover: the payload
-    at `hang_point` under g, the least-norm tensions `cable_tensions` that carry m_p g e_z
-    (Eq. 2.73's payload rows); found False where the payload cannot hang (T zero)."""
+    """(T (n,) [N], e (n, 3), found) of the UAVs at `places` (n, 3) [m] at hover: the payload's
+    `cable_statics` under g e_z (Eq. 2.73's payload rows); found False where the payload cannot
+    hang (T zero)."""
+    return cable_statics(constants, places, np.array((0.0, 0.0, constants[FOLLOWER_GRAVITY])))
+
+
+@jit
+def cable_statics(constants, places, effective):
+    """(T (n,) [N], e (n, 3), found) of the payload hanging at rest from the UAVs at `places`
+    (n, 3) [m] under the apparent gravity `effective` = g e_z + a [m/s^2]: a point payload at
+    `hang_point` with the least-norm `cable_tensions` that carry m_p (g e_z + a), or with
+    REORGANIZE_RIGID a rigid body (`laws.rigid_statics.body_tensions`); T zero, found False
+    where it cannot hang."""
+    if constants[REORGANIZE_RIGID] != 0.0:
+        return body_tensions(constants, places, effective)
     n = places.shape[0]
     lengths = np.empty(n)
     for j in range(n):
         lengths[j] = constants[REORGANIZE_UAVS + REORGANIZE_UAV_SIZE * j + REORGANIZE_UAV_LENGTH]
-    payload, found = hang_point(places, lengths, np.array((0.0, 0.0, -1.0)))
+    size = math.sqrt(effective[0] ** 2 + effective[1] ** 2 + effective[2] ** 2)
+    payload, found = hang_point(places, lengths, -effective / size)
     if not found:
         return np.zeros(n), np.zeros((n, 3)), False
-    load = np.array((0.0, 0.0, constants[REORGANIZE_PAYLOAD_MASS] * constants[FOLLOWER_GRAVITY]))
-    tensions, units = cable_tensions(places, lengths, payload, load)
+    tensions, units = cable_tensions(places, lengths, payload,
+                                     constants[REORGANIZE_PAYLOAD_MASS] * effective)
     return tensions, units, True
 
 

@@ -17,7 +17,7 @@ from multilift_sim.constraints import cable_residuals, cable_tension
 from multilift_sim.formation_params import FormationParams, StateLayout
 from multilift_sim.kinematics import rotation_matrix
 from multilift_sim.scenario import Scenario
-from multilift_sim.start import formation_start, uav_offsets
+from multilift_sim.start import formation_start, start_body_pose, uav_offsets
 
 
 @dataclass(frozen=True)
@@ -132,10 +132,13 @@ def scenario_configuration(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
 
 def scenario_equilibrium(scenario: Scenario) -> Equilibrium:
     """The static equilibrium (Eq. 2.73) of the scenario's formation at its hanging rest,
-    UAVs at the scenario's yaw angles, a rigid payload level (the simulator's start)."""
+    UAVs at the scenario's yaw angles, a rigid payload level, or tilted as it hangs from
+    `formation.start_places` (the simulator's start, `start.start_body_pose`)."""
     uavs, payload = scenario_configuration(scenario)
+    tilted = scenario.payload.type == 'rigid_body' and scenario.n_uavs > 1
     return static_equilibrium(scenario.formation_params(0.0, 0.0), uavs, payload,
-                              [u.yaw for u in scenario.uavs])
+                              [u.yaw for u in scenario.uavs], payload_quaternion=(
+                                  start_body_pose(scenario)[1] if tilted else None))
 
 
 def payload_multipliers(params: FormationParams, offsets: np.ndarray,

@@ -116,26 +116,38 @@ def point_statics_refused(scenario) -> str | None:
 def starts_at_rest(scenario) -> bool:
     """Whether the formation starts at the static equilibrium of Eq. 2.73 with its controllers
     trimmed to it (`start.start_equilibrium`): a reorganising formation (thrust_margin,
-    cable_forces) of a point payload whose statics hold (`point_statics_refused`); every other
-    starts level (the seed's start)."""
+    cable_forces) of a point payload whose statics hold (`point_statics_refused`) or of a rigid
+    body (`rigid_start`); every other starts level (the seed's start)."""
     f = scenario.formation
     return (f is not None and f.reorganize in SPACED and scenario.n_uavs > 1
-            and point_statics_refused(scenario) is None)
+            and (point_statics_refused(scenario) is None or rigid_start(scenario)))
+
+
+def rigid_start(scenario) -> bool:
+    """A rigid body on cables that keep their length from the UAVs' centres, hung level at the
+    geometry's places or where it hangs from `start_places` (`start.start_body_pose`): what
+    the rigid statics of the law (`laws.rigid_statics`) and the start's equilibrium hold."""
+    return (scenario.payload.type == 'rigid_body' and scenario.cable_model in ('rigid', 'slack')
+            and not any(any(u.attach_point) for u in scenario.uavs))
 
 
 def check_start_places(scenario) -> None:
-    """`formation.start_places` hangs a point payload from cables that keep their length,
-    held at the UAVs' centres (the start's statics, `simulation.formation_start`)."""
+    """`formation.start_places` hangs a point payload or a rigid body (`rigid_start`) from
+    cables that keep their length, held at the UAVs' centres (the start's statics,
+    `simulation.formation_start`)."""
     why = point_statics_refused(scenario)
-    if why is not None:
+    if why is not None and not rigid_start(scenario):
         raise ScenarioError(f'{scenario.source}: formation.start_places: hangs a point payload '
                             f'on rigid or slack cables from the UAVs\' centres, not {why}')
 
 
 def check_payload(scenario) -> None:
     """`cable_forces` allocates a point payload's cables (its triangle of forces meets at one
-    point): a rigid-body payload is refused."""
+    point) or a rigid body's (`laws.rigid_allocation`, `rigid_start`): another body is
+    refused."""
     f = scenario.formation
-    if f is not None and f.reorganize == 'cable_forces' and scenario.payload.type == 'rigid_body':
+    if f is not None and f.reorganize == 'cable_forces' and scenario.payload.type == 'rigid_body' \
+            and not rigid_start(scenario):
         raise ScenarioError(f'{scenario.source}: formation.reorganize: \'cable_forces\' allocates '
-                            'a point payload\'s cables, not a rigid body\'s')
+                            'a point payload\'s cables or a rigid body\'s on cables that keep '
+                            'their length from the UAVs\' centres, not this one')

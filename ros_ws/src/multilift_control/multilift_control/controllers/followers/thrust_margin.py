@@ -63,11 +63,15 @@ def mode_arrays(scenario: Scenario, index: int, mode: float
     own[slots.REORGANIZE_DEPTH] = float(np.mean(uavs[:, 2]) - payload[2])  # a level start
     own[slots.REORGANIZE_MODE] = mode
     own[slots.REORGANIZE_AT_REST] = float(starts_at_rest(scenario))
+    rigid = scenario.payload.type == 'rigid_body'  # its statics: laws.rigid_statics
+    own[slots.REORGANIZE_RIGID] = float(rigid)
     for j, uav in enumerate(scenario.uavs):
         row = slots.REORGANIZE_UAVS + slots.REORGANIZE_UAV_SIZE * j
         own[row + slots.REORGANIZE_UAV_MASS] = uav.vehicle.mass
         own[row + slots.REORGANIZE_UAV_LARGEST] = uav.vehicle.max_thrust
         own[row + slots.REORGANIZE_UAV_LENGTH] = uav.cable_length
+        attach = slice(row + slots.REORGANIZE_UAV_ATTACH, row + slots.REORGANIZE_UAV_ATTACH + 3)
+        own[attach] = scenario.payload.attach_points[j] if rigid else (0.0, 0.0, 0.0)
     follower = FormationFollower.from_scenario(scenario, index)
     rows, targets = follower.constraints.rows, follower.constraints.targets
     extended = np.zeros(slots.REORGANIZE_SHIFT + len(targets))  # the acceleration: 0

@@ -147,9 +147,10 @@ def test_the_rigid_statics_compiled_equal_their_uncompiled_run():
 
 def test_the_hover_feedforward_of_a_rigid_body_is_its_cable_s_vertical_pull():
     s, constants = _box()
-    tensions, units, _ = reorganize.cable_statics(constants, MOVED, np.array([0.0, 0.0, G]))
+    tensions, units, found = reorganize.cable_statics(constants, MOVED, np.array([0.0, 0.0, G]))
+    assert found
     for i in range(3):
-        assert reorganize.hover_mass(constants, MOVED, i) == pytest.approx(
+        assert reorganize.hover_mass(constants, tensions, units, found, i) == pytest.approx(
             s.uavs[i].vehicle.mass + tensions[i] * units[i, 2] / G, rel=1e-12)
     # the vertical pulls carry the box's weight
     assert sum(tensions * units[:, 2]) == pytest.approx(s.payload.mass * G, rel=1e-9)

@@ -10,10 +10,9 @@ with the least effort under the thrust limits: the weighted least norm, min sum 
 with c_i = u_T,max,i - m_i |g e_z + a| (the thrust UAV i has left for its cable), f_0 = C A^T
 (A C A^T)^+ w; plus the internal force N z (A N = 0: it moves no part of the wrench) that
 spreads the cables as the formation's places did at the start: UAV i out along its attach
-point's horizontal direction u_i, its cable as steep as at the start (REORGANIZE_DEPTH, the
-UAVs' height over the body's centre: t_i = sqrt(l_i^2 - v_i^2) / v_i with v_i that depth less
-b_i's height; the horizontal part of f_i as close as least squares can bring it to
-t_i f_0,i,z u_i; the minimum-norm z leaves f_0's vertical parts as they are). Each UAV then
+point's horizontal direction u_i at REORGANIZE_RADIUS from the body's centre (the horizontal
+part of f_i as close as least squares can bring it to t_i f_0,i,z u_i, t_i the slope of a cable
+reaching that far; the minimum-norm z leaves f_0's vertical parts as they are). Each UAV then
 flies where its cable pulls its force, b_i + l_i f_i / |f_i|.
 World frame z up, SI units; places relative to the leader [m]."""
 import math
@@ -21,7 +20,7 @@ import math
 import numpy as np
 
 from multilift_control.laws import jit
-from multilift_control.laws.layout import (REORGANIZE_DEPTH, REORGANIZE_PAYLOAD_MASS,
+from multilift_control.laws.layout import (REORGANIZE_PAYLOAD_MASS, REORGANIZE_RADIUS,
                                            REORGANIZE_UAV_ATTACH, REORGANIZE_UAV_LARGEST,
                                            REORGANIZE_UAV_LENGTH, REORGANIZE_UAV_MASS,
                                            REORGANIZE_UAV_SIZE, REORGANIZE_UAVS)
@@ -98,7 +97,7 @@ def internal_forces(rows):
 def body_cable_forces(constants, effective):
     """f (n, 3) [N], world: the least-effort cable forces on the level body (module docstring)
     under the apparent gravity `effective` = g e_z + a [m/s^2], spread by internal forces as the
-    formation was at the start (REORGANIZE_DEPTH)."""
+    formation was at the start (REORGANIZE_RADIUS)."""
     n = (constants.shape[0] - REORGANIZE_UAVS) // REORGANIZE_UAV_SIZE
     weight = math.sqrt(effective[0] ** 2 + effective[1] ** 2 + effective[2] ** 2)
     attach = np.empty((n, 3))
@@ -111,10 +110,10 @@ def body_cable_forces(constants, effective):
         largest = constants[row + REORGANIZE_UAV_LARGEST]
         spare[j] = max(largest - constants[row + REORGANIZE_UAV_MASS] * weight,
                        LEAST_SPARE * largest)
-        vertical = constants[REORGANIZE_DEPTH] - attach[j, 2]  # the cable's at the start
+        out = constants[REORGANIZE_RADIUS] - math.sqrt(attach[j, 0] ** 2 + attach[j, 1] ** 2)
         length = constants[row + REORGANIZE_UAV_LENGTH]
-        if 0.0 < vertical < length:
-            slope[j] = math.sqrt(length ** 2 - vertical ** 2) / vertical
+        if 0.0 < out < length:
+            slope[j] = out / math.sqrt(length ** 2 - out ** 2)
     rows = wrench_rows(attach)
     wrench = np.zeros(6)
     for d in range(3):

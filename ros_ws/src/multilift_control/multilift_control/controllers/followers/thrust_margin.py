@@ -61,6 +61,7 @@ def mode_arrays(scenario: Scenario, index: int, mode: float
     own[slots.REORGANIZE_FILTER_TIME] = FILTER_TIME
     uavs, payload = formation_start(scenario)  # where the formation hangs at the start
     own[slots.REORGANIZE_DEPTH] = float(np.mean(uavs[:, 2]) - payload[2])  # a level start
+    own[slots.REORGANIZE_RADIUS] = float(np.mean(np.hypot(*(uavs[:, :2] - payload[:2]).T)))
     own[slots.REORGANIZE_MODE] = mode
     own[slots.REORGANIZE_AT_REST] = float(starts_at_rest(scenario))
     rigid = scenario.payload.type == 'rigid_body'  # its statics: laws.rigid_statics

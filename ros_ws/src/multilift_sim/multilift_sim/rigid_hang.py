@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import minimize
 
 
 def _rotation(vector: np.ndarray) -> np.ndarray:
@@ -58,6 +57,7 @@ def _least_potential(uavs, lengths, attach, down, position, rotation) -> np.ndar
     """(dp (3,) [m], dtheta (3,) [rad]): the turn and shift of the pose (position, rotation)
     that put the body lowest along `down` with every cable within its length: SLSQP with the
     constraints' gradients (exact at the pose, first order in dtheta)."""
+    from scipy.optimize import minimize  # here: scipy's import is 0.25 s of every start-up
     scale = float(lengths.max())
 
     def gaps(x):

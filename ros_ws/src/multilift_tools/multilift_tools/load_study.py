@@ -174,6 +174,7 @@ def _plot(rows: dict[str, dict[str, dict]], path: Path) -> None:
     margin_axes.legend(fontsize=7)
     for axes in (margin_axes, saturation_axes):
         axes.grid(True, axis='y', alpha=0.3)
+        axes.tick_params(axis='x', labelsize=8)  # five missions' names side by side
     for row, name in enumerate(names):
         axes = figure.add_subplot(grid[row, 1])
         fixed = rows[name]['none']

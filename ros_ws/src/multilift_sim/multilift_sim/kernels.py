@@ -278,4 +278,79 @@ def _import_numba_quietly() -> None:
             if sys.modules.get(name, False) is None:
                 del sys.modules[name]
     _compile_in_turn()
+    _load_without_lowering()
     plain_reference_counts()
+
+
+def _load_without_lowering() -> None:
+    """Load a cached kernel with what running it needs, not what compiling needs (start-up
+    of `run twin_lift --headless` 1.07 s to NNN, benchmarks/results.md). Two of numba's steps
+    are for compiling, and a later compile does them itself:
+    - `Cache.load_overload` refreshes the target context first: imports numba's lowering
+      (numba.cpython, numba.typed, numba.np.random, ...) and installs its registries, 0.3 s
+      here, of which loading object code needs only NRT (`rtsys.initialize`); a compile
+      refreshes anyway (numba's `CompilerBase` does), and numba.np.arraymath is imported
+      first, quietly (`_import_numba_quietly`), so a compile's code does not change.
+    - Unserialising a library of object code parses the LLVM bitcode saved beside it (for
+      linking into another library's compile) and reads its symbols into the JIT engine's
+      table (`JitEngine.is_symbol_defined`): 0.15 s for the tick's 4.5 MB. Here the bitcode is
+      kept as bytes and parsed when a compile links the library (`_get_module_for_linking`);
+      the table asks the engine, whose loaded objects hold the same symbols, then parses
+      what is pending before it answers no.
+    Private names of numba 0.68 (pinned), as `_compile_in_turn`."""
+    from numba.core import caching, codegen
+    from numba.core.runtime import nrt
+    if getattr(caching.Cache.load_overload, 'without_lowering', False):
+        return
+    library_class, engine_class = codegen.CPUCodeLibrary, codegen.JitEngine
+    unserialize = library_class._unserialize.__func__
+    module_for_linking = library_class._get_module_for_linking
+    symbol_defined = engine_class.is_symbol_defined
+
+    def load_overload(self, sig, target_context):
+        nrt.rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
+    def unserialize_unparsed(cls, codegen_, state):
+        name, kind, data = state
+        if kind != 'object':
+            return unserialize(cls, codegen_, state)
+        object_code, linking_bitcode = data
+        library = codegen_.create_library(name)
+        library.enable_object_caching()
+        library._set_compiled_object(object_code)
+        library._linking_bitcode = linking_bitcode
+        library._finalize_final_module()
+        engine = codegen_._engine
+        engine._unparsed = [*getattr(engine, '_unparsed', ()), library]
+        return library
+
+    def parse(library) -> None:
+        if getattr(library, '_linking_bitcode', None) is not None:
+            library._shared_module = codegen.ll.parse_bitcode(library._linking_bitcode)
+            library._linking_bitcode = None
+            library._codegen._engine._load_defined_symbols(library._shared_module)
+
+    def parsed_module_for_linking(library):
+        parse(library)
+        return module_for_linking(library)
+
+    def is_symbol_defined(engine, name: str) -> bool:
+        if symbol_defined(engine, name):
+            return True
+        unparsed = getattr(engine, '_unparsed', ())
+        if not unparsed:
+            return False
+        if engine._ee.get_global_value_address(name):
+            return True
+        engine._unparsed = []
+        for library in unparsed:
+            parse(library)
+        return symbol_defined(engine, name)
+
+    load_overload.without_lowering = True
+    caching.Cache.load_overload = load_overload
+    library_class._unserialize = classmethod(unserialize_unparsed)
+    library_class._get_module_for_linking = parsed_module_for_linking
+    engine_class.is_symbol_defined = is_symbol_defined

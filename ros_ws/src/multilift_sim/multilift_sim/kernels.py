@@ -283,9 +283,9 @@ def _import_numba_quietly() -> None:
 
 
 def _load_without_lowering() -> None:
-    """Load a cached kernel with what running it needs, not what compiling needs (start-up
-    of `run twin_lift --headless` 1.07 s to NNN, benchmarks/results.md). Two of numba's steps
-    are for compiling, and a later compile does them itself:
+    """Load a cached kernel with what running it needs, not what compiling needs (`run
+    twin_lift --headless` from 1.07-1.08 s to 0.72-0.77 s here, benchmarks/results.md). Two of
+    numba's steps are for compiling, and a later compile does them itself:
     - `Cache.load_overload` refreshes the target context first: imports numba's lowering
       (numba.cpython, numba.typed, numba.np.random, ...) and installs its registries, 0.3 s
       here, of which loading object code needs only NRT (`rtsys.initialize`); a compile

@@ -19,8 +19,12 @@ from multilift_sim.bag.metadata_yaml import OfferedQos
 from multilift_sim.wire.msgdefs import MessageDefinitionError, split_type_name
 
 # What the recorder asks for: our publishers are reliable + transient_local, so a recorder that
-# starts late still gets their startup messages.
-RECORD_QOS_DEPTH = 1000
+# starts late still gets their startup messages. The depth is what a reader keeps until the
+# recorder takes it: `window` publishes at 500 Hz of simulated time, several times faster than
+# real time through ROS, so 1,000 could last under a second of a starved recorder (a CI run lost
+# 2 of its /uav1/odom messages; tests/ros/test_recorder.py's burst of 6,001 kept 2,026 with
+# 1,000, all with this).
+RECORD_QOS_DEPTH = 10000
 
 
 def import_message_type(type_name: str) -> type:

@@ -8,7 +8,7 @@
   publisher is added when it appears (graph polled every 0.5 s), the user's own nodes' topics
   included, except /rosout,
   /parameter_events and hidden topics.
-- Subscriptions are raw (the CDR bytes go into the bag untouched), keep_last 1000, reliable +
+- Subscriptions are raw (the CDR bytes go into the bag untouched), keep_last 10,000, reliable +
   transient_local (our publishers are reliable + transient_local, so a recorder that starts late
   still gets their startup messages). Where publishers already offer less when the topic is
   subscribed, the request is lowered to match them, as rosbag2 does (`introspection.adapted_qos`);
@@ -73,7 +73,7 @@ DRAIN_MAX = 3.0  # [s] longest drain
 # ~0.01 ms, so a backlog is read in batches (bounded, so /clock and other topics keep their turn).
 TAKE_BATCH = 256
 ROUND_PERIOD = 0.02  # [s] between reading rounds (a round takes every message waiting)
-CLOCK_DEPTH = 1000  # /clock messages a round can find waiting
+CLOCK_DEPTH = introspection.RECORD_QOS_DEPTH  # /clock messages a round can find waiting
 HOLD_MAX = 1.0  # [s] longest a message waits for the /clock after it (its log time settled)
 HANG_REPORT = 7.0  # [s] after a stop signal: the stacks of a drain or close still running
 

@@ -8,12 +8,17 @@ import math
 
 import numpy as np
 import pytest
+import yaml
 
 from multilift_control.headless import fly
+from multilift_control.laws import runnable
+from multilift_control.laws.rigid_statics import hang_body
 from multilift_sim import scenario as scenario_io
 from multilift_sim.analysis.equilibrium import scenario_configuration
 from multilift_sim.analysis.loads import QuasiStatic, _hang, hover_loads
 from multilift_tools.loads_cli import loads_main
+
+from conftest import ROOT
 
 
 def _largest(vehicle) -> float:
@@ -98,5 +103,42 @@ def test_the_command_prints_and_writes_the_figures(tmp_path, capsys):
     assert 'least margin' in capsys.readouterr().out
     assert loads_main(['no_such_scenario']) == 2
     assert 'unknown scenario' in capsys.readouterr().err
-    assert loads_main(['box_lift']) == 0  # a rigid body: its hover, the mission refused
+    assert loads_main(['box_lift']) == 0  # a rigid body: its hover and its mission
+    assert capsys.readouterr().out.count('least margin') == 4
+    off_centre = yaml.safe_load((ROOT / 'scenarios' / 'twin_lift.yaml').read_text())
+    for uav in off_centre['uavs']:
+        uav['attach_point'] = [0.0, 0.0, -0.08]  # a UAV held off its centre would tilt
+    path = tmp_path / 'off_centre.yaml'
+    path.write_text(yaml.safe_dump(off_centre))
+    assert loads_main([str(path)]) == 0
     assert 'hover loads only' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize('name', ['beam_lift', 'box_lift', 'v3_box_mixed'])
+def test_a_rigid_body_at_rest_quasi_statically_is_its_hover(name):
+    """Two solvers of a rigid body's rest: the quasi-static one (laws.rigid_statics, Newton
+    on its rows from the body level) and the hover's (analysis.equilibrium's start pose, the
+    least potential by SLSQP where the body tilts, then Eq. 2.73's rows)."""
+    s = scenario_io.load(name)
+    hover = hover_loads(s)
+    at_rest = QuasiStatic(s, runnable(hang_body)).loads(np.zeros(3))
+    np.testing.assert_allclose(at_rest.tensions, hover.tensions, rtol=1e-9)
+    np.testing.assert_allclose(at_rest.thrusts, hover.thrusts, rtol=1e-9)
+
+
+def test_a_beam_s_cables_share_as_a_twin_lift_s():
+    """A beam held by its ends, which lie on its centre's line: across the UAVs' line the
+    whole formation swings about it and both cables carry |g e_z + a| / g of their hover
+    tension (as a point payload's, above); along it the cable ahead pulls more."""
+    s = scenario_io.load('beam_lift')
+    hover = hover_loads(s)
+    uavs, _ = scenario_configuration(s)
+    line = (uavs[1] - uavs[0]) / np.linalg.norm(uavs[1] - uavs[0])
+    statics = QuasiStatic(s, runnable(hang_body))
+    sideways = statics.loads(1.5 * np.cross([0.0, 0.0, 1.0], line))
+    factor = math.hypot(s.simulation.gravity, 1.5) / s.simulation.gravity
+    np.testing.assert_allclose(sideways.tensions, hover.tensions * factor, rtol=1e-9)
+    ahead = statics.loads(1.5 * line)
+    assert ahead.tensions[1] > hover.tensions[1] > ahead.tensions[0] > 0
+    with pytest.raises(ValueError, match='statics'):
+        QuasiStatic(s)  # a rigid body's needs its statics passed in

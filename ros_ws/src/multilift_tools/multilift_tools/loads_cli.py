@@ -2,8 +2,9 @@
 each cable's tension, each UAV's thrust and thrust margin (the share of its largest thrust
 left, 1 - u_T / u_T,max) at hover, from the statics of Eq. 2.73, and the least margin of each
 UAV over the mission's reference flown quasi-statically (multilift_sim.analysis.loads: the
-reference's acceleration and velocity, the payload hanging where they take it). The run
-summary's least thrust margin is the flown one. World frame (z up), SI units.
+reference's acceleration and velocity, the payload hanging where they take it; a rigid body at
+its rest under them, laws.rigid_statics.hang_body). The run summary's least thrust margin is
+the flown one. World frame (z up), SI units.
 Exit codes: 0 done, 2 bad scenario or argument (one `error:` line).
 """
 from __future__ import annotations
@@ -15,6 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from multilift_control.controllers import LeaderController
+from multilift_control.laws import runnable
+from multilift_control.laws.rigid_statics import hang_body
 from multilift_sim.analysis.loads import LoadShares, QuasiStatic, hover_loads
 from multilift_sim.scenario import Scenario, ScenarioError, load
 from multilift_tools.plot_style import Parser, parse_args
@@ -25,7 +28,7 @@ def mission_loads(scenario: Scenario) -> list[tuple[float, LoadShares]]:
     (`LeaderController`'s path: filters and input shaping as flown); instants with the same
     reference acceleration and velocity share one solve."""
     path = LeaderController(scenario).path
-    statics = QuasiStatic(scenario)
+    statics = QuasiStatic(scenario, runnable(hang_body))
     solved: dict[tuple, LoadShares] = {}
     out = []
     for tick in range(scenario.simulation.tick_count + 1):

@@ -9,10 +9,13 @@ among its cables and what each UAV's rotors have left, from the statics of Eq. 2
   and the payload its drag in still air (Eq. 2.53). The UAVs keep their hover places (the
   followers hold the geometry); a point payload hangs where its apparent weight and drag take
   it (the lowest point along them the cables reach: a single lift's swings out fully, a
-  twin-lift's about the UAVs' line, three cables or more pin it; a rigid body's turn and a UAV
-  held off its centre are not solved: their hover only). The tensions then follow from the
-  payload's rows (`equilibrium.payload_multipliers`) over the cables still taut, and UAV i's
-  rotors give u_T,i = |m_i (g e_z + a) - 2 lambda_i d_i| (its row of Eq. 2.73).
+  twin-lift's about the UAVs' line, three cables or more pin it), its tensions from its rows
+  (`equilibrium.payload_multipliers`) over the cables still taut; a rigid body hangs where it
+  rests, turned, under them (its force and moment rows with every cable at its length, solved
+  by the `hang_body` the caller passes: multilift_control's `laws.rigid_statics.hang_body`,
+  which this layer cannot import; four cables or more: its least-norm steps' rest). A UAV
+  held off its centre is not solved (it would tilt): its hover only. UAV i's rotors give
+  u_T,i = |m_i (g e_z + a) - 2 lambda_i d_i| (its row of Eq. 2.73).
 
 A UAV's thrust margin is 1 - u_T / u_T,max, u_T,max its rotors' thrust at rotor_speed_max (Eq.
 2.9): the share of its largest thrust left. Transients (a payload swinging after a corner, the
@@ -23,6 +26,7 @@ formation's when the UAVs are equal and symmetric, not in general.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -68,14 +72,21 @@ def hover_loads(scenario: Scenario) -> LoadShares:
 
 class QuasiStatic:
     """The quasi-static shares of one scenario's formation (the module's docstring), its hover
-    configuration computed once: `loads(acceleration, velocity)` per instant."""
+    configuration computed once: `loads(acceleration, velocity)` per instant. A rigid body's
+    needs `hang_body(uavs (n, 3), lengths (n,), attach (n, 3), load (3,)) -> (p, R, lambda,
+    found)`, its rest under `load` [N] (lambda_i d_i its cables' pulls, d_i from the body's
+    end to the UAV's)."""
 
-    def __init__(self, scenario: Scenario):
+    def __init__(self, scenario: Scenario, hang_body: Callable | None = None):
         self.params = scenario.formation_params(0.0, 0.0)
-        if self.params.rigid_payload or self.params.uav_attach_points is not None:
-            raise ValueError('quasi-static loads under acceleration are solved for a point '
-                             'payload on cables from the UAVs\' centres (a rigid body would '
-                             'turn, a UAV held off its centre tilt): hover loads only')
+        if self.params.uav_attach_points is not None or (self.params.rigid_payload
+                                                         and hang_body is None):
+            raise ValueError('quasi-static loads under acceleration are solved for cables from '
+                             'the UAVs\' centres (a UAV held off its centre would tilt): hover '
+                             'loads only' if self.params.uav_attach_points is not None else
+                             'a rigid body\'s quasi-static loads need its statics '
+                             '(multilift_control\'s laws.rigid_statics.hang_body)')
+        self.hang_body = hang_body
         self.uavs, self.hover_payload = scenario_configuration(scenario)
         self.lengths = np.asarray(self.params.cable_lengths, dtype=float)
         self.masses = np.array([u.vehicle.mass for u in scenario.uavs])
@@ -92,6 +103,8 @@ class QuasiStatic:
         speed = float(np.linalg.norm(v))
         # what the cables must give the payload [N]: m_p (g e_z + a) less its drag (Eq. 2.53)
         load = params.payload_mass * effective + params.payload_drag_coefficient * speed * v
+        if params.rigid_payload:
+            return self._rigid_loads(a, effective, load)
         payload = _hang(self.uavs, self.hover_payload, self.lengths, load)
         offsets = cable_offsets(params, self.uavs, payload, None)  # d_i, (n, 3)
         taut = np.linalg.norm(offsets, axis=1) >= self.lengths * (1.0 - TAUT)
@@ -102,6 +115,24 @@ class QuasiStatic:
                                                 tolerance=1e-6)
         forces = self.masses[:, None] * effective - 2.0 * multipliers[:, None] * offsets
         return LoadShares(a, cable_tension(multipliers, self.lengths),
+                          np.linalg.norm(forces, axis=1), self.largest)
+
+    def _rigid_loads(self, acceleration: np.ndarray, effective: np.ndarray,
+                     load: np.ndarray) -> LoadShares:
+        """A rigid body's shares: at its rest under `load` [N] (`hang_body`), T_i = lambda_i
+        |d_i| and u_T,i = |m_i (g e_z + a) + lambda_i d_i|."""
+        attach = np.asarray(self.params.payload_attach_points, dtype=float)
+        position, rotation, multipliers, found = self.hang_body(self.uavs, self.lengths,
+                                                                 attach, load)
+        if not found:
+            raise ValueError('the rigid body finds no rest under the load '
+                             f'{np.array2string(load, precision=3)} N')
+        if multipliers.min() < 0.0:
+            raise ValueError('a cable of the rigid body would push under the load '
+                             f'{np.array2string(load, precision=3)} N')
+        gaps = self.uavs - position - attach @ np.asarray(rotation).T      # d_i, (n, 3)
+        forces = self.masses[:, None] * effective + multipliers[:, None] * gaps
+        return LoadShares(acceleration, multipliers * np.linalg.norm(gaps, axis=1),
                           np.linalg.norm(forces, axis=1), self.largest)
 
 

@@ -11,4 +11,4 @@ record -s mcap` writes them.
 The writer's names are imported from here (`from multilift_sim.bag import BagWriter`).
 """
 from multilift_sim.bag.mcap_writer import (TORN_RECORD_ERRORS, BagError,  # noqa: F401
-                                           BagWriter, recover)
+                                           BagWriter, Column, recover)

@@ -80,15 +80,29 @@ class _MessageIndex(MessageIndex):
         count = len(self.records) + sum(len(block) for block in self.blocks)
         stream.write4(count * 16)
         if self.blocks:
-            stream.write(np.concatenate(self.blocks).astype('<u8').tobytes())
-        stream.write(struct.pack(f'<{2 * len(self.records)}Q',
-                                 *itertools.chain.from_iterable(self.records)))
+            stream.write(b''.join(block.astype('<u8', copy=False).tobytes()
+                                  for block in self.blocks))
+        if self.records:
+            stream.write(struct.pack(f'<{2 * len(self.records)}Q',
+                                     *itertools.chain.from_iterable(self.records)))
         stream.finish_record()
 
 
 # a column of a block (`MessageAppender.add_block`): (channel id, the sequence of its first
 # message, its messages' data (m, size) uint8, the ticks that have one (m,) or None: all)
 BlockColumn = tuple[int, int, np.ndarray, np.ndarray | None]
+
+
+def _patterns(present: np.ndarray, sparse: list[bool]) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of `present` (ticks, columns) and each tick's, as np.unique(axis=0)
+    gives them, keyed by the `sparse` columns alone (the others are present at every tick)."""
+    varying = np.flatnonzero(sparse)
+    if len(varying) > 62:  # no 64-bit key
+        patterns, which = np.unique(present, axis=0, return_inverse=True)
+        return patterns, which.reshape(-1)
+    keys = present[:, varying].astype(np.int64) @ (1 << np.arange(len(varying), dtype=np.int64))
+    _, first, which = np.unique(keys, return_index=True, return_inverse=True)
+    return present[first], which.reshape(-1)
 
 
 class MessageAppender:
@@ -168,8 +182,7 @@ class MessageAppender:
             ticks_of.append(ticks)
         if not present.any():
             return self._chunk.num_messages
-        patterns, which = np.unique(present, axis=0, return_inverse=True)
-        which = which.reshape(-1)
+        patterns, which = _patterns(present, [ticks is not None for *_, ticks in columns])
         sizes = patterns * np.array(widths)               # (P, C) each column's bytes a tick
         within = np.cumsum(sizes, axis=1) - sizes        # (P, C) where it starts in the tick
         starts = np.concatenate(([0], np.cumsum(sizes.sum(axis=1)[which])))
@@ -181,8 +194,10 @@ class MessageAppender:
                                    axis=1)[which] > 0
         end_ticks = np.broadcast_to(np.arange(count)[:, None], ends.shape)[nonempty]
         ends = ends[nonempty]
+        pairs = []  # each column's (log time, offset in the block) pairs
         for c, ticks in enumerate(ticks_of):
             offsets.append(starts[ticks] + within[which[ticks], c])
+            pairs.append(np.stack((log_times[ticks].astype(np.int64), offsets[-1]), axis=1))
         stream = self._stream(rows, present, patterns, which, sizes)
         position, done = 0, 0
         while done < len(ends):
@@ -190,7 +205,7 @@ class MessageAppender:
             cut = int(np.searchsorted(ends, room, side='right'))
             stop = min(cut, len(ends) - 1)
             self._append(stream, position, int(ends[stop]), log_times[end_ticks[done:stop + 1]],
-                         columns, offsets, ticks_of, log_times)
+                         columns, offsets, pairs)
             position, done = int(ends[stop]), stop + 1
             self._maybe_finish_chunk()  # past chunk_size at the cut
         return self._chunk.num_messages
@@ -218,8 +233,7 @@ class MessageAppender:
         return memoryview(b''.join(pieces))
 
     def _append(self, stream, start: int, stop: int, group_times: np.ndarray,
-                columns: Sequence[BlockColumn], offsets: list, ticks_of: list,
-                log_times: np.ndarray) -> None:
+                columns: Sequence[BlockColumn], offsets: list, pairs: list) -> None:
         """Write the block's bytes start .. stop (whole groups logged at `group_times`) into
         the chunk in progress, with the bookkeeping `add_many` does for their messages."""
         stats, chunk = self._statistics, self._chunk
@@ -247,7 +261,5 @@ class MessageAppender:
             index = indices.get(channel)
             if index is None:
                 index = indices[channel] = _MessageIndex(channel_id=channel, records=[])
-            index.add_pairs(np.stack((log_times[ticks_of[c][low:high]],
-                                      offsets[c][low:high] - start + base), axis=1
-                                     ).astype(np.uint64))
+            index.add_pairs((pairs[c][low:high] + (0, base - start)).astype('<u8'))
         chunk.record_writer.write(stream[start:stop])

@@ -8,8 +8,10 @@ two runs of a scenario write byte-identical bags.
 ticks per compiled call into a `TickRecord`, and packs each tick's messages from the record's
 rows (`EngineBag`): the state at t and every answer to it, then `/formation/state` (the
 tension of the integration that starts at t, g and g_dot at t) and every MARKER_DECIMATION-th
-tick the markers. The state at t_max has no answers; its `/formation/state` is solved under the
-commands held since the tick before, as the simulator node does. `HeadlessBag` writes the same
+tick the markers; each topic's messages of the CHUNK_TICKS ticks at once (numpy rows,
+`cdr_layout.Layout.pack_rows`), written as one block (`BagWriter.write_block`). The state at
+t_max has no answers; its `/formation/state` is solved under the commands held since the tick
+before, as the simulator node does. `HeadlessBag` writes the same
 bag tick by tick from `run_headless` (the objects the nodes use).
 """
 from __future__ import annotations
@@ -57,8 +59,9 @@ def _add_topics(scenario: Scenario, writer: BagWriter, controllers: bool = True)
 
 class EngineBag:
     """Writes one engine-flown run's messages to a BagWriter from its TickRecords (see the
-    module docstring): the same messages, in the same order and the same `write_many` groups
-    (a chunk of the MCAP is finished after a group) as `HeadlessBag`. With
+    module docstring): the same messages, in the same order and the same groups (`write_many`
+    calls or a block's groups: a chunk of the MCAP is finished after a group) as
+    `HeadlessBag`, so the same bytes (tests/unit/test_headless_bag.py). With
     `controllers=False` (answers that are a policy's rotor speeds) only the rotor commands of
     the answers are written, and the bag has no controller topic."""
 

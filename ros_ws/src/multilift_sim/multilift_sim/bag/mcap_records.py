@@ -58,9 +58,14 @@ MESSAGE_HEADER = np.dtype([(name, '<' + code) for name, code in zip(
 assert MESSAGE_HEADER.itemsize == _MESSAGE_RECORD.size
 
 
+# an MCAP MessageIndex record up to its (log time, offset) pairs: opcode, record length,
+# channel id, the pairs' length [B] (MCAP spec, "Message Index")
+_MESSAGE_INDEX_HEADER = struct.Struct('<BQHI')
+
+
 class _MessageIndex(MessageIndex):
-    """mcap's MessageIndex written with one pack of its (log time, offset) pairs: the same
-    bytes as the library's two 8-byte writes per message (most of a long bag's close). Pairs
+    """mcap's MessageIndex in one write, its (log time, offset) pairs packed at once: the
+    same bytes as the library's two 8-byte writes per message (most of a long bag's close). Pairs
     come one by one (`records`, as the library's) or as arrays (`add_pairs`), kept in order."""
 
     def __init__(self, channel_id: int, records: list) -> None:
@@ -75,17 +80,12 @@ class _MessageIndex(MessageIndex):
         self.blocks.append(pairs)
 
     def write(self, stream) -> None:
-        stream.start_record(Opcode.MESSAGE_INDEX)
-        stream.write2(self.channel_id)
-        count = len(self.records) + sum(len(block) for block in self.blocks)
-        stream.write4(count * 16)
-        if self.blocks:
-            stream.write(b''.join(block.astype('<u8', copy=False).tobytes()
-                                  for block in self.blocks))
-        if self.records:
-            stream.write(struct.pack(f'<{2 * len(self.records)}Q',
-                                     *itertools.chain.from_iterable(self.records)))
-        stream.finish_record()
+        body = b''.join([block.astype('<u8', copy=False).tobytes() for block in self.blocks]
+                        + [struct.pack(f'<{2 * len(self.records)}Q',
+                                       *itertools.chain.from_iterable(self.records))])
+        length = _MESSAGE_INDEX_HEADER.size - 1 - 8 + len(body)  # after opcode and length
+        stream.write(_MESSAGE_INDEX_HEADER.pack(Opcode.MESSAGE_INDEX, length, self.channel_id,
+                                                len(body)) + body)
 
 
 # a column of a block (`MessageAppender.add_block`): (channel id, the sequence of its first

@@ -94,6 +94,10 @@ def test_a_block_s_misuse_is_reported(tmp_path):
         writer.write_block(np.arange(3), [[Column(TOPICS[0], data)], [Column(TOPICS[0], data)]])
     with pytest.raises(BagError, match='2 messages for 3 ticks'):
         writer.write_block(np.arange(3), [[Column(TOPICS[0], data[:2])]])
+    with pytest.raises(BagError, match='must increase within 0 .. 2'):
+        writer.write_block(np.arange(3), [[Column(TOPICS[0], data[:2], np.array([2, 1]))]])
+    with pytest.raises(BagError, match='must increase within 0 .. 2'):
+        writer.write_block(np.arange(3), [[Column(TOPICS[0], data[:1], np.array([3]))]])
     with pytest.raises(BagError, match='negative log time'):
         writer.write_block(np.arange(3) - 1, [[Column(TOPICS[0], data)]])
     writer.write_block(np.arange(3), [[Column(TOPICS[0], data[:0], np.arange(0))]])

@@ -217,6 +217,11 @@ class BagWriter:
                 if entry in entries:
                     raise BagError(f'topic {column.topic} is in two columns of a block')
                 messages = count if column.ticks is None else len(column.ticks)
+                if column.ticks is not None and len(column.ticks) and (
+                        column.ticks[0] < 0 or column.ticks[-1] >= count
+                        or np.any(np.diff(column.ticks) <= 0)):
+                    raise BagError(f'{column.topic}: its ticks must increase within 0 .. '
+                                   f'{count - 1}')
                 if column.data.ndim != 2 or len(column.data) != messages:
                     raise BagError(f'{column.topic}: {len(column.data)} messages for '
                                    f'{messages} ticks')

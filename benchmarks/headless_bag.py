@@ -5,9 +5,14 @@ of several repeats, so other processes on the machine disturb it little):
   rclpy.serialization.serialize_message) against multilift_sim.wire.cdr (pack from the same values);
 - per RK4 step (twin_lift, n = 2): the pure-Python float kernel against the compiled one;
 - a new process importing the compiled kernel from numba's cache and making its first call;
-- a headless twin_lift run with and without the bag, per tick.
+- a headless twin_lift run with and without the bag, per tick;
+- the bag's share of a whole engine-flown mission (`--bag-only`, issue 31's "--bag at least
+  65x"): CPU of `multilift_control.headless.fly` (what `run --headless` does) and of
+  `record_headless` (what `run --headless --bag` does), best of 3 each, and the bag's messages
+  a second of its extra CPU (packing and writing, in blocks of ticks: BagWriter.write_block).
 
 Run: source scripts/env.sh && python benchmarks/headless_bag.py [--seconds 20]
+     source scripts/env.sh && python benchmarks/headless_bag.py --bag-only [--scenario twin_lift]
 """
 from __future__ import annotations
 
@@ -149,11 +154,43 @@ def run_table(seconds: float) -> None:
     os.environ.pop('MULTILIFT_KERNEL')
 
 
+def bag_table(name: str, repeat: int = 3) -> None:
+    from multilift_control.headless import fly
+    from multilift_sim import scenario as scenario_io
+    from multilift_tools.headless_bag import record_headless
+
+    scenario = scenario_io.load(name)
+    fly(scenario)  # kernels loaded, caches warm
+    plain = bagged = float('inf')
+    messages = 0
+    for _ in range(repeat):
+        start = time.process_time()
+        fly(scenario)
+        plain = min(plain, time.process_time() - start)
+        with tempfile.TemporaryDirectory() as tmp:
+            start = time.process_time()
+            record_headless(scenario, Path(tmp) / 'bag')
+            bagged = min(bagged, time.process_time() - start)
+            text = (Path(tmp) / 'bag' / 'metadata.yaml').read_text()
+            messages = int(text.split('message_count: ', 1)[1].split()[0])
+    share = bagged - plain
+    print(f'{name}, {scenario.simulation.duration:g} s simulated, CPU best of {repeat} '
+          f'(load {os.getloadavg()[0]:.2f}): fly {plain:.3f} s, record_headless {bagged:.3f} s,'
+          f' the bag {share:.3f} s for {messages} messages: {messages / share:,.0f} messages/s')
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--seconds', type=float, default=20.0,
                         help='simulated seconds of the headless runs (default 20)')
+    parser.add_argument('--bag-only', action='store_true',
+                        help="only the bag's share of a whole mission (the last table)")
+    parser.add_argument('--scenario', default='twin_lift',
+                        help='the mission of --bag-only (default twin_lift, 120 s)')
     args = parser.parse_args()
+    if args.bag_only:
+        bag_table(args.scenario)
+        return
     messages_table()
     kernel_table()
     run_table(args.seconds)

@@ -88,3 +88,24 @@ def test_a_hexa_beside_a_quad_writes_the_per_object_path_s_bag(tmp_path, monkeyp
     engine_run, object_run = _same_bags(tmp_path, scenario_io.loads(yaml.safe_dump(data)), 16,
                                         monkeypatch)
     assert engine_run.error is None and object_run.error is None
+
+
+def test_events_on_a_block_s_first_tick_inside_it_and_together(tmp_path, monkeypatch):
+    """Ticks that events fall on are written message by message between the blocks
+    (`EngineBag.ticks`): an event on a block's first tick (0.16 s, tick 16 of blocks of 16), one
+    inside a block (0.21 s) and two on one tick (0.37 s) give the per-object path's bag."""
+    import yaml
+    data = yaml.safe_load(scenario_io.resolve('hexa_rotor_failure').read_text())
+    data['simulation']['duration'] = 0.45
+    data['events'] = [
+        {'time': 0.16, 'type': 'rotor_effectiveness', 'uav': 1, 'rotor': 1,
+         'effectiveness': 0.5},
+        {'time': 0.21, 'type': 'rotor_effectiveness', 'uav': 2, 'rotor': 3,
+         'effectiveness': 0.8},
+        {'time': 0.37, 'type': 'rotor_effectiveness', 'uav': 1, 'rotor': 2,
+         'effectiveness': 0.9},
+        {'time': 0.37, 'type': 'rotor_effectiveness', 'uav': 2, 'rotor': 1,
+         'effectiveness': 0.7}]
+    engine_run, object_run = _same_bags(tmp_path, scenario_io.loads(yaml.safe_dump(data)), 16,
+                                        monkeypatch)
+    assert engine_run.error is None and object_run.error is None

@@ -5,12 +5,14 @@ from __future__ import annotations
 
 from typing import Sequence
 
+import numpy as np
+
 from multilift_control.laws.layout import REFERENCE_ACCELERATION, REFERENCE_POSITION
 from multilift_control.runtime import ControllerAnswer
 from multilift_sim.wire import cdr
 from multilift_sim.wire.msgvalues import uav_frame
 from multilift_sim.scenario import Scenario
-from multilift_sim.wire.tick_messages import Message
+from multilift_sim.wire.tick_messages import Message, MessageRows
 from multilift_sim.topics import (ATTITUDE_SETPOINT, FORMATION_ERROR, REFERENCE, ROTOR_CMD,
                                   uav_topic)
 
@@ -68,3 +70,32 @@ class AnswerMessages:
                 packer = self._errors[rows] = cdr.virtual_constraint_error(rows)
             messages.append((error_topic, packer.pack(t_ns, errors, rates)))
         return messages
+
+    def answer_rows(self, t_ns: np.ndarray, speeds: Sequence[np.ndarray],
+                    saturated: Sequence[np.ndarray], setpoints: np.ndarray | None = None,
+                    thrust: np.ndarray | None = None, reference: np.ndarray | None = None,
+                    errors: Sequence[np.ndarray] = (), rates: Sequence[np.ndarray] = ()
+                    ) -> list[MessageRows]:
+        """Every UAV's `answer_of` (`command_of` alone without `setpoints`) of K ticks (t_ns
+        (K,) [ns]) at once, topic by topic in their order: per UAV its rotor speeds and
+        saturation (K, its rotors), setpoints (K, n, 3) and thrust (K, n), the leader's
+        reference (K, 9 or more) or None, each follower's errors and rates (K, rows) (index
+        0, the leader's, unused)."""
+        out = []
+        for i, (cmd_topic, cmd, setpoint_topic, setpoint_packer, ref_topic,
+                error_topic) in enumerate(self._uavs):
+            out.append((cmd_topic, cmd.pack_rows(t_ns, speeds[i], saturated[i])))
+            if setpoints is None:
+                continue
+            out.append((setpoint_topic, setpoint_packer.pack_rows(
+                t_ns, np.concatenate((setpoints[:, i], thrust[:, i, None]), axis=1))))
+            if i == 0 and reference is not None:
+                out.append((ref_topic, self._reference.pack_rows(
+                    t_ns, reference[:, REFERENCE_POSITION:REFERENCE_ACCELERATION + 3])))
+            if i:
+                rows = errors[i].shape[1]
+                packer = self._errors.get(rows)
+                if packer is None:
+                    packer = self._errors[rows] = cdr.virtual_constraint_error(rows)
+                out.append((error_topic, packer.pack_rows(t_ns, errors[i], rates[i])))
+        return out

@@ -8,8 +8,10 @@ two runs of a scenario write byte-identical bags.
 ticks per compiled call into a `TickRecord`, and packs each tick's messages from the record's
 rows (`EngineBag`): the state at t and every answer to it, then `/formation/state` (the
 tension of the integration that starts at t, g and g_dot at t) and every MARKER_DECIMATION-th
-tick the markers. The state at t_max has no answers; its `/formation/state` is solved under the
-commands held since the tick before, as the simulator node does. `HeadlessBag` writes the same
+tick the markers; each topic's messages of the CHUNK_TICKS ticks at once (numpy rows,
+`cdr_layout.Layout.pack_rows`), written as one block (`BagWriter.write_block`). The state at
+t_max has no answers; its `/formation/state` is solved under the commands held since the tick
+before, as the simulator node does. `HeadlessBag` writes the same
 bag tick by tick from `run_headless` (the objects the nodes use).
 """
 from __future__ import annotations
@@ -25,7 +27,7 @@ from multilift_control.engine import Engine
 from multilift_control.engine.arrays import TickRecord
 from multilift_control.headless import FlownRun, HeadlessRun, progress_ticker, run_headless
 from multilift_control.runtime import ControllerAnswer
-from multilift_sim.bag import BagWriter
+from multilift_sim.bag import BagWriter, Column
 from multilift_sim.bag.metadata_yaml import OfferedQos, qos_yaml
 from multilift_sim.formation_params import StateLayout
 from multilift_sim import kernels
@@ -39,7 +41,8 @@ from multilift_sim.simulation import (FormationSimulator, SimulationStopped, Sna
 from multilift_sim.estimators.published import ESTIMATE_COLUMNS
 from multilift_sim.wire.tick_messages import (SimulatorMessages, measured_odometry, payload_motion,
                                               state_rows)
-from multilift_sim.topics import MARKER_DECIMATION, scenario_topics
+from multilift_sim.topics import (FORMATION_SNAPSHOT, MARKER_DECIMATION, MARKERS,
+                                  scenario_topics)
 
 # ticks per compiled call (and between two progress reports): 2.5 s of a 100 Hz mission
 CHUNK_TICKS = 250
@@ -56,8 +59,9 @@ def _add_topics(scenario: Scenario, writer: BagWriter, controllers: bool = True)
 
 class EngineBag:
     """Writes one engine-flown run's messages to a BagWriter from its TickRecords (see the
-    module docstring): the same messages, in the same order and the same `write_many` groups
-    (a chunk of the MCAP is finished after a group) as `HeadlessBag`. With
+    module docstring): the same messages, in the same order and the same groups (`write_many`
+    calls or a block's groups: a chunk of the MCAP is finished after a group) as
+    `HeadlessBag`, so the same bytes (tests/unit/test_headless_bag.py). With
     `controllers=False` (answers that are a policy's rotor speeds) only the rotor commands of
     the answers are written, and the bag has no controller topic."""
 
@@ -67,6 +71,7 @@ class EngineBag:
         self._controllers = controllers
         self._commands = scenario.controlled  # none when every UAV's motion is prescribed
         self._scenario, self._engine, self._write = scenario, engine, writer.write_many
+        self._bag = writer
         self._simulator = SimulatorMessages(scenario)
         self._answers = AnswerMessages(scenario)
         self._n = scenario.n_uavs
@@ -94,87 +99,109 @@ class EngineBag:
                                            self._wind)
 
     def ticks(self, first: int, record: TickRecord, count: int) -> None:
-        """Write ticks first .. first + count - 1 of formation 0 from `record`'s rows."""
+        """Write ticks first .. first + count - 1 of formation 0 from `record`'s rows: each
+        topic's messages of the `count` ticks packed at once (`state_rows_of`, `answer_rows`,
+        ...), written a block of ticks at a time (`BagWriter.write_block`) between the ticks
+        that differ, which are written message by message from the same rows: the run's first
+        tick (its snapshot holds no rotor speeds yet) and the ticks events fall on."""
         if count <= 0:
             return
-        n, period, rows = self._n, self._period_ns, self._own_rows
+        n = self._n
+        t_ns = (first + np.arange(count, dtype=np.int64)) * self._period_ns
         states = record.states[:count, 0]
         received = record.measured[:count, 0]  # what the controllers received
         payload_estimates = record.payload_estimate[:count, 0] \
             if record.payload_estimate.shape[2] else None  # /payload/estimate
         snapshots, odometry = state_rows(states, n, received, payload_estimates)
-        measured = measured_odometry(received).tolist() if self._sensors \
-            else [None] * count
-        estimates = record.estimate[:count, 0].tolist() if record.estimate.shape[3] \
-            else [None] * count  # /uav{i}/estimate (an estimator)
-        winds = self._wind[first:first + count].tolist() if self._wind is not None \
-            else [None] * count
-        speeds = record.speeds[:count, 0]
+        speeds, saturated = record.speeds[:count, 0], record.saturated[:count, 0]
         flat = speeds.reshape(count, -1)
         if self._counts is not None:
             flat = flat[:, self._real]
+        specials = set()  # ticks written message by message (`_tick`)
+        first_snapshot = None  # the run's first, without rotor speeds
         if self._held is None:  # from t = 0: no rotor speeds held yet
-            snapshots = [snapshots[0].tolist()] + np.concatenate(
-                (snapshots[1:], flat[:-1]), axis=1).tolist()
-        else:
-            snapshots = np.concatenate(
-                (snapshots, np.concatenate((self._held[None], flat[:-1]))), axis=1).tolist()
+            first_snapshot = self._simulator.snapshot_of(int(t_ns[0]), snapshots[0].tolist(),
+                                                         0)[1]
+            specials.add(0)
+        held = np.zeros_like(flat[:1]) if self._held is None else self._held[None]
+        snapshots = np.concatenate((snapshots, np.concatenate((held, flat[:-1]))), axis=1)
         self._held = flat[-1].copy()
-        previous_count = flat.shape[1]
-        odometry = odometry.tolist()
+        events = self._engine.arrays.events[0][:, EVENT_TICK] - first
+        specials.update(int(k) for k in events if 0 <= k < count)
         layout = StateLayout(n, self._rigid, self._chain_nodes)
-        euler = layout.uav_euler(states).tolist()
-        chains = layout.chain_positions(states) if self._chain_nodes else [None] * count
-        payload_position = layout.payload_position(states).tolist()
+        payload_position = layout.payload_position(states)
         payload_velocity = layout.payload_velocity(states)
-        poses = [None] * count
-        orientations = [None] * count  # a rigid payload's, for the markers
+        pose, orientations = None, [None] * count  # a rigid payload's, for the markers
         if self._rigid:  # its pose and its twist in its frame, as the per-object path packs
             motions = [payload_motion(payload_attitude(state, n), velocity)
                        for state, velocity in zip(states, payload_velocity)]
-            payload_velocity = [motion[0] for motion in motions]
-            poses = [motion[1] for motion in motions]
-            orientations = [pose[0] for pose in poses]
-        else:
-            payload_velocity = payload_velocity.tolist()
-        gusts = record.gust[:count, 0].tolist()
-        speed_lists, saturated = speeds.tolist(), record.saturated[:count, 0].tolist()
-        if self._counts is not None:
-            speed_lists, saturated = ([[row[:c] for row, c in zip(uavs, self._counts)]
-                                       for uavs in lists] for lists in (speed_lists, saturated))
-        setpoints, thrusts = record.setpoints[:count, 0].tolist(), record.thrust[:count, 0].tolist()
-        references = record.reference[:count, 0].tolist()
-        errors = [record.errors[:count, 0, i, :rows[i]].tolist() for i in range(n)]
-        rates = [record.rates[:count, 0, i, :rows[i]].tolist() for i in range(n)]
-        tension, g = record.tension[:count, 0].tolist(), record.g[:count, 0].tolist()
-        g_dot, taut = record.g_dot[:count, 0].tolist(), record.taut[:count, 0].tolist()
-        lengths = record.cable_length[:count, 0].tolist()
-        simulator, answer_of, write = self._simulator, self._answers.answer_of, self._write
-        command_of = self._answers.command_of
-        for k in range(count):
-            tick = first + k
-            t_ns = tick * period
-            messages = simulator.state_of(t_ns, snapshots[k], previous_count if tick else 0,
-                                          odometry[k], payload_position[k],
-                                          payload_velocity[k], gusts[k], measured[k],
-                                          winds[k], poses[k], lengths[k], estimates[k],
-                                          None if payload_estimates is None
-                                          else payload_estimates[k].tolist())
-            messages += self._events_at(tick, t_ns)
-            for i in range(n if self._commands else 0):
-                if not self._controllers:
-                    messages += command_of(i, t_ns, speed_lists[k][i], saturated[k][i])
-                    continue
-                messages += answer_of(i, t_ns, speed_lists[k][i], saturated[k][i],
-                                      setpoints[k][i], thrusts[k][i],
-                                      references[k] if i == 0 and self._reference else None,
-                                      errors[i][k] if i else None, rates[i][k] if i else None)
-            write(messages, t_ns)
-            self._formation(tick, t_ns, tension[k], g[k], g_dot[k], taut[k], odometry[k],
-                            euler[k], payload_position[k], orientations[k], chains[k],
-                            speed_lists[k] if self._commands else None)
-        if count:
-            self._last_speeds = speed_lists[count - 1] if self._commands else None
+            payload_velocity = np.array([motion[0] for motion in motions])
+            orientations = [motion[1][0] for motion in motions]
+            pose = (np.array(orientations), np.array([motion[1][1] for motion in motions]))
+        counts = self._counts or [speeds.shape[2]] * n
+        uav_speeds = [speeds[:, i, :c] for i, c in enumerate(counts)]
+        uav_saturated = [saturated[:, i, :c] for i, c in enumerate(counts)]
+        state = self._simulator.state_rows_of(
+            t_ns, snapshots, flat.shape[1], odometry, payload_position, payload_velocity,
+            record.gust[:count, 0],
+            measured_odometry(received) if self._sensors else None,
+            None if self._wind is None else self._wind[first:first + count], pose,
+            record.cable_length[:count, 0],
+            record.estimate[:count, 0] if record.estimate.shape[3] else None,
+            payload_estimates)
+        answers = []
+        if self._commands:
+            rows = self._own_rows
+            answers = self._answers.answer_rows(
+                t_ns, uav_speeds, uav_saturated,
+                *((record.setpoints[:count, 0], record.thrust[:count, 0],
+                   record.reference[:count, 0] if self._reference else None,
+                   [record.errors[:count, 0, i, :rows[i]] for i in range(n)],
+                   [record.rates[:count, 0, i, :rows[i]] for i in range(n)])
+                  if self._controllers else ()))
+        tension, g = record.tension[:count, 0], record.g[:count, 0]
+        g_dot, taut = record.g_dot[:count, 0], record.taut[:count, 0]
+        formation = [self._simulator.formation_rows_of(t_ns, tension, g, g_dot, taut)]
+        formation += self._simulator.margin_rows(uav_speeds if self._commands else [])
+        marker_ticks = np.flatnonzero((first + np.arange(count)) % MARKER_DECIMATION == 0)
+        euler = layout.uav_euler(states[marker_ticks])
+        chains = layout.chain_positions(states[marker_ticks]) if self._chain_nodes \
+            else [None] * len(marker_ticks)
+        markers = [self._simulator.markers_of(
+            int(t_ns[k]), odometry[k, :, :3].tolist(), euler[m].tolist(),
+            payload_position[k].tolist(), tension[k].tolist(), taut[k].tolist(),
+            orientations[k], chains[m])[1] for m, k in enumerate(marker_ticks)]
+        start = 0
+        for stop in sorted(specials) + [count]:
+            if stop > start:
+                self._block(t_ns, start, stop, state + answers, formation, markers,
+                            marker_ticks)
+            if stop < count:
+                tick_state = [(topic, first_snapshot if first_snapshot is not None and
+                               stop == 0 and topic == FORMATION_SNAPSHOT
+                               else rows[stop].tobytes()) for topic, rows in state]
+                marker = [(MARKERS, markers[m]) for m in np.flatnonzero(marker_ticks == stop)]
+                self._write(tick_state + self._events_at(first + stop, int(t_ns[stop]))
+                            + [(topic, rows[stop].tobytes()) for topic, rows in answers],
+                            int(t_ns[stop]))
+                self._write([(topic, rows[stop].tobytes()) for topic, rows in formation]
+                            + marker, int(t_ns[stop]))
+            start = stop + 1
+        self._last_speeds = [s[-1].tolist() for s in uav_speeds] if self._commands else None
+
+    def _block(self, t_ns: np.ndarray, start: int, stop: int, first: list, second: list,
+               markers: list[bytes], marker_ticks: np.ndarray) -> None:
+        """Ticks start .. stop - 1 of `t_ns` in one `write_block`: each tick's `first` group
+        (the state and the answers), then its `second` (`/formation/state`, the margins and,
+        every MARKER_DECIMATION-th tick, the markers)."""
+        second = [Column(topic, rows[start:stop]) for topic, rows in second]
+        shown = np.flatnonzero((marker_ticks >= start) & (marker_ticks < stop))
+        if len(shown):
+            second.append(Column(MARKERS, np.frombuffer(b''.join(markers[m] for m in shown),
+                                                        np.uint8).reshape(len(shown), -1),
+                                 marker_ticks[shown] - start))
+        self._bag.write_block(t_ns[start:stop], [
+            [Column(topic, rows[start:stop]) for topic, rows in first], second])
 
     def last(self) -> None:
         """Write the state at t_max (the engine's current state, which nothing answers) and

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
 
+import numpy as np
 from mcap.exceptions import McapError
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
@@ -78,6 +79,15 @@ class _Topic:
             },
             'message_count': self.message_count,
         }
+
+
+@dataclass(frozen=True)
+class Column:
+    """One topic's messages in a block of K ticks (`BagWriter.write_block`): at most one a
+    tick, all of one size."""
+    topic: str
+    data: np.ndarray                 # (m, size) uint8: each message's CDR bytes
+    ticks: np.ndarray | None = None  # (m,) increasing: the ticks that have one; None: all K
 
 
 class BagWriter:
@@ -188,6 +198,53 @@ class BagWriter:
         self._end_ns = max(self._end_ns, log_time_ns)
         self._unflushed = (0 if self._file.writes != writes_before
                            else self._unflushed + len(records))
+
+    def write_block(self, log_times_ns: np.ndarray, groups: Sequence[Sequence[Column]]) -> None:
+        """The bag `write_many` gives called for every tick k of a block and every group in
+        turn, with the group's messages at tick k (its columns' in order) logged and published
+        at log_times_ns[k] [ns] (a group without any at k writes nothing), packed with numpy
+        a block at a time (`MessageAppender.add_block`; tests/unit/test_bag_blocks.py holds
+        the files equal). A topic is in at most one column of a block."""
+        self._check_open()
+        log_times = np.asarray(log_times_ns, dtype=np.int64)
+        count, columns, column_groups, entries = len(log_times), [], [], []
+        for group, group_columns in enumerate(groups):
+            for column in group_columns:
+                entry = self._topics.get(column.topic)
+                if entry is None:
+                    raise BagError(f'topic {column.topic} was not added to bag '
+                                   f'{self.directory}; call add_topic first')
+                if entry in entries:
+                    raise BagError(f'topic {column.topic} is in two columns of a block')
+                messages = count if column.ticks is None else len(column.ticks)
+                if column.ticks is not None and len(column.ticks) and (
+                        column.ticks[0] < 0 or column.ticks[-1] >= count
+                        or np.any(np.diff(column.ticks) <= 0)):
+                    raise BagError(f'{column.topic}: its ticks must increase within 0 .. '
+                                   f'{count - 1}')
+                if column.data.ndim != 2 or len(column.data) != messages:
+                    raise BagError(f'{column.topic}: {len(column.data)} messages for '
+                                   f'{messages} ticks')
+                columns.append((entry.channel_id, entry.message_count,
+                                np.ascontiguousarray(column.data, dtype=np.uint8),
+                                column.ticks))
+                column_groups.append(group)
+                entries.append(entry)
+        if not columns or not count:
+            return
+        if log_times.min() < 0:
+            raise BagError(f'negative log time {log_times.min()} ns in a block')
+        times = log_times.astype(np.uint64)
+        self._unflushed = self._messages.add_block(times, times, columns, column_groups)
+        for entry, (_, _, data, _) in zip(entries, columns):
+            entry.message_count += len(data)
+            self._message_count += len(data)
+        present = np.zeros(count, bool)
+        for _, _, data, ticks in columns:
+            present[slice(None) if ticks is None else ticks] = True
+        if present.any():
+            self._start_ns = min(self._start_ns, int(log_times[present].min()))
+            self._end_ns = max(self._end_ns, int(log_times[present].max()))
 
     def flush(self) -> None:
         """Finish the chunk in progress so every message written so far is on disk."""

@@ -12,6 +12,8 @@ duration (RMW_DURATION_INFINITE) is `sec: 9223372036, nsec: 854775807`.
 
 from __future__ import annotations
 
+import copy
+import functools
 import json
 import re
 from dataclasses import dataclass
@@ -33,10 +35,15 @@ def _scalar(value: Any) -> str:
     if isinstance(value, int):
         return str(value)
     if isinstance(value, str):
-        if _PLAIN.match(value) and yaml.safe_load(value) == value:
-            return value
-        return json.dumps(value, ensure_ascii=False)
+        return value if _plain(value) else json.dumps(value, ensure_ascii=False)
     raise TypeError(f'cannot write {type(value).__name__} {value!r} to rosbag2 YAML')
+
+
+@functools.lru_cache(maxsize=4096)
+def _plain(text: str) -> bool:
+    """Whether yaml-cpp writes `text` unquoted: it reads back as itself (a bag writes the same
+    names, types and hashes many times: each parsed once)."""
+    return bool(_PLAIN.match(text)) and yaml.safe_load(text) == text
 
 
 def _is_block(value: Any) -> bool:
@@ -130,9 +137,15 @@ def qos_yaml(profiles: Sequence[OfferedQos]) -> str:
     return dump([p.to_dict() for p in profiles])
 
 
+@functools.lru_cache(maxsize=64)
+def _parsed(text: str) -> Any:
+    """`text` parsed (once: every topic of a bag offers the same profiles); not to be changed."""
+    return yaml.safe_load(text)
+
+
 def parse_qos_yaml(text: str) -> list[dict[str, Any]]:
     """The list of QoS profile maps in an `offered_qos_profiles` string ('' = no profile)."""
-    data = yaml.safe_load(text) if text.strip() else []
+    data = copy.deepcopy(_parsed(text)) if text.strip() else []
     if data is None:
         data = []
     if not isinstance(data, list) or not all(isinstance(p, dict) for p in data):

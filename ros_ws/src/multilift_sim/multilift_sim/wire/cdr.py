@@ -13,7 +13,7 @@ from typing import Sequence
 import numpy as np
 
 from multilift_sim.wire.cdr_layout import ENCAPSULATION, Layout, header_layout
-from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp
+from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp, stamps
 
 
 class Clock:
@@ -28,6 +28,10 @@ class Clock:
     def pack(self, t_ns: int) -> bytes:
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns))
 
+    def pack_rows(self, t_ns: np.ndarray) -> np.ndarray:
+        """`pack` of K times [ns] (K,): the messages' bytes (K, size)."""
+        return self.layout.pack_rows(ENCAPSULATION, *stamps(t_ns))
+
 
 class Float64:
     """std_msgs/Float64 (no header: a bag's log time stamps it)."""
@@ -39,6 +43,10 @@ class Float64:
 
     def pack(self, value: float) -> bytes:
         return self._struct.pack(ENCAPSULATION, value)
+
+    def pack_rows(self, values: np.ndarray) -> np.ndarray:
+        """`pack` of K values (K,): the messages' bytes (K, size)."""
+        return self.layout.pack_rows(ENCAPSULATION, values)
 
 
 class Odometry:
@@ -67,6 +75,10 @@ class Odometry:
         """From the 13 numbers of `pack`'s four tuples in a row (with `covariance`, 85)."""
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, *row)
 
+    def pack_rows(self, t_ns: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """`pack_row` of K times (K,) and rows (K, 13) (or (K, 85)): the bytes (K, size)."""
+        return self.layout.pack_rows(ENCAPSULATION, *stamps(t_ns), *self._frame, rows)
+
 
 class _Stamped:
     """A header then `floats` float64 fields (Vector3Stamped, AttitudeSetpoint,
@@ -79,6 +91,10 @@ class _Stamped:
 
     def pack(self, t_ns: int, *values: float) -> bytes:
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, *values)
+
+    def pack_rows(self, t_ns: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """`pack` of K times (K,) and the values of each (K, floats): the bytes (K, size)."""
+        return self.layout.pack_rows(ENCAPSULATION, *stamps(t_ns), *self._frame, values)
 
 
 class Vector3Stamped(_Stamped):
@@ -118,13 +134,22 @@ class FloatSequences:
     def pack(self, t_ns: int, *sequences: Sequence[float]) -> bytes:
         return self._struct.pack(*self._arguments(t_ns, sequences))
 
-    def _arguments(self, t_ns: int, sequences: Sequence[Sequence[float]]) -> list:
-        args = [ENCAPSULATION, *stamp(t_ns), *self._frame]
+    def pack_rows(self, t_ns: np.ndarray, *sequences: np.ndarray) -> np.ndarray:
+        """`pack` of K times (K,) and each sequence's K rows (K, length): bytes (K, size)."""
+        return self.layout.pack_rows(*self._arguments(t_ns, sequences, rows=True))
+
+    def _arguments(self, t_ns, sequences: Sequence, rows: bool = False) -> list:
+        """`pack`'s arguments; with `rows`, of K messages (`pack_rows`'s columns)."""
+        args = [ENCAPSULATION, *(stamps(t_ns) if rows else stamp(t_ns)), *self._frame]
         for length, values in zip(self._lengths, sequences, strict=True):
-            if len(values) != length:
-                raise ValueError(f'a sequence of {len(values)} values for a layout of {length}')
+            given = values.shape[1] if rows else len(values)
+            if given != length:
+                raise ValueError(f'a sequence of {given} values for a layout of {length}')
             args.append(length)
-            args.extend(values)
+            if rows:
+                args.append(values)
+            else:
+                args.extend(values)
         return args
 
 
@@ -144,6 +169,12 @@ class FormationState(FloatSequences):
             raise ValueError(f'{len(taut)} taut flags for {self._n} cables')
         args = self._arguments(t_ns, (tension, g, g_dot))
         return self._struct.pack(*args, self._n, *(bool(v) for v in taut))
+
+    def pack_rows(self, t_ns: np.ndarray, tension: np.ndarray, g: np.ndarray,
+                  g_dot: np.ndarray, taut: np.ndarray) -> np.ndarray:
+        """`pack` of K times (K,) and K rows (K, n) of each: the bytes (K, size)."""
+        args = self._arguments(t_ns, (tension, g, g_dot), rows=True)
+        return self.layout.pack_rows(*args, self._n, np.asarray(taut, dtype=bool))
 
 
 class FormationEvent:
@@ -231,6 +262,19 @@ class FormationSnapshot:
                              *row[4 * r:4 * r + 6], len(self._counts), *self._counts,
                              previous, *row[4 * r + 6:])
 
+    def pack_rows(self, t_ns: np.ndarray, rows: np.ndarray, previous: int) -> np.ndarray:
+        """`pack_row` of K times (K,) and rows (K, 12 n + 6 + previous): bytes (K, size)."""
+        layout = self._structs[previous][0]
+        r = self._rows
+        if rows.shape[1] != 4 * r + 6 + previous:
+            raise ValueError(f'{rows.shape[1]} values for {r} per field (3 per UAV), 6 of the '
+                             f'payload and {previous} rotor speeds')
+        return layout.pack_rows(ENCAPSULATION, *stamps(t_ns), *self._frame, r, rows[:, :r],
+                                r, rows[:, r:2 * r], r, rows[:, 2 * r:3 * r], r,
+                                rows[:, 3 * r:4 * r], rows[:, 4 * r:4 * r + 6],
+                                len(self._counts), *self._counts, previous,
+                                rows[:, 4 * r + 6:])
+
     def unpack(self, data: bytes) -> tuple[int, np.ndarray, np.ndarray, np.ndarray,
                                            np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The inverse of `pack` for this formation: (t_ns, position, velocity, euler,
@@ -283,3 +327,9 @@ class RotorCommand:
     def pack(self, t_ns: int, speeds: Sequence[float], saturated: Sequence[bool]) -> bytes:
         return self._struct.pack(ENCAPSULATION, *stamp(t_ns), *self._frame, self._n, *speeds,
                                  self._n, *saturated)
+
+    def pack_rows(self, t_ns: np.ndarray, speeds: np.ndarray, saturated: np.ndarray
+                  ) -> np.ndarray:
+        """`pack` of K times (K,), speeds and saturation (K, n_rotors): bytes (K, size)."""
+        return self.layout.pack_rows(ENCAPSULATION, *stamps(t_ns), *self._frame, self._n,
+                                     speeds, self._n, np.asarray(saturated, dtype=bool))

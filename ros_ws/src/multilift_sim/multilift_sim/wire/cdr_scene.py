@@ -5,8 +5,10 @@ from __future__ import annotations
 
 from typing import Sequence
 
+import numpy as np
+
 from multilift_sim.wire.cdr_layout import ENCAPSULATION, Layout
-from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp
+from multilift_sim.wire.msgvalues import WORLD_FRAME, stamp, stamps
 from multilift_sim.wire.scene import MarkerSpec
 
 
@@ -36,6 +38,17 @@ class TFMessage:
                 self._names, translations, rotations, strict=True):
             args += (sec, nanosec, flen, fdata, clen, cdata, *translation, *rotation)
         return self._struct.pack(*args)
+
+    def pack_rows(self, t_ns: np.ndarray, translations: np.ndarray, rotations: np.ndarray
+                  ) -> np.ndarray:
+        """`pack` of K times (K,), translations (K, children, 3) and rotations (K, children,
+        4): the messages' bytes (K, size)."""
+        sec, nanosec = stamps(t_ns)
+        args = [ENCAPSULATION, len(self._names)]
+        for k, (flen, fdata, clen, cdata) in enumerate(self._names):
+            args += (sec, nanosec, flen, fdata, clen, cdata, translations[:, k],
+                     rotations[:, k])
+        return self.layout.pack_rows(*args)
 
 
 class MarkerArray:

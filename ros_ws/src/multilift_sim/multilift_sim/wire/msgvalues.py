@@ -40,6 +40,13 @@ def stamp(t_ns: int) -> tuple[int, int]:
     return int(t_ns // 1_000_000_000), int(t_ns % 1_000_000_000)
 
 
+def stamps(t_ns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`stamp` of K times [ns] at once: (sec (K,), nanosec (K,)), columns for
+    `cdr_layout.Layout.pack_rows`."""
+    t_ns = np.asarray(t_ns, dtype=np.int64)
+    return t_ns // 1_000_000_000, t_ns % 1_000_000_000
+
+
 def quaternion(euler: Sequence[float]) -> Quat:
     """(x, y, z, w) of ZYX Euler angles [rad], for the markers (scene.py): physics.measurement
     .euler_quaternion (the odometry's), run uncompiled on plain floats (one attitude per

@@ -32,6 +32,8 @@ from multilift_sim.topics import (CABLE_LENGTH, CLOCK, ESTIMATE, EVENTS, FORMATI
                                   margin_topics, uav_topic)
 
 Message = tuple[str, bytes]  # (topic, CDR bytes)
+# (topic, the CDR bytes of K messages (K, size) uint8): a topic's messages of K ticks
+MessageRows = tuple[str, np.ndarray]
 _ZERO = (0.0, 0.0, 0.0)
 # an odometry row's 13 numbers (msgvalues.odometry's order: position, orientation (x, y, z, w),
 # body-frame velocity, body rates) taken from the rows of physics.measurement.odometry_states
@@ -132,7 +134,7 @@ class SimulatorMessages:
         orientation, spin = (IDENTITY, _ZERO) if payload_pose is None else payload_pose
         out = [(CLOCK, self._clock.pack(t_ns))]
         if snapshot is not None:
-            out.append((FORMATION_SNAPSHOT, self._snapshot.pack_row(t_ns, snapshot, previous)))
+            out.append(self.snapshot_of(t_ns, snapshot, previous))
         for uav, (topic, packer) in zip(uavs, self._odometry):
             out.append((topic, packer.pack_row(t_ns, uav)))
         if measured is not None:
@@ -155,6 +157,66 @@ class SimulatorMessages:
             t_ns, [u[:3] for u in uavs] + [payload_position] + self._attach,
             [u[3:7] for u in uavs] + [orientation] + [IDENTITY] * len(self._attach))))
         return out
+
+    def snapshot_of(self, t_ns: int, snapshot: list[float], previous: int) -> Message:
+        """`state_of`'s /formation/snapshot alone."""
+        return FORMATION_SNAPSHOT, self._snapshot.pack_row(t_ns, snapshot, previous)
+
+    def state_rows_of(self, t_ns: np.ndarray, snapshot: np.ndarray | None, previous: int,
+                      uavs: np.ndarray, payload_position: np.ndarray,
+                      payload_velocity: np.ndarray, gust: np.ndarray,
+                      measured: np.ndarray | None = None, wind: np.ndarray | None = None,
+                      payload_pose: tuple[np.ndarray, np.ndarray] | None = None,
+                      cable_lengths: np.ndarray | None = None,
+                      estimates: np.ndarray | None = None,
+                      payload_estimate: np.ndarray | None = None) -> list[MessageRows]:
+        """`state_of` of K ticks at once (t_ns (K,) [ns]), topic by topic in its order: the
+        same arguments, each with a first axis of K ticks (snapshot (K, 12 n + 6 + previous),
+        uavs and measured (K, n, 13), payload_pose (orientations (K, 4), body rates (K, 3)),
+        cable_lengths (K, n), estimates (K, n, 85), ...); row k of a topic's bytes is the
+        message `state_of` packs at tick k (tests/unit/test_headless_bag.py)."""
+        k = len(t_ns)
+        if payload_pose is None:
+            orientation, spin = np.broadcast_to(IDENTITY, (k, 4)), np.zeros((k, 3))
+        else:
+            orientation, spin = payload_pose
+        out = [(CLOCK, self._clock.pack_rows(t_ns))]
+        if snapshot is not None:
+            out.append((FORMATION_SNAPSHOT, self._snapshot.pack_rows(t_ns, snapshot, previous)))
+        for i, (topic, packer) in enumerate(self._odometry):
+            out.append((topic, packer.pack_rows(t_ns, uavs[:, i])))
+        for uav, (topic, packer) in enumerate(self._measured if measured is not None else ()):
+            out.append((topic, packer.pack_rows(t_ns, measured[:, uav])))
+        for uav, (topic, packer) in enumerate(self._estimates if estimates is not None else ()):
+            out.append((topic, packer.pack_rows(t_ns, estimates[:, uav])))
+        for i, topic, packer in self._lengths:
+            out.append((topic, packer.pack_rows(cable_lengths[:, i])))
+        out.append((PAYLOAD_ODOM, self._payload.pack_rows(t_ns, np.concatenate(
+            (payload_position, orientation, payload_velocity, spin), axis=1))))
+        if payload_estimate is not None:
+            out.append((PAYLOAD_ESTIMATE, self._payload_estimate.pack_rows(t_ns,
+                                                                           payload_estimate)))
+        out.append((PAYLOAD_GUST, self._gust.pack_rows(t_ns, gust)))
+        if self._wind is not None:
+            out.append((WIND, self._wind.pack_rows(t_ns, wind)))
+        attach = len(self._attach)
+        translations = np.concatenate((uavs[..., :3], payload_position[:, None],
+                                       np.broadcast_to(np.reshape(self._attach, (1, attach, 3)),
+                                                       (k, attach, 3))), axis=1)
+        rotations = np.concatenate((uavs[..., 3:7], orientation[:, None],
+                                    np.broadcast_to(IDENTITY, (k, attach, 4))), axis=1)
+        out.append((TF, self._tf.pack_rows(t_ns, translations, rotations)))
+        return out
+
+    def formation_rows_of(self, t_ns: np.ndarray, tension: np.ndarray, g: np.ndarray,
+                          g_dot: np.ndarray, taut: np.ndarray) -> MessageRows:
+        """`formation_of` of K ticks (t_ns (K,), the rest (K, n))."""
+        return FORMATION_STATE, self._state.pack_rows(t_ns, tension, g, g_dot, taut)
+
+    def margin_rows(self, rotor_speeds: Sequence[np.ndarray]) -> list[MessageRows]:
+        """`margins` of K ticks: each UAV's rotor speeds (K, its rotors) [rad/s]."""
+        return [(topic, packer.pack_rows(vehicle.thrust_margin(speeds)))
+                for (topic, packer, vehicle), speeds in zip(self._margins, rotor_speeds)]
 
     def events(self, t_ns: int, rows: np.ndarray) -> list[Message]:
         """/formation/events: one message per event row (physics.layout EVENT_*) that

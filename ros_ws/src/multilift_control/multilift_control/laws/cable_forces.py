@@ -8,7 +8,8 @@ g e_z + a is vertical, the formation tilted as one body), the tensions nearest t
 that the followers feed forward (`allocated_statics`), and the followers' step towards them
 (`allocate`), rate limited and within the spacing and spread limits of `laws.reorganize`
 (whose statics, apparent gravity and memory it shares: constants FOLLOWER_* then REORGANIZE_*,
-memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT).
+memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT). A rigid body's places are
+searched with its rigid statics instead (`laws.rigid_allocation`, which `allocate` calls).
 
 The statics of a place: UAV i at r_i from the point above the payload, h_i above it, on its
 cable of length l_i (h_i = sqrt(l_i^2 - r_i^2)), pulling along u_i horizontally. Its cable's

@@ -251,19 +251,21 @@ def test_v3_mixed_saturates_fixed_and_carries_its_load_reorganised(tmp_path):
 
 
 def test_v3_mixed_flies_with_its_cables_allocated(tmp_path):
-    """cable_forces on v3_mixed (docs/loads.md: it meets the issue's bar only in part): the
-    mission flown to its end, no rotor saturated (from the file's start places, the shares
-    fed forward), tracking within the seed's on multi_lift plus 20 %, UAV 3's least margin
-    above 4 % (4.55 % measured, at the second gust: thrust_margin's 4.74 % is not reached)."""
+    """cable_forces on v3_mixed (issue 35 item 3's bar): the mission flown to its end, no
+    rotor saturated (from the file's start places, the shares fed forward), tracking within
+    the seed's on multi_lift plus 20 %, every cable pulling, and UAV 3's least thrust margin
+    over the run at least the reorganising formation's (the same file flown with
+    `thrust_margin`) and at least 4.9 %: the allocation solves the shares directly."""
     seed = _flown(scenario_io.load('multi_lift'))['leader']['max_tracking_error']
     allocated = scenario_io.load(_v3_mixed(tmp_path, reorganize='cable_forces'))
     assert allocated.control.follower == 'cable_forces'
     whole = _flown(allocated)
-    after = (whole['sim']['saturated_time'][2]
-             - _flown(allocated, HOVER)['sim']['saturated_time'][2])
-    assert after == 0.0 and sum(whole['sim']['saturated_time']) == 0.0  # no rotor, no UAV
+    gradient = _flown(scenario_io.load('v3_mixed'))['sim']['least_thrust_margin']
+    assert sum(whole['sim']['saturated_time']) == 0.0  # no rotor, no UAV
     assert whole['leader']['max_tracking_error'] <= 1.2 * seed
-    assert whole['sim']['min_tension'] > 0.1 and whole['sim']['least_thrust_margin'][2] > 0.04
+    assert whole['sim']['min_tension'] > 0.1
+    least = whole['sim']['least_thrust_margin']
+    assert min(least) >= min(gradient) and least[2] >= gradient[2] and least[2] >= 0.049
 
 
 def test_the_hover_feedforward_is_the_statics_share_of_the_geometry_flown():

@@ -8,7 +8,8 @@ g e_z + a is vertical, the formation tilted as one body), the tensions nearest t
 that the followers feed forward (`allocated_statics`), and the followers' step towards them
 (`allocate`), rate limited and within the spacing and spread limits of `laws.reorganize`
 (whose statics, apparent gravity and memory it shares: constants FOLLOWER_* then REORGANIZE_*,
-memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT).
+memory FOLLOWER_* then REORGANIZE_ACCELERATION and REORGANIZE_SHIFT). A rigid body's places are
+searched with its rigid statics instead (`laws.rigid_allocation`, which `allocate` calls).
 
 The statics of a place: UAV i at r_i from the point above the payload, h_i above it, on its
 cable of length l_i (h_i = sqrt(l_i^2 - r_i^2)), pulling along u_i horizontally. Its cable's
@@ -26,9 +27,10 @@ from multilift_control.laws.layout import (FOLLOWER_GRAVITY, REORGANIZE_DEPTH, R
                                            REORGANIZE_UAV_LARGEST, REORGANIZE_UAV_LENGTH,
                                            REORGANIZE_UAV_MASS, REORGANIZE_UAV_SIZE,
                                            REORGANIZE_UAVS)
-from multilift_control.laws.reorganize import (LEAST_TENSION_SHARE, TAUT, _begin, _kept,
-                                              cable_tensions, hang_point, statics_hold)
-from multilift_control.laws.rigid_allocation import body_allocated_places
+from multilift_control.laws.reorganize import (TAUT, _begin, _kept,
+                                              cable_tensions, hang_point, hover_statics,
+                                              statics_hold)
+from multilift_control.laws.rigid_allocation import body_allocation_step
 
 SHARE_MARGIN = 0.02  # n >= 3: every share at most 1/2 less this [-] (a polygon of forces)
 BISECTIONS = 60      # halvings of a bracket: the utilisation's, n = 2's radius [-]
@@ -39,6 +41,13 @@ CLOSED = 1e-12       # the balance met within this share of sum_i s_i r_i / H [-
 # tension, solved again by the statics, would otherwise fall below it by a rounding and the
 # allocation's own places be refused [-]
 ROUNDING_GUARD = 1e-6
+# the least tension a cable keeps in the allocation, as a share of m_p |g e_z + a| / n [-]:
+# below `laws.reorganize`'s LEAST_TENSION_SHARE (a third), which the gradient's formation also
+# leaves between v3_mixed's corners (UAV 3's cable 0.53 N median over 80-95 s against the third's
+# 0.87 N; docs/loads.md). At a third UAV 3's least margin was 4.55 % (the second gust); at 0.27
+# it keeps 5.06 % and its cable 0.16 N at least, flown (the climb's start, t = 10.0 s: the
+# leader's step takes 0.55 N from it at once)
+ALLOCATED_TENSION_SHARE = 0.27
 
 
 @jit
@@ -50,15 +59,15 @@ def _uav(constants, j, slot):
 @jit
 def share_bounds(constants, n):
     """(low (n,), high (n,)) [-]: the shares s_i each of n cables may carry. Low: its
-    tension at least LEAST_TENSION_SHARE of the even share W / n (`laws.reorganize`'s slack
-    bound, which is on the tension T_i = s_i W l_i / h_i, so s_i >= LEAST_TENSION_SHARE h_i /
-    (n l_i), h_i the depth REORGANIZE_DEPTH of the level start; ROUNDING_GUARD above). High:
+    tension at least ALLOCATED_TENSION_SHARE of the even share W / n (the slack bound, on the
+    tension T_i = s_i W l_i / h_i, so s_i >= ALLOCATED_TENSION_SHARE h_i / (n l_i), h_i the
+    depth REORGANIZE_DEPTH of the level start; ROUNDING_GUARD above). High:
     n >= 3 below 1/2 less SHARE_MARGIN (no side of a polygon of forces longer than the others
     together); n = 2 one less the other's low."""
     low = np.empty(n)
     high = np.empty(n)
     for j in range(n):
-        low[j] = (LEAST_TENSION_SHARE * (1.0 + ROUNDING_GUARD) * constants[REORGANIZE_DEPTH]
+        low[j] = (ALLOCATED_TENSION_SHARE * (1.0 + ROUNDING_GUARD) * constants[REORGANIZE_DEPTH]
                   / (n * _uav(constants, j, REORGANIZE_UAV_LENGTH)))
     for j in range(n):
         high[j] = 0.5 - SHARE_MARGIN if n > 2 else 1.0 - low[1 - j]
@@ -257,22 +266,21 @@ def level_places(constants, gravity, places):
 
 @jit
 def allocate(constants, memory, t, masses, rows, targets, vectors):
-    """`reorganize`'s tick for `formation.reorganize: cable_forces` (n >= 2 UAVs, a point
-    payload): each follower's place moves towards `allocated_places` at the apparent gravity,
-    at most REORGANIZE_MAX_RATE, and is kept within the limits and where its cables keep their
-    least tension (`tensions_hold`; `_kept`, its height too: n = 2's follower climbs or sinks
-    to its place); returns targets + shift (m,)
-    [m]."""
+    """`reorganize`'s tick for `formation.reorganize: cable_forces` (n >= 2 UAVs): a point
+    payload's followers move towards `allocated_places` at the apparent gravity, at most
+    REORGANIZE_MAX_RATE, kept within the limits and where every cable keeps its least tension
+    (`tensions_hold`; `_kept`, the height too: n = 2's follower climbs or sinks to its place);
+    a rigid body's take `laws.rigid_allocation.body_allocation_step` (x, y; kept where its
+    rigid statics hold, `statics_hold`). Returns targets + shift (m,) [m]."""
     n = vectors.shape[0]
     dt, effective, shift, places = _begin(constants, memory, t, masses, rows, targets, vectors)
-    rigid = constants[REORGANIZE_RIGID] != 0.0
-    if rigid:  # a rigid body's (laws.rigid_allocation): the places move in x, y only
-        wanted = body_allocated_places(constants, effective)
-        wanted[:, 2] = places[:, 2]
-    else:
-        wanted, found = allocated_places(constants, effective, places)
-        if not found:  # the places hold
-            return _kept(rows, targets, shift, constants, places, 3, False)
+    if constants[REORGANIZE_RIGID] != 0.0:  # the rigid statics (laws.rigid_statics)
+        moved = body_allocation_step(constants, places, effective, dt)
+        return _kept(rows, targets, shift, constants, moved, 2,
+                     statics_hold(constants, moved, effective))
+    wanted, found = allocated_places(constants, effective, places)
+    if not found:  # the places hold
+        return _kept(rows, targets, shift, constants, places, 3, False)
     moved = places.copy()
     step = constants[REORGANIZE_MAX_RATE] * dt
     for j in range(1, n):
@@ -283,9 +291,6 @@ def allocate(constants, memory, t, masses, rows, targets, vectors):
         scale = 1.0 if gap <= step else step / gap
         for d in range(3):
             moved[j, d] += scale * (wanted[j, d] - places[j, d])
-    if rigid:  # the rigid statics (laws.rigid_statics through reorganize.cable_statics)
-        return _kept(rows, targets, shift, constants, moved, 2,
-                     statics_hold(constants, moved, effective))
     return _kept(rows, targets, shift, constants, moved, 3,
                  tensions_hold(constants, moved, effective))
 
@@ -329,7 +334,11 @@ def nearest_tensions(constants, places, effective):
 @jit
 def allocated_statics(constants, places):
     """(T (n,) [N], e (n, 3), found) at hover (`nearest_tensions` under g e_z): as
-    `laws.reorganize.hover_statics`, the tensions the followers feed forward."""
+    `laws.reorganize.hover_statics`, the tensions the followers feed forward; a rigid body's
+    are its rigid statics' (`hover_statics` itself: its cables do not meet at a point, and the
+    point payload's hang put 0.34 s of UAV 2's saturation in beam_lift's start)."""
+    if constants[REORGANIZE_RIGID] != 0.0:
+        return hover_statics(constants, places)
     return nearest_tensions(constants, places,
                             np.array((0.0, 0.0, constants[FOLLOWER_GRAVITY])))
 
@@ -337,12 +346,12 @@ def allocated_statics(constants, places):
 @jit
 def tensions_hold(constants, places, effective):
     """Whether the payload hangs from the UAVs at `places` (n, 3) [m] under `effective`
-    [m/s^2] with every `nearest_tensions` at least LEAST_TENSION_SHARE of the even share
+    [m/s^2] with every `nearest_tensions` at least ALLOCATED_TENSION_SHARE of the even share
     m_p |g_eff| / n (`laws.reorganize.statics_hold` with the allocation's tensions)."""
     n = places.shape[0]
     tensions, _, found = nearest_tensions(constants, places, effective)
     size = math.sqrt(effective[0] ** 2 + effective[1] ** 2 + effective[2] ** 2)
-    least = LEAST_TENSION_SHARE * constants[REORGANIZE_PAYLOAD_MASS] * size / n
+    least = ALLOCATED_TENSION_SHARE * constants[REORGANIZE_PAYLOAD_MASS] * size / n
     if not found:
         return False
     for j in range(n):

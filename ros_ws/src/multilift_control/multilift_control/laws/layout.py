@@ -129,9 +129,7 @@ REORGANIZE_AT_REST = FOLLOWER_SIZE + 9        # 1: a point payload's statics in 
 #                                               (laws.reorganize.static_pulls), 0: none
 REORGANIZE_RIGID = FOLLOWER_SIZE + 10         # 1: a rigid-body payload's statics
 #                                               (laws.rigid_statics), 0: a point payload's
-REORGANIZE_RADIUS = FOLLOWER_SIZE + 11        # a rigid body's cable_forces: the UAVs' mean
-#                                               horizontal distance from its centre at the start [m]
-REORGANIZE_UAVS = FOLLOWER_SIZE + 12          # then a row of REORGANIZE_UAV_SIZE per UAV:
+REORGANIZE_UAVS = FOLLOWER_SIZE + 11          # then a row of REORGANIZE_UAV_SIZE per UAV:
 REORGANIZE_UAV_MASS = 0                       # its vehicle's mass m_i [kg]
 REORGANIZE_UAV_LARGEST = 1                    # u_T,max,i, every rotor at its limit [N]
 REORGANIZE_UAV_LENGTH = 2                     # its cable's length l_i [m]

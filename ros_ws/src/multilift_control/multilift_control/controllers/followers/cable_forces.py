@@ -1,10 +1,12 @@
-"""Cable-force allocation (`formation.reorganize: cable_forces`, issue 35 item 3, three UAVs and
-a point payload): each tick the share of the payload's apparent weight each cable should carry
-so that every UAV flies at the same share of its largest thrust (the least effort under the
-thrust limits; `laws.cable_forces.load_shares`, closed form), and the places where level cables
-pull those forces (`allocated_places`: the triangle of forces); the followers' offsets move
-there at `formation.max_offset_rate` within the spacing and spread limits
-(`laws.cable_forces.allocate`) and the followers fly the seed's virtual-constraint law to them.
+"""Cable-force allocation (`formation.reorganize: cable_forces`, issue 35 item 3, two UAVs or
+more): for a point payload each tick the share of the payload's apparent weight each cable
+should carry so that the UAVs' largest thrust utilisation is least (the least effort under the
+thrust limits; `laws.cable_forces.load_shares`, closed form), and the places where the cables
+pull those forces (`allocated_places`: for three, the triangle of forces); for a rigid body the
+places whose rigid statics make that utilisation least (`laws.rigid_allocation`, searched); the
+followers' offsets move there at `formation.max_offset_rate` within the spacing and spread
+limits (`laws.cable_forces.allocate`) and the followers fly the seed's virtual-constraint law
+to them.
 Its arrays are `thrust_margin`'s in REORGANIZE_ALLOCATE mode, its answer that part's."""
 from __future__ import annotations
 

@@ -335,12 +335,15 @@ def reorganize(constants, memory, t, masses, rows, targets, vectors):
     returned as the targets the follower keeps (targets + shift, (m,) [m]): the apparent
     gravity (`filtered_gravity`), the cost's gradient over the followers' horizontal places,
     each follower's rate -REORGANIZE_GAIN grad clipped to REORGANIZE_MAX_RATE, the step taken
-    when its places keep the limits and the payload hangs. Call before `follower_update`,
-    which advances FOLLOWER_LAST_T."""
+    when its places keep the limits and the payload hangs there and at every probe of the
+    gradient (where it cannot, the cost is infinite: no step this tick, as a NaN rate refused
+    it before, without the NaN). Call before `follower_update`, which advances
+    FOLLOWER_LAST_T."""
     n = vectors.shape[0]
     dt, effective, shift, places = _begin(constants, memory, t, masses, rows, targets, vectors)
     floor = constants[REORGANIZE_FLOOR]
     moved = places.copy()
+    refused = False  # a probe where the payload cannot hang refuses this tick's step
     for j in range(1, n):
         rate = np.zeros(2)
         for d in range(2):
@@ -351,13 +354,14 @@ def reorganize(constants, memory, t, masses, rows, targets, vectors):
             behind = margin_cost(static_margins(constants, probe, effective), floor)
             rate[d] = -constants[REORGANIZE_GAIN] * (ahead - behind) / (2.0 * STEP)
         speed = math.sqrt(rate[0] ** 2 + rate[1] ** 2)
+        if not math.isfinite(speed):
+            refused = True
+            continue
         limit = constants[REORGANIZE_MAX_RATE]
         scale = limit / speed if speed > limit else 1.0
-        if not math.isfinite(speed):
-            scale = 0.0
         for d in range(2):
             moved[j, d] += scale * rate[d] * dt
     if dt == 0.0:
         moved = places
     return _kept(rows, targets, shift, constants, moved, 2,
-                 statics_hold(constants, moved, effective))
+                 (dt == 0.0 or not refused) and statics_hold(constants, moved, effective))

@@ -70,8 +70,8 @@ class EngineBag:
         _add_topics(scenario, writer, controllers)
         self._controllers = controllers
         self._commands = scenario.controlled  # none when every UAV's motion is prescribed
-        self._scenario, self._engine, self._write = scenario, engine, writer.write_many
-        self._bag = writer
+        self._scenario, self._engine = scenario, engine
+        self._write, self._write_block = writer.write_many, writer.write_block
         self._simulator = SimulatorMessages(scenario)
         self._answers = AnswerMessages(scenario)
         self._n = scenario.n_uavs
@@ -200,7 +200,7 @@ class EngineBag:
             second.append(Column(MARKERS, np.frombuffer(b''.join(markers[m] for m in shown),
                                                         np.uint8).reshape(len(shown), -1),
                                  marker_ticks[shown] - start))
-        self._bag.write_block(t_ns[start:stop], [
+        self._write_block(t_ns[start:stop], [
             [Column(topic, rows[start:stop]) for topic, rows in first], second])
 
     def last(self) -> None:
